@@ -1,0 +1,165 @@
+#pragma once
+// The configuration document (YAML, version 1) as plain structs, before any block is built.
+// parse_config_file() checks structure, keys, types and ranges of everything it can check
+// without the block registry; build_runtime() (runtime.hpp) checks block types, parameters and
+// wires. Both report every problem as file:line:col. docs/config.md is the user-facing schema.
+// Non-RT; thread-compatible.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "edm/runtime/diagnostics.hpp"
+#include "edm/runtime/time.hpp"
+
+namespace edm::rt {
+
+/// A name written in the config, with where it was written.
+struct NameRef {
+  std::string name;
+  SourceLoc loc;
+};
+
+/// One `key: value` under a `params:` map. Values are scalars, kept as written; the builder
+/// converts them to the parameter's type (and reports type errors at value_loc).
+struct ParamSetting {
+  std::string key;
+  std::string value;      // the scalar's text
+  bool quoted{false};     // the scalar was quoted ("1.0" is then a string, not a number)
+  SourceLoc key_loc;
+  SourceLoc value_loc;
+};
+
+struct BlockSpec {
+  std::string name;
+  std::string type;
+  std::vector<ParamSetting> params;
+  SourceLoc loc;       // the block entry
+  SourceLoc name_loc;  // the name's value
+  SourceLoc type_loc;  // the type's value
+};
+
+/// `dest: source` under `wires:`. dest is `block.pin` or `io.pin` (an input); source is
+/// `block.pin`, `program.block.pin` or `io.pin` (an output), or a constant.
+struct WireSpec {
+  std::string dest;
+  std::string source;          // text of the scalar
+  bool source_is_name{true};   // false: a constant (number or true/false)
+  SourceLoc dest_loc;
+  SourceLoc source_loc;
+};
+
+struct ProgramSpec {
+  std::string name;
+  std::vector<BlockSpec> blocks;
+  std::vector<WireSpec> wires;
+  SourceLoc loc;
+  SourceLoc name_loc;
+};
+
+enum class WatchdogAction : std::uint8_t { kFault, kWarn };
+enum class OverrunPolicy : std::uint8_t { kSkip, kAsap };
+
+struct WatchdogSpec {
+  bool enabled{false};
+  Duration time{};            // > 0 when enabled
+  int sensitivity{1};         // >= 1
+  WatchdogAction action{WatchdogAction::kFault};
+  SourceLoc loc;
+};
+
+struct TaskSpec {
+  std::string name;
+  Duration interval{};        // > 0
+  int priority{0};            // 0 = highest, 0..31
+  std::optional<int> cpu;     // >= 0
+  WatchdogSpec watchdog;
+  OverrunPolicy overrun{OverrunPolicy::kSkip};
+  std::vector<NameRef> programs;  // in execution order
+  SourceLoc loc;
+  SourceLoc name_loc;
+};
+
+struct IoSpec {
+  std::string driver{"loopback"};
+  std::optional<NameRef> task;  // default: the highest-priority task (lowest number; first wins)
+  std::vector<ParamSetting> params;
+  SourceLoc loc;
+  SourceLoc driver_loc;
+};
+
+struct AxisSpec {
+  std::string name;           // X, Y or Z
+  double min_mm{0.0};
+  double max_mm{0.0};         // > min_mm
+  double v_max_mm_s{10.0};    // > 0
+  double a_max_mm_s2{1000.0}; // > 0
+  SourceLoc loc;
+};
+
+struct MachineSpec {
+  std::string name;
+  IoSpec io;
+  std::vector<AxisSpec> axes;
+  SourceLoc loc;
+};
+
+enum class Polarity : std::uint8_t { kNegative, kPositive };
+
+/// A machining condition (selected by E number).
+struct ConditionSpec {
+  int e{0};                    // >= 1, unique
+  std::string name;
+  Polarity polarity{Polarity::kNegative};
+  double open_voltage_v{120.0};
+  double peak_current_a{10.0};
+  double on_time_us{20.0};
+  double off_time_us{40.0};
+  double tdr_us{8.0};          // reference ignition delay for the gap controller
+  double servo_ref_v{40.0};    // reference mean gap voltage for voltage-based servos
+  double wear_ratio{0.0};      // electrode volume / workpiece volume, 0..10
+  SourceLoc loc;
+};
+
+struct TraceSpec {
+  std::vector<NameRef> variables;
+  std::size_t capacity{8192};  // samples per task ring, power of two
+  SourceLoc loc;
+};
+
+struct BridgeSpec {
+  std::string bind{"127.0.0.1"};
+  int port{7730};                   // 0 = no bridge
+  std::string token_file;           // operator role
+  std::string viewer_token_file;    // viewer role
+  int max_sessions{8};
+  std::size_t max_line_bytes{1u << 20};
+  SourceLoc loc;
+};
+
+struct RetainSpec {
+  std::string file;                 // empty = no retain store
+  Duration min_interval{std::chrono::seconds(1)};  // rate limit of on-change writes
+  std::vector<NameRef> variables;
+  SourceLoc loc;
+};
+
+struct Config {
+  std::string path;
+  int version{1};
+  MachineSpec machine;
+  std::vector<ConditionSpec> conditions;
+  std::vector<TaskSpec> tasks;
+  std::vector<ProgramSpec> programs;
+  TraceSpec trace;
+  BridgeSpec bridge;
+  RetainSpec retain;
+};
+
+/// Reads and checks a config file. Throws ConfigError listing every problem (file:line:col).
+Config parse_config_file(const std::string& path);
+/// Same, from text (path is used in messages only).
+Config parse_config_text(const std::string& text, const std::string& path);
+
+}  // namespace edm::rt

@@ -1,0 +1,173 @@
+#pragma once
+// Typed pins: the data inputs and outputs of blocks, drivers and programs.
+//
+// An Output owns its value; an Input holds a direct pointer to the Output it is wired to
+// (resolved once at load), or to its own constant when unwired. Values live in relaxed atomics,
+// so any thread (trace, bridge, stats) reads a pin without tearing and without a lock; on x86-64
+// these are plain loads and stores.
+//
+// Forcing (as in CODESYS): a forced pin takes the forced value regardless of the program.
+//  - forced Output: every set() by the owning block stores the forced value instead, so every
+//    reader (wires, trace, bridge, I/O) sees the forced value from the next cycle on;
+//  - forced Input: get() returns the forced value; the wire is not read.
+// unforce() returns the pin to its computed value: at the next set() for outputs, at once for
+// inputs.
+//
+// RT-safe: get(), set(). Non-RT: connect(), set_constant(). force()/unforce() may be called from
+// any thread. Pins are neither copyable nor movable (wires point at them).
+
+#include <atomic>
+#include <cstdint>
+#include <string_view>
+
+namespace edm::rt {
+
+/// IEC 61131-3 elementary types used on pins: BOOL, LINT (64-bit integer), LREAL (double).
+enum class PinType : std::uint8_t { kBool, kInt, kReal };
+
+std::string_view to_string(PinType t) noexcept;
+
+template <class T>
+struct PinTypeOf;
+template <>
+struct PinTypeOf<bool> {
+  static constexpr PinType value = PinType::kBool;
+};
+template <>
+struct PinTypeOf<std::int64_t> {
+  static constexpr PinType value = PinType::kInt;
+};
+template <>
+struct PinTypeOf<double> {
+  static constexpr PinType value = PinType::kReal;
+};
+
+template <class T>
+concept PinValue = requires { PinTypeOf<T>::value; };
+
+template <PinValue T>
+class Output {
+ public:
+  explicit Output(T initial = T{}) noexcept : value_(initial) {}
+  Output(const Output&) = delete;
+  Output& operator=(const Output&) = delete;
+
+  /// Writes the block's result (or the forced value while forced). RT-safe.
+  void set(T v) noexcept {
+    value_.store(forced_.load(std::memory_order_acquire)
+                     ? force_value_.load(std::memory_order_relaxed)
+                     : v,
+                 std::memory_order_relaxed);
+  }
+  /// Current value. RT-safe, any thread.
+  [[nodiscard]] T get() const noexcept { return value_.load(std::memory_order_relaxed); }
+
+  void force(T v) noexcept {
+    force_value_.store(v, std::memory_order_relaxed);
+    forced_.store(true, std::memory_order_release);
+    value_.store(v, std::memory_order_relaxed);
+  }
+  void unforce() noexcept { forced_.store(false, std::memory_order_release); }
+  [[nodiscard]] bool forced() const noexcept { return forced_.load(std::memory_order_acquire); }
+
+  [[nodiscard]] const std::atomic<T>& cell() const noexcept { return value_; }
+
+ private:
+  std::atomic<T> value_;
+  std::atomic<T> force_value_{};
+  std::atomic<bool> forced_{false};
+};
+
+template <PinValue T>
+class Input {
+ public:
+  /// default_value is what an unwired input reads (YAML may replace it with a constant).
+  explicit Input(T default_value = T{}) noexcept : constant_(default_value) {}
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
+
+  /// The wired source's current value, the constant if unwired, or the forced value. RT-safe.
+  [[nodiscard]] T get() const noexcept {
+    if (forced_.load(std::memory_order_acquire)) {
+      return force_value_.load(std::memory_order_relaxed);
+    }
+    return src_->load(std::memory_order_relaxed);
+  }
+
+  /// Wires this input to an output. Non-RT (load time only).
+  void connect(const Output<T>& source) noexcept {
+    src_ = &source.cell();
+    connected_ = true;
+  }
+  /// Makes this input read a constant. Non-RT (load time only).
+  void set_constant(T v) noexcept {
+    constant_.store(v, std::memory_order_relaxed);
+    src_ = &constant_;
+    connected_ = false;
+  }
+  [[nodiscard]] bool connected() const noexcept { return connected_; }
+
+  void force(T v) noexcept {
+    force_value_.store(v, std::memory_order_relaxed);
+    forced_.store(true, std::memory_order_release);
+  }
+  void unforce() noexcept { forced_.store(false, std::memory_order_release); }
+  [[nodiscard]] bool forced() const noexcept { return forced_.load(std::memory_order_acquire); }
+
+ private:
+  std::atomic<T> constant_;
+  const std::atomic<T>* src_{&constant_};
+  std::atomic<T> force_value_{};
+  std::atomic<bool> forced_{false};
+  bool connected_{false};
+};
+
+enum class PinDir : std::uint8_t { kInput, kOutput };
+
+/// A type-erased reference to one pin, as handed to PinVisitor implementations.
+struct PinRef {
+  PinDir dir{PinDir::kInput};
+  PinType type{PinType::kReal};
+  void* pin{nullptr};
+
+  template <PinValue T>
+  static PinRef of(Input<T>& p) noexcept {
+    return {PinDir::kInput, PinTypeOf<T>::value, &p};
+  }
+  template <PinValue T>
+  static PinRef of(Output<T>& p) noexcept {
+    return {PinDir::kOutput, PinTypeOf<T>::value, &p};
+  }
+  template <PinValue T>
+  [[nodiscard]] Input<T>* as_input() const noexcept {
+    return dir == PinDir::kInput && type == PinTypeOf<T>::value ? static_cast<Input<T>*>(pin)
+                                                                : nullptr;
+  }
+  template <PinValue T>
+  [[nodiscard]] Output<T>* as_output() const noexcept {
+    return dir == PinDir::kOutput && type == PinTypeOf<T>::value ? static_cast<Output<T>*>(pin)
+                                                                 : nullptr;
+  }
+};
+
+/// Reads a pin of any type as a double (bool → 0/1). RT-safe, any thread.
+double read_pin_as_double(const PinRef& ref) noexcept;
+
+/// Visits the pins of a block in declaration order. Blocks call input()/output() for each pin.
+class PinVisitor {
+ public:
+  virtual ~PinVisitor() = default;
+  template <PinValue T>
+  void input(std::string_view name, Input<T>& pin, std::string_view unit = {}) {
+    on_pin(name, PinRef::of(pin), unit);
+  }
+  template <PinValue T>
+  void output(std::string_view name, Output<T>& pin, std::string_view unit = {}) {
+    on_pin(name, PinRef::of(pin), unit);
+  }
+
+ protected:
+  virtual void on_pin(std::string_view name, PinRef ref, std::string_view unit) = 0;
+};
+
+}  // namespace edm::rt
