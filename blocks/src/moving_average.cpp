@@ -1,0 +1,93 @@
+#include "edm/blocks/moving_average.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edm::blocks {
+namespace {
+
+// Index of `window` in MovingAverageParams::visit().
+constexpr std::size_t kWindowIndex = 0;
+
+}  // namespace
+
+std::vector<rt::ParamError> MovingAverageParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "window", static_cast<double>(window), 1.0,
+                    static_cast<double>(kMaxWindow));
+  return errs;
+}
+
+void MovingAverage::CompensatedSum::add(double x) noexcept {
+  // Knuth's TwoSum: s + e == hi + x exactly (needs strict IEEE evaluation: no -ffast-math).
+  const double s = hi + x;
+  const double b = s - hi;
+  const double e = (hi - (s - b)) + (x - b);
+  hi = s;
+  lo += e;
+}
+
+void MovingAverage::visit_pins(rt::PinVisitor& v) {
+  v.input("in", in_);
+  v.output("out", out_);
+  v.output("full", full_);
+}
+
+std::vector<rt::ParamError> MovingAverage::configure(const rt::BlockSetup& /*setup*/) {
+  auto errs = params_.validate();
+  if (!errs.empty()) {
+    return errs;
+  }
+  buf_.assign(static_cast<std::size_t>(params_.window), 0.0);
+  activate();
+  return errs;
+}
+
+void MovingAverage::activate() noexcept {
+  std::fill(buf_.begin(), buf_.end(), 0.0);
+  next_ = 0;
+  count_ = 0;
+  sum_ = {};
+  pass_sum_ = {};
+  out_.set(0.0);
+  full_.set(false);
+}
+
+rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const double x = in_.get();
+  const std::size_t window = buf_.size();
+  if (!std::isfinite(x) || window == 0) {  // window 0: not configured
+    return rt::BlockStatus::kFault;
+  }
+  const double old = count_ == window ? buf_[next_] : 0.0;
+  buf_[next_] = x;
+  sum_.add(x);
+  sum_.add(-old);
+  pass_sum_.add(x);
+  if (++next_ == window) {
+    // The buffer now holds exactly the samples of this pass: restart from their sum.
+    next_ = 0;
+    sum_ = pass_sum_;
+    pass_sum_ = {};
+  }
+  if (count_ < window) {
+    ++count_;
+  }
+  const double mean = sum_.value() / static_cast<double>(count_);
+  full_.set(count_ == window);
+  if (!std::isfinite(mean)) {
+    return rt::BlockStatus::kFault;
+  }
+  out_.set(mean);
+  return rt::BlockStatus::kOk;
+}
+
+std::vector<rt::ParamError> MovingAverage::stage_param(std::size_t index,
+                                                       const rt::ParamValue& v) {
+  if (index == kWindowIndex) {
+    return {{"window", "cannot change at run time (it sizes the buffer); reload the config"}};
+  }
+  return BlockWithParams::stage_param(index, v);
+}
+
+}  // namespace edm::blocks

@@ -1,0 +1,93 @@
+#pragma once
+// The runtime: everything a config describes, built and wired — the I/O driver, the programs
+// and their blocks, the tasks, the variable registry, the trace recorder and the retain store —
+// and run on the real or the virtual clock.
+//
+// Thread-safety: build and run from one controlling thread. While running, machine(),
+// variables() and stats are safe to use from other non-RT threads.
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/io_driver.hpp"
+#include "edm/runtime/machine.hpp"
+#include "edm/runtime/program.hpp"
+#include "edm/runtime/retain.hpp"
+#include "edm/runtime/stats_json.hpp"
+#include "edm/runtime/task.hpp"
+#include "edm/runtime/trace.hpp"
+#include "edm/runtime/type_registry.hpp"
+#include "edm/runtime/variables.hpp"
+
+namespace edm::rt {
+
+struct BuildOptions {
+  std::optional<std::uint64_t> seed;  // overrides the driver's seed (--seed)
+  bool load_retain{true};             // read the retain file (and start the store) at build
+};
+
+struct RunOptions {
+  ClockKind clock{ClockKind::kReal};
+  std::optional<Duration> run_for;            // nullopt: until *stop
+  const std::atomic<bool>* stop{nullptr};     // set by a signal handler
+  std::string trace_out;                      // CSV path; empty: no trace file
+};
+
+struct RunSummary {
+  MachineState final_state{MachineState::kOff};
+  bool fifo_degraded{false};
+  std::uint64_t trace_dropped{0};
+  std::uint64_t alarms_dropped{0};
+};
+
+class Runtime {
+ public:
+  /// Builds everything the config describes. Throws ConfigError (every problem, file:line:col).
+  static std::unique_ptr<Runtime> build(const Config& cfg, const BlockRegistry& blocks,
+                                        const DriverRegistry& drivers,
+                                        const BuildOptions& options = {});
+  ~Runtime();
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  /// Powers on (READY), runs the tasks until run_for elapses or *stop, then stops in order:
+  /// safe state, tasks joined, retain flushed, trace written. Throws std::runtime_error on a
+  /// start-up failure (threads, CPU, trace file).
+  RunSummary run(const RunOptions& options);
+
+  [[nodiscard]] Machine& machine() noexcept { return machine_; }
+  [[nodiscard]] VariableRegistry& variables() noexcept { return variables_; }
+  [[nodiscard]] IoDriver& driver() noexcept { return *driver_; }
+  [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept {
+    return tasks_;
+  }
+  [[nodiscard]] Program* program(std::string_view name) const;
+  [[nodiscard]] TraceRecorder& trace() noexcept { return trace_; }
+  [[nodiscard]] RetainStore* retain() noexcept { return retain_.get(); }
+  [[nodiscard]] const std::string& retain_warning() const noexcept { return retain_warning_; }
+  [[nodiscard]] std::vector<TaskStatsReport> stats_reports() const;
+  [[nodiscard]] const Config& config() const noexcept { return config_; }
+
+ private:
+  friend class RuntimeBuilder;
+  Runtime() = default;
+  void drain_alarms();
+
+  Config config_;
+  Machine machine_;
+  std::unique_ptr<IoDriver> driver_;
+  std::vector<std::unique_ptr<Program>> programs_;
+  std::vector<std::unique_ptr<Task>> tasks_;
+  VariableRegistry variables_;
+  TraceRecorder trace_;
+  bool has_trace_{false};
+  std::unique_ptr<RetainStore> retain_;
+  std::string retain_warning_;
+};
+
+}  // namespace edm::rt

@@ -1,0 +1,75 @@
+#pragma once
+// Schedulers: when each task's run_cycle() is called.
+//
+// RealTimeScheduler — one thread per task, released on the absolute grid
+//   T0 + k·interval with clock_nanosleep(TIMER_ABSTIME); SCHED_FIFO priority 90 − priority when
+//   the process may use it (otherwise one loud warning and SCHED_OTHER); optional CPU
+//   affinity; stack pre-faulted. mlockall() is done once by lock_memory().
+// VirtualScheduler — one thread, deterministic: the task with the earliest release runs next,
+//   ties broken by priority (0 first), then by task order. A cycle executes atomically at its
+//   release time (no preemption in virtual time); execution time is zero unless a block charges
+//   time to the VirtualClock, in which case later releases start late (latency) and overrun
+//   rules apply exactly as on the real clock.
+//
+// Thread-safety: start()/stop()/run_until() from one controlling thread.
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/task.hpp"
+
+namespace edm::rt {
+
+/// Locks current and future memory (mlockall). Returns an empty string or a warning.
+std::string lock_memory();
+
+class RealTimeScheduler {
+ public:
+  RealTimeScheduler() = default;
+  ~RealTimeScheduler() { stop(); }
+  RealTimeScheduler(const RealTimeScheduler&) = delete;
+  RealTimeScheduler& operator=(const RealTimeScheduler&) = delete;
+
+  /// Starts one thread per task; all grids start at the same T0 (now + lead time). Throws
+  /// std::runtime_error if a thread cannot be created or a CPU is not available.
+  void start(const std::vector<Task*>& tasks, const RealClock& clock);
+  /// Asks every task thread to finish its current cycle, then joins them. Idempotent.
+  void stop();
+  /// True if any task fell back from SCHED_FIFO to SCHED_OTHER.
+  [[nodiscard]] bool degraded() const noexcept { return degraded_.load(); }
+
+ private:
+  void task_main(Task& task, TimePoint t0) noexcept;
+
+  const RealClock* clock_{nullptr};
+  std::vector<std::thread> threads_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> degraded_{false};
+  std::atomic<bool> warned_{false};
+};
+
+class VirtualScheduler {
+ public:
+  /// Tasks all start their grid at the clock's current time.
+  VirtualScheduler(std::vector<Task*> tasks, VirtualClock& clock);
+
+  /// Runs cycles whose release is < end (virtual time), then sets the clock to end. Calls
+  /// between_cycles (if set) after every cycle; stops early when *stop becomes true.
+  void run_until(TimePoint end, const std::function<void()>& between_cycles = {},
+                 const std::atomic<bool>* stop = nullptr);
+
+  [[nodiscard]] TimePoint next_release(std::size_t task_index) const {
+    return next_[task_index];
+  }
+
+ private:
+  std::vector<Task*> tasks_;
+  std::vector<TimePoint> next_;
+  VirtualClock* clock_;
+};
+
+}  // namespace edm::rt

@@ -1,0 +1,90 @@
+#pragma once
+// The variable registry: every pin and parameter of every block (and of the I/O driver) as a
+// variable named `program.block.pin` (driver: `io.pin`), listable, readable, writable
+// (parameters) and forceable (pins).
+//
+// Reads of pins are lock-free atomic loads. Parameter reads and writes go through the block's
+// shadow parameter copy under a mutex (non-RT threads only); an accepted write is queued to the
+// owning task and applied at the start of its next cycle. The RT threads never touch this
+// registry. Forcing semantics: see pin.hpp.
+//
+// Thread-safety: all members are thread-safe for non-RT callers once the runtime is built.
+
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+#include "edm/runtime/param.hpp"
+#include "edm/runtime/pin.hpp"
+
+namespace edm::rt {
+
+class Task;
+
+enum class VarKind : std::uint8_t { kInput, kOutput, kParam };
+std::string_view to_string(VarKind k) noexcept;
+
+struct Variable {
+  std::string name;     // program.block.pin | io.pin
+  VarKind kind{VarKind::kOutput};
+  PinRef pin{};         // pins
+  Block* block{nullptr};
+  std::uint32_t param_index{0};
+  ParamType param_type{ParamType::kReal};
+  std::string unit;
+  Task* owner{nullptr};  // the task whose thread updates it
+
+  [[nodiscard]] bool is_pin() const noexcept { return kind != VarKind::kParam; }
+  /// The IEC type name: BOOL, LINT, LREAL, TIME, STRING.
+  [[nodiscard]] std::string_view type_name() const noexcept;
+};
+
+enum class VarResult : std::uint8_t {
+  kOk,
+  kNotFound,     // no such variable
+  kWrongKind,    // e.g. writing a pin or forcing a parameter
+  kTypeMismatch, // value does not fit the variable's type
+  kInvalid,      // the block's validate() refused it (message says why)
+  kBusy,         // the task's write queue is full
+};
+
+struct VarStatus {
+  VarResult result{VarResult::kOk};
+  std::string message;
+  explicit operator bool() const noexcept { return result == VarResult::kOk; }
+};
+
+class VariableRegistry {
+ public:
+  /// Adds a variable; false if the name exists. Non-RT, build time.
+  bool add(Variable v);
+
+  [[nodiscard]] const Variable* find(std::string_view name) const;
+  /// Every variable: pins sorted by name, then parameters in program and block order.
+  [[nodiscard]] const std::vector<Variable>& all() const noexcept { return vars_; }
+
+  /// Current value (pins: live value; params: the accepted value). Bools as 0/1, TIME in
+  /// seconds. nullopt for unknown names and string parameters.
+  [[nodiscard]] std::optional<double> read(std::string_view name) const;
+  [[nodiscard]] std::optional<ParamValue> read_param(std::string_view name) const;
+
+  /// Writes a parameter: checks type, validates on the block's shadow copy, queues it to the
+  /// owning task (or applies it at once when `apply_now`, only before tasks run).
+  VarStatus write(std::string_view name, double value, bool apply_now = false);
+  VarStatus write(std::string_view name, const ParamValue& value, bool apply_now = false);
+  /// Forces a pin to a value (converted to the pin's type: bool ≠ 0, integers must be whole).
+  VarStatus force(std::string_view name, double value);
+  VarStatus unforce(std::string_view name);
+  [[nodiscard]] std::vector<std::string> forced() const;
+
+ private:
+  std::vector<Variable> vars_;
+  std::unordered_map<std::string, std::size_t> index_;
+  mutable std::mutex param_mutex_;  // non-RT only: guards the blocks' shadow parameters
+};
+
+}  // namespace edm::rt

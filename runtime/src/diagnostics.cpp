@@ -1,0 +1,36 @@
+#include "edm/runtime/diagnostics.hpp"
+
+#include <utility>
+
+namespace edm::rt {
+
+std::string Diagnostic::str() const {
+  std::string out = loc.file;
+  if (loc.line > 0) {
+    if (!out.empty()) {
+      out += ':';
+    }
+    out += std::to_string(loc.line);
+    if (loc.col > 0) {
+      out += ':' + std::to_string(loc.col);
+    }
+  }
+  if (out.empty()) {
+    return message;
+  }
+  return out + ": " + message;
+}
+
+namespace {
+
+// runtime_error needs its message before diags_ exists, so build it from the argument.
+std::string first_message(const std::vector<Diagnostic>& diags) {
+  return diags.empty() ? std::string("invalid configuration") : diags.front().str();
+}
+
+}  // namespace
+
+ConfigError::ConfigError(std::vector<Diagnostic> diags)
+    : std::runtime_error(first_message(diags)), diags_(std::move(diags)) {}
+
+}  // namespace edm::rt

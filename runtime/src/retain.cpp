@@ -1,0 +1,589 @@
+#include "edm/runtime/retain.hpp"
+
+#include <fcntl.h>
+#include <pthread.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <chrono>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+namespace edm::rt {
+namespace {
+
+constexpr std::string_view kHeader = "edmplc-retain 1";
+constexpr std::string_view kHeaderMagic = "edmplc-retain ";
+constexpr std::string_view kEndPrefix = "end ";
+// Far above any real retain set; stops a wrong path (e.g. a disk image) from being slurped.
+constexpr std::size_t kMaxFileBytes = 64U * 1024U * 1024U;
+
+// Nibble table: 16 entries are enough for a few KB written at most once a second.
+constexpr std::array<std::uint32_t, 16> make_crc_table() {
+  std::array<std::uint32_t, 16> t{};
+  for (std::uint32_t n = 0; n < 16; ++n) {
+    std::uint32_t c = n;
+    for (int k = 0; k < 4; ++k) {
+      c = (c & 1U) != 0 ? 0xEDB88320U ^ (c >> 1) : c >> 1;
+    }
+    t[n] = c;
+  }
+  return t;
+}
+constexpr std::array<std::uint32_t, 16> kCrcTable = make_crc_table();
+
+std::string_view type_name(RetainType t) {
+  switch (t) {
+    case RetainType::kBool:
+      return "BOOL";
+    case RetainType::kInt:
+      return "LINT";
+    case RetainType::kReal:
+      return "LREAL";
+  }
+  return "?";
+}
+
+std::optional<RetainType> parse_type(std::string_view s) {
+  if (s == "BOOL") {
+    return RetainType::kBool;
+  }
+  if (s == "LINT") {
+    return RetainType::kInt;
+  }
+  if (s == "LREAL") {
+    return RetainType::kReal;
+  }
+  return std::nullopt;
+}
+
+void append_value(std::string& out, const RetainValue& v) {
+  std::array<char, 64> buf{};
+  std::to_chars_result res{};
+  switch (v.type) {
+    case RetainType::kBool:
+      out += v.b ? '1' : '0';
+      return;
+    case RetainType::kInt:
+      res = std::to_chars(buf.data(), buf.data() + buf.size(), v.i);
+      break;
+    case RetainType::kReal:
+      // Shortest representation that parses back to the same bits (C++17 to_chars guarantee).
+      res = std::to_chars(buf.data(), buf.data() + buf.size(), v.r);
+      break;
+  }
+  out.append(buf.data(), res.ptr);
+}
+
+std::optional<RetainValue> parse_value(RetainType t, std::string_view s) {
+  const char* first = s.data();
+  const char* last = s.data() + s.size();
+  switch (t) {
+    case RetainType::kBool:
+      if (s == "0" || s == "1") {
+        return RetainValue::make_bool(s == "1");
+      }
+      return std::nullopt;
+    case RetainType::kInt: {
+      std::int64_t v{};
+      auto [p, ec] = std::from_chars(first, last, v);
+      if (ec != std::errc{} || p != last || s.empty()) {
+        return std::nullopt;
+      }
+      return RetainValue::make_int(v);
+    }
+    case RetainType::kReal: {
+      double v{};
+      auto [p, ec] = std::from_chars(first, last, v);
+      if (ec != std::errc{} || p != last || s.empty()) {
+        return std::nullopt;
+      }
+      return RetainValue::make_real(v);
+    }
+  }
+  return std::nullopt;
+}
+
+// For warnings: a garbled line may hold control bytes or be huge.
+std::string printable(std::string_view s) {
+  constexpr std::size_t kMax = 40;
+  std::string out;
+  for (const char c : s.substr(0, kMax)) {
+    const auto u = static_cast<unsigned char>(c);
+    out += (u >= 0x20 && u < 0x7F) ? c : '?';
+  }
+  if (s.size() > kMax) {
+    out += "...";
+  }
+  return out;
+}
+
+std::string errno_text(int err) { return std::generic_category().message(err); }
+
+[[noreturn]] void throw_io(int err, const std::string& path, std::string_view step) {
+  throw std::system_error(err, std::generic_category(),
+                          fmt::format("retain file '{}': {}", path, step));
+}
+
+// Closes the fd on every path out of the writer.
+class Fd {
+ public:
+  explicit Fd(int fd) noexcept : fd_(fd) {}
+  ~Fd() {
+    if (fd_ >= 0) {
+      ::close(fd_);
+    }
+  }
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  [[nodiscard]] int get() const noexcept { return fd_; }
+  int release() noexcept { return std::exchange(fd_, -1); }
+
+ private:
+  int fd_;
+};
+
+// A failure after the temp file exists must not leave it behind.
+[[noreturn]] void fail_and_unlink(Fd& fd, const std::string& tmp, const std::string& path,
+                                  std::string_view step) {
+  const int err = errno;
+  ::close(fd.release());
+  ::unlink(tmp.c_str());
+  throw_io(err, path, step);
+}
+
+std::string temp_prefix(const std::string& path) { return path + ".tmp."; }
+
+std::string dir_of(const std::string& path) {
+  std::string dir = std::filesystem::path(path).parent_path().string();
+  return dir.empty() ? std::string(".") : dir;
+}
+
+TimePoint steady_now() {
+  return std::chrono::duration_cast<Duration>(
+      std::chrono::steady_clock::now().time_since_epoch());
+}
+
+}  // namespace
+
+bool operator==(const RetainValue& a, const RetainValue& b) noexcept {
+  if (a.type != b.type) {
+    return false;
+  }
+  switch (a.type) {
+    case RetainType::kBool:
+      return a.b == b.b;
+    case RetainType::kInt:
+      return a.i == b.i;
+    case RetainType::kReal:
+      return std::bit_cast<std::uint64_t>(a.r) == std::bit_cast<std::uint64_t>(b.r);
+  }
+  return false;
+}
+
+bool is_valid_retain_name(std::string_view name) noexcept {
+  if (name.empty()) {
+    return false;
+  }
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u <= 0x20 || u >= 0x7F) {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::uint32_t crc32_ieee(std::string_view data) noexcept {
+  std::uint32_t crc = 0xFFFFFFFFU;
+  for (const char ch : data) {
+    crc ^= static_cast<unsigned char>(ch);
+    crc = kCrcTable[crc & 0x0FU] ^ (crc >> 4);
+    crc = kCrcTable[crc & 0x0FU] ^ (crc >> 4);
+  }
+  return crc ^ 0xFFFFFFFFU;
+}
+
+std::string format_retain_file(const RetainMap& values) {
+  std::string out;
+  out.reserve(32 + values.size() * 48);
+  out += kHeader;
+  out += '\n';
+  for (const auto& [name, value] : values) {
+    if (!is_valid_retain_name(name)) {
+      throw std::invalid_argument(
+          fmt::format("retain: invalid variable name '{}' (empty or has whitespace or control "
+                      "characters)",
+                      printable(name)));
+    }
+    out += name;
+    out += ' ';
+    out += type_name(value.type);
+    out += ' ';
+    append_value(out, value);
+    out += '\n';
+  }
+  out += fmt::format("{}{:08x}\n", kEndPrefix, crc32_ieee(out));
+  return out;
+}
+
+RetainLoadResult parse_retain_file(std::string_view text) noexcept {
+  auto fail = [](std::string message) { return RetainLoadResult{{}, std::move(message)}; };
+  try {
+    if (text.empty()) {
+      return fail("empty file");
+    }
+    if (text.back() != '\n') {
+      return fail("truncated (last line has no newline)");
+    }
+    // Split into lines without their '\n'; the text ends with '\n', so no partial line is left.
+    std::vector<std::string_view> lines;
+    for (std::size_t pos = 0; pos < text.size();) {
+      const std::size_t nl = text.find('\n', pos);
+      lines.push_back(text.substr(pos, nl - pos));
+      pos = nl + 1;
+    }
+    if (lines.front() != kHeader) {
+      if (lines.front().starts_with(kHeaderMagic)) {
+        return fail(fmt::format("line 1: unsupported version '{}' (this build reads '{}')",
+                                printable(lines.front()), kHeader));
+      }
+      return fail(fmt::format("line 1: not a retain file (expected '{}', found '{}')", kHeader,
+                              printable(lines.front())));
+    }
+    // The end line must be the last one; check the checksum before trusting any value line.
+    const std::string_view end_line = lines.back();
+    if (lines.size() < 2 || !end_line.starts_with(kEndPrefix)) {
+      for (std::size_t n = 1; n + 1 < lines.size(); ++n) {
+        if (lines[n].starts_with(kEndPrefix)) {
+          return fail(fmt::format("line {}: data after the end line", n + 2));
+        }
+      }
+      return fail("missing end line (file truncated?)");
+    }
+    const std::string_view hex = end_line.substr(kEndPrefix.size());
+    std::uint32_t stored = 0;
+    const bool hex_ok =
+        hex.size() == 8 && hex.find_first_not_of("0123456789abcdef") == std::string_view::npos &&
+        std::from_chars(hex.data(), hex.data() + hex.size(), stored, 16).ec == std::errc{};
+    if (!hex_ok) {
+      return fail(fmt::format("line {}: bad end line '{}'", lines.size(), printable(end_line)));
+    }
+    const std::size_t body_bytes = text.size() - end_line.size() - 1;
+    const std::uint32_t computed = crc32_ieee(text.substr(0, body_bytes));
+    if (stored != computed) {
+      return fail(fmt::format("checksum mismatch (stored {:08x}, computed {:08x})", stored,
+                              computed));
+    }
+    RetainLoadResult result;
+    for (std::size_t n = 1; n + 1 < lines.size(); ++n) {
+      const std::string_view line = lines[n];
+      const std::size_t line_no = n + 1;
+      const std::size_t s1 = line.find(' ');
+      const std::size_t s2 = s1 == std::string_view::npos ? s1 : line.find(' ', s1 + 1);
+      if (s2 == std::string_view::npos) {
+        return fail(fmt::format("line {}: expected 'NAME TYPE VALUE', found '{}'", line_no,
+                                printable(line)));
+      }
+      const std::string_view name = line.substr(0, s1);
+      const std::string_view type_text = line.substr(s1 + 1, s2 - s1 - 1);
+      const std::string_view value_text = line.substr(s2 + 1);
+      if (!is_valid_retain_name(name)) {
+        return fail(fmt::format("line {}: bad name '{}'", line_no, printable(name)));
+      }
+      const std::optional<RetainType> type = parse_type(type_text);
+      if (!type) {
+        return fail(fmt::format("line {}: unknown type '{}'", line_no, printable(type_text)));
+      }
+      const std::optional<RetainValue> value = parse_value(*type, value_text);
+      if (!value) {
+        return fail(fmt::format("line {}: bad {} value '{}'", line_no, type_name(*type),
+                                printable(value_text)));
+      }
+      if (!result.values.emplace(std::string(name), *value).second) {
+        return fail(fmt::format("line {}: duplicate name '{}'", line_no, printable(name)));
+      }
+    }
+    return result;
+  } catch (const std::exception& e) {
+    return fail(fmt::format("internal error while parsing: {}", e.what()));
+  }
+}
+
+RetainLoadResult load_retain_file(const std::string& path) noexcept {
+  auto fail = [&path](std::string_view problem) {
+    return RetainLoadResult{{}, fmt::format("retain file '{}': {}; using defaults", path, problem)};
+  };
+  try {
+    Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+    if (fd.get() < 0) {
+      const int err = errno;
+      return fail(err == ENOENT ? std::string("not found") : "cannot open: " + errno_text(err));
+    }
+    struct stat st {};
+    if (::fstat(fd.get(), &st) != 0) {
+      return fail("cannot stat: " + errno_text(errno));
+    }
+    if (!S_ISREG(st.st_mode)) {
+      return fail("not a regular file");
+    }
+    if (static_cast<std::uint64_t>(st.st_size) > kMaxFileBytes) {
+      return fail(fmt::format("too large ({} bytes)", st.st_size));
+    }
+    std::string text;
+    std::array<char, 8192> buf{};
+    for (;;) {
+      const ssize_t n = ::read(fd.get(), buf.data(), buf.size());
+      if (n < 0) {
+        if (errno == EINTR) {
+          continue;
+        }
+        return fail("read error: " + errno_text(errno));
+      }
+      if (n == 0) {
+        break;
+      }
+      text.append(buf.data(), static_cast<std::size_t>(n));
+      if (text.size() > kMaxFileBytes) {
+        return fail("too large");
+      }
+    }
+    RetainLoadResult result = parse_retain_file(text);
+    if (!result.warning.empty()) {
+      return fail(result.warning);
+    }
+    return result;
+  } catch (const std::exception& e) {
+    return fail(fmt::format("internal error: {}", e.what()));
+  }
+}
+
+void write_retain_file_atomic(const std::string& path, const RetainMap& values) {
+  const std::string text = format_retain_file(values);
+  const std::string tmp = temp_prefix(path) + std::to_string(::getpid());
+  Fd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  if (fd.get() < 0) {
+    throw_io(errno, path, fmt::format("cannot create temp file '{}'", tmp));
+  }
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd.get(), text.data() + done, text.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) {
+        continue;
+      }
+      fail_and_unlink(fd, tmp, path, "write to temp file");
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  // The data must be on disk before the rename makes it visible, or a power cut could leave a
+  // renamed but empty file.
+  if (::fsync(fd.get()) != 0) {
+    fail_and_unlink(fd, tmp, path, "fsync temp file");
+  }
+  if (::close(fd.release()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw_io(err, path, "close temp file");
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw_io(err, path, fmt::format("rename '{}' over it", tmp));
+  }
+  // Makes the rename itself durable.
+  const std::string dir = dir_of(path);
+  Fd dfd(::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dfd.get() < 0) {
+    throw_io(errno, path, fmt::format("open directory '{}' to fsync", dir));
+  }
+  if (::fsync(dfd.get()) != 0) {
+    throw_io(errno, path, fmt::format("fsync directory '{}'", dir));
+  }
+}
+
+std::size_t remove_stale_retain_temps(const std::string& path) noexcept {
+  std::size_t removed = 0;
+  try {
+    const std::string prefix = std::filesystem::path(temp_prefix(path)).filename().string();
+    const std::string own_pid = std::to_string(::getpid());
+    std::error_code ec;
+    for (std::filesystem::directory_iterator it(dir_of(path), ec), end; !ec && it != end;
+         it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (!name.starts_with(prefix)) {
+        continue;
+      }
+      const std::string_view pid = std::string_view(name).substr(prefix.size());
+      if (pid.empty() || pid.find_first_not_of("0123456789") != std::string_view::npos ||
+          pid == own_pid) {
+        continue;
+      }
+      std::error_code rm_ec;
+      if (std::filesystem::remove(it->path(), rm_ec)) {
+        ++removed;
+      }
+    }
+  } catch (...) {
+    // A leftover temp file only costs disk space; never fail the caller for it.
+  }
+  return removed;
+}
+
+RetainStore::RetainStore(std::string path, Duration min_interval, std::vector<Variable> vars)
+    : path_(std::move(path)), min_interval_(min_interval), vars_(std::move(vars)) {
+  if (min_interval_ < Duration::zero()) {
+    throw std::invalid_argument("retain: min_interval must not be negative");
+  }
+  std::map<std::string_view, std::size_t> seen;
+  current_.reserve(vars_.size());
+  for (std::size_t k = 0; k < vars_.size(); ++k) {
+    const Variable& v = vars_[k];
+    if (!is_valid_retain_name(v.name)) {
+      throw std::invalid_argument(
+          fmt::format("retain: invalid variable name '{}'", printable(v.name)));
+    }
+    if (!seen.emplace(v.name, k).second) {
+      throw std::invalid_argument(fmt::format("retain: duplicate variable '{}'", v.name));
+    }
+    if (!v.read) {
+      throw std::invalid_argument(fmt::format("retain: variable '{}' has no read function", v.name));
+    }
+    current_.push_back(RetainValue{v.type, false, 0, 0.0});
+  }
+  type_mismatch_logged_.assign(vars_.size(), false);
+}
+
+RetainStore::~RetainStore() { stop(); }
+
+void RetainStore::read_all_locked() {
+  for (std::size_t k = 0; k < vars_.size(); ++k) {
+    const RetainValue v = vars_[k].read();
+    if (v.type == vars_[k].type) {
+      current_[k] = v;
+    } else if (!type_mismatch_logged_[k]) {
+      type_mismatch_logged_[k] = true;
+      spdlog::error("retain: '{}' is {} but read() returned {}; keeping its last value",
+                    vars_[k].name, type_name(vars_[k].type), type_name(v.type));
+    }
+  }
+}
+
+bool RetainStore::write_locked() noexcept {
+  try {
+    RetainMap map;
+    for (std::size_t k = 0; k < vars_.size(); ++k) {
+      map.emplace(vars_[k].name, current_[k]);
+    }
+    write_retain_file_atomic(path_, map);
+    written_ = current_;
+    writes_.fetch_add(1, std::memory_order_relaxed);
+    if (failure_streak_ > 0) {
+      spdlog::info("retain: writing '{}' works again after {} failed attempts", path_,
+                   failure_streak_);
+      failure_streak_ = 0;
+    }
+    return true;
+  } catch (const std::exception& e) {
+    write_failures_.fetch_add(1, std::memory_order_relaxed);
+    ++failure_streak_;
+    // First failure, then every 100th: a full disk must be visible but not flood the log.
+    if (failure_streak_ % 100 == 1) {
+      spdlog::error("retain: write failed ({} in a row, retrying on change): {}", failure_streak_,
+                    e.what());
+    }
+    return false;
+  }
+}
+
+bool RetainStore::poll(TimePoint now) noexcept {
+  try {
+    const std::lock_guard lock(mutex_);
+    read_all_locked();
+    if (written_ && *written_ == current_) {
+      return false;
+    }
+    if (last_attempt_ && now - *last_attempt_ < min_interval_) {
+      return false;
+    }
+    last_attempt_ = now;
+    return write_locked();
+  } catch (const std::exception& e) {
+    write_failures_.fetch_add(1, std::memory_order_relaxed);
+    spdlog::error("retain: poll of '{}' failed: {}", path_, e.what());
+    return false;
+  }
+}
+
+bool RetainStore::flush() noexcept {
+  try {
+    const std::lock_guard lock(mutex_);
+    read_all_locked();
+    if (written_ && *written_ == current_) {
+      return false;
+    }
+    return write_locked();
+  } catch (const std::exception& e) {
+    write_failures_.fetch_add(1, std::memory_order_relaxed);
+    spdlog::error("retain: flush of '{}' failed: {}", path_, e.what());
+    return false;
+  }
+}
+
+void RetainStore::start(Duration poll_period) {
+  if (thread_.joinable()) {
+    throw std::logic_error("retain: store already started");
+  }
+  if (poll_period <= Duration::zero()) {
+    throw std::invalid_argument("retain: poll_period must be positive");
+  }
+  if (const std::size_t n = remove_stale_retain_temps(path_); n > 0) {
+    spdlog::info("retain: removed {} temp file(s) left by an interrupted write of '{}'", n, path_);
+  }
+  {
+    const std::lock_guard lock(thread_mutex_);
+    stop_requested_ = false;
+  }
+  stopped_ = false;
+  thread_ = std::thread([this, poll_period] { run(poll_period); });
+  // Shows up in top/ps; failure to name the thread is harmless.
+  ::pthread_setname_np(thread_.native_handle(), "edm-retain");
+}
+
+void RetainStore::run(Duration poll_period) noexcept {
+  std::unique_lock lock(thread_mutex_);
+  while (!stop_requested_) {
+    lock.unlock();
+    poll(steady_now());
+    lock.lock();
+    wake_.wait_for(lock, poll_period, [this] { return stop_requested_; });
+  }
+}
+
+void RetainStore::stop() noexcept {
+  if (stopped_) {
+    return;
+  }
+  {
+    const std::lock_guard lock(thread_mutex_);
+    stop_requested_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) {
+    thread_.join();
+  }
+  flush();
+  stopped_ = true;
+}
+
+}  // namespace edm::rt

@@ -1,0 +1,138 @@
+#include "edm/runtime/runtime.hpp"
+
+#include <csignal>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "edm/runtime/scheduler.hpp"
+
+namespace edm::rt {
+
+Runtime::~Runtime() {
+  if (retain_) {
+    retain_->stop();
+  }
+}
+
+Program* Runtime::program(std::string_view name) const {
+  for (const auto& p : programs_) {
+    if (p->name() == name) {
+      return p.get();
+    }
+  }
+  return nullptr;
+}
+
+std::vector<TaskStatsReport> Runtime::stats_reports() const {
+  std::vector<TaskStatsReport> out;
+  for (const auto& t : tasks_) {
+    out.push_back({t->name(), t->spec().interval, t->spec().priority, t->stats().snapshot()});
+  }
+  return out;
+}
+
+void Runtime::drain_alarms() {
+  Alarm a;
+  while (machine_.pop_alarm(a)) {
+    const double t_s = to_seconds(a.time);
+    if (a.severity == AlarmSeverity::kFault) {
+      spdlog::error("ALARM {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
+                    to_string(a.code), a.source, t_s, a.text, a.value);
+    } else {
+      spdlog::warn("alarm {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
+                   to_string(a.code), a.source, t_s, a.text, a.value);
+    }
+  }
+}
+
+RunSummary Runtime::run(const RunOptions& options) {
+  std::vector<Task*> tasks;
+  for (auto& t : tasks_) {
+    tasks.push_back(t.get());
+  }
+  if (machine_.state() == MachineState::kOff) {
+    machine_.command(MachineCommand::kPowerOn);
+  }
+  RunSummary summary;
+  const auto stop_requested = [&] {
+    return options.stop != nullptr && options.stop->load(std::memory_order_relaxed);
+  };
+
+  if (options.clock == ClockKind::kVirtual) {
+    VirtualClock clock;
+    std::ofstream trace_file;
+    if (!options.trace_out.empty()) {
+      trace_file.open(options.trace_out, std::ios::out | std::ios::trunc);
+      if (!trace_file) {
+        throw std::runtime_error("cannot write trace file '" + options.trace_out + "'");
+      }
+    }
+    VirtualScheduler sched(tasks, clock);
+    // Virtual time has no deadline: drain the trace between cycles so nothing is dropped and
+    // the CSV is identical from run to run.
+    std::uint64_t n = 0;
+    auto between = [&] {
+      if (trace_file.is_open() && has_trace_) {
+        trace_.drain(trace_file);
+      }
+      if ((++n & 1023) == 0) {
+        drain_alarms();
+        if (retain_) {
+          retain_->poll(clock.now());
+        }
+      }
+    };
+    const TimePoint end = options.run_for ? TimePoint{*options.run_for}
+                                          : TimePoint{std::numeric_limits<std::int64_t>::max()};
+    sched.run_until(end, between, options.stop);
+    for (auto& t : tasks_) {
+      t->enter_safe_state_now({MachineState::kOff, AlarmCode::kNone});
+    }
+    if (trace_file.is_open() && has_trace_) {
+      trace_.drain(trace_file);
+    }
+  } else {
+    const std::string mlock_warning = lock_memory();
+    if (!mlock_warning.empty()) {
+      spdlog::warn("{}", mlock_warning);
+    }
+    RealClock clock;
+    if (!options.trace_out.empty() && has_trace_) {
+      trace_.start_file_writer(options.trace_out);
+    }
+    if (retain_) {
+      retain_->start(std::chrono::milliseconds(100));
+    }
+    RealTimeScheduler sched;
+    sched.start(tasks, clock);
+    const TimePoint deadline = options.run_for ? clock.now() + *options.run_for
+                                               : TimePoint{std::numeric_limits<std::int64_t>::max()};
+    // The controlling thread only watches the time and the stop flag; the tasks do the work.
+    while (!stop_requested() && clock.now() < deadline) {
+      drain_alarms();
+      const TimePoint wake = std::min(deadline, clock.now() + std::chrono::milliseconds(20));
+      RealClock::sleep_until(wake);
+    }
+    sched.stop();
+    summary.fifo_degraded = sched.degraded();
+    for (auto& t : tasks_) {
+      t->enter_safe_state_now({MachineState::kOff, AlarmCode::kNone});
+    }
+    if (has_trace_ && !options.trace_out.empty()) {
+      trace_.stop();
+    }
+  }
+  if (retain_) {
+    retain_->stop();
+  }
+  drain_alarms();
+  summary.final_state = machine_.state();
+  summary.trace_dropped = has_trace_ ? trace_.dropped() : 0;
+  summary.alarms_dropped = machine_.dropped_alarms();
+  return summary;
+}
+
+}  // namespace edm::rt

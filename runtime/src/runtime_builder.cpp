@@ -1,0 +1,535 @@
+// Builds a Runtime from a parsed Config: driver, blocks, parameters, wires, tasks, variables,
+// trace channels and the retain store. Every problem is reported as file:line:col.
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <map>
+
+#include <spdlog/spdlog.h>
+
+#include "edm/runtime/runtime.hpp"
+#include "param_reader.hpp"
+
+namespace edm::rt {
+
+namespace {
+
+struct PinEntry {
+  PinRef ref;
+  std::string unit;
+  Task* owner{nullptr};
+};
+
+// Collects a block's pins into a table keyed by "<prefix>.<pin>".
+class PinCollector final : public PinVisitor {
+ public:
+  PinCollector(std::string prefix, Task* owner, std::map<std::string, PinEntry>& table,
+               std::vector<std::string>& names)
+      : prefix_(std::move(prefix)), owner_(owner), table_(table), names_(names) {}
+  std::vector<std::string> duplicates;
+
+ protected:
+  void on_pin(std::string_view name, PinRef ref, std::string_view unit) override {
+    std::string full = prefix_ + "." + std::string(name);
+    names_.emplace_back(name);
+    if (!table_.emplace(full, PinEntry{ref, std::string(unit), owner_}).second) {
+      duplicates.push_back(full);
+    }
+  }
+
+ private:
+  std::string prefix_;
+  Task* owner_;
+  std::map<std::string, PinEntry>& table_;
+  std::vector<std::string>& names_;
+};
+
+class ParamLister final : public ParamVisitor {
+ public:
+  struct Field {
+    std::string name;
+    ParamType type;
+    std::string unit;
+  };
+  std::vector<Field> fields;
+
+ protected:
+  void on_param(std::string_view name, ParamRef ref, ParamInfo info) override {
+    fields.push_back({std::string(name), ref.type, std::string(info.unit)});
+  }
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    std::size_t dot = s.find('.', start);
+    parts.push_back(s.substr(start, dot - start));
+    if (dot == std::string::npos) {
+      return parts;
+    }
+    start = dot + 1;
+  }
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& s : v) {
+    out += (out.empty() ? "" : ", ") + s;
+  }
+  return out.empty() ? "none" : out;
+}
+
+}  // namespace
+
+class RuntimeBuilder {
+ public:
+  RuntimeBuilder(const Config& cfg, const BlockRegistry& blocks, const DriverRegistry& drivers,
+                 const BuildOptions& options)
+      : cfg_(cfg), block_types_(blocks), driver_types_(drivers), options_(options) {}
+
+  std::unique_ptr<Runtime> build() {
+    rt_.reset(new Runtime());
+    rt_->config_ = cfg_;
+    make_tasks();
+    make_driver();
+    make_programs();
+    wire();
+    register_variables();
+    make_trace();
+    diag_.throw_if_any();
+    finish();
+    make_retain();
+    diag_.throw_if_any();
+    return std::move(rt_);
+  }
+
+ private:
+  void make_tasks() {
+    for (const TaskSpec& ts : cfg_.tasks) {
+      auto t = std::make_unique<Task>(ts, rt_->machine_);
+      for (const NameRef& p : ts.programs) {
+        program_task_[p.name] = t.get();
+      }
+      tasks_by_name_[ts.name] = t.get();
+      rt_->tasks_.push_back(std::move(t));
+    }
+    const IoSpec& io = cfg_.machine.io;
+    if (io.task) {
+      auto it = tasks_by_name_.find(io.task->name);
+      if (it == tasks_by_name_.end()) {
+        diag_.error(io.task->loc, "machine.io.task: unknown task '" + io.task->name + "'");
+      } else {
+        io_task_ = it->second;
+      }
+    } else {
+      for (auto& t : rt_->tasks_) {
+        if (io_task_ == nullptr || t->spec().priority < io_task_->spec().priority) {
+          io_task_ = t.get();
+        }
+      }
+    }
+  }
+
+  void make_driver() {
+    const IoSpec& io = cfg_.machine.io;
+    rt_->driver_ = driver_types_.create(io.driver);
+    if (!rt_->driver_) {
+      diag_.error(io.driver_loc, "machine.io.driver: unknown I/O driver '" + io.driver +
+                                     "' (known: " + join(driver_types_.names()) + ")");
+      return;
+    }
+    const std::string what = "I/O driver '" + io.driver + "'";
+    read_params(*rt_->driver_, io.params, what, diag_);
+    report_validation(*rt_->driver_, io.params, what, io.loc, diag_);
+    if (options_.seed && !rt_->driver_->set_seed(*options_.seed)) {
+      diag_.error(SourceLoc{cfg_.path, 0, 0},
+                  "--seed: the '" + io.driver + "' driver has no random seed");
+    }
+    if (!diag_.empty()) {
+      return;
+    }
+    const Duration period = io_task_ != nullptr ? io_task_->spec().interval : Duration{};
+    report_param_errors(rt_->driver_->configure({"io", period}), io.params, what, io.loc, diag_);
+    std::vector<std::string> names;
+    PinCollector pc("io", io_task_, pins_, names);
+    rt_->driver_->visit_pins(pc);
+    if (io_task_ != nullptr) {
+      io_task_->attach_driver(*rt_->driver_);
+    }
+    block_pin_names_["io"] = names;
+  }
+
+  void make_programs() {
+    for (const ProgramSpec& ps : cfg_.programs) {
+      auto prog = std::make_unique<Program>(ps.name, rt_->machine_);
+      Task* task = nullptr;
+      if (auto it = program_task_.find(ps.name); it != program_task_.end()) {
+        task = it->second;
+      }
+      const Duration period = task != nullptr ? task->spec().interval : Duration{};
+      for (const BlockSpec& bs : ps.blocks) {
+        std::unique_ptr<Block> block = block_types_.create(bs.type);
+        if (!block) {
+          diag_.error(bs.type_loc, "block '" + bs.name + "': unknown block type '" + bs.type +
+                                       "' (known: " + join(block_types_.names()) + ")");
+          continue;
+        }
+        const std::string what = "block '" + bs.name + "' (" + bs.type + ")";
+        const std::size_t before = diag_.diagnostics().size();
+        read_params(*block, bs.params, what, diag_);
+        if (diag_.diagnostics().size() == before) {
+          report_validation(*block, bs.params, what, bs.loc, diag_);
+        }
+        if (diag_.diagnostics().size() == before) {
+          const std::string full = ps.name + "." + bs.name;
+          report_param_errors(block->configure({full, period}), bs.params, what, bs.loc, diag_);
+        }
+        std::vector<std::string> names;
+        PinCollector pc(ps.name + "." + bs.name, task, pins_, names);
+        block->visit_pins(pc);
+        for (const auto& d : pc.duplicates) {
+          diag_.error(bs.loc, what + ": pin '" + d + "' declared twice (block type bug)");
+        }
+        block_pin_names_[ps.name + "." + bs.name] = names;
+        block_types_by_name_[ps.name + "." + bs.name] = bs.type;
+        prog->add(bs.name, std::move(block));
+      }
+      if (task != nullptr) {
+        task->add_program(*prog);
+      }
+      rt_->programs_.push_back(std::move(prog));
+    }
+  }
+
+  // Resolves a wire endpoint to a pin entry, reporting what is wrong at loc.
+  const PinEntry* resolve(const std::string& program, const std::string& name,
+                          const SourceLoc& loc, bool allow_other_program) {
+    std::vector<std::string> parts = split(name);
+    std::string key;
+    std::string block_key;
+    if (parts.size() == 2) {
+      block_key = parts[0] == "io" ? "io" : program + "." + parts[0];
+      key = block_key + "." + parts[1];
+    } else if (parts.size() == 3 && allow_other_program && parts[0] != "io") {
+      block_key = parts[0] + "." + parts[1];
+      key = name;
+    } else {
+      diag_.error(loc, "'" + name + "' is not a pin name (use block.pin, io.pin" +
+                           std::string(allow_other_program ? " or program.block.pin)" : ")"));
+      return nullptr;
+    }
+    if (auto it = pins_.find(key); it != pins_.end()) {
+      return &it->second;
+    }
+    auto bit = block_pin_names_.find(block_key);
+    if (bit == block_pin_names_.end()) {
+      if (parts.size() == 3 && program_task_.count(parts[0]) == 0 &&
+          std::none_of(cfg_.programs.begin(), cfg_.programs.end(),
+                       [&](const ProgramSpec& p) { return p.name == parts[0]; })) {
+        diag_.error(loc, "'" + name + "': unknown program '" + parts[0] + "'");
+      } else {
+        diag_.error(loc, "'" + name + "': unknown block '" + block_key + "'");
+      }
+      return nullptr;
+    }
+    std::string type = block_key == "io" ? "I/O driver" : block_types_by_name_[block_key];
+    diag_.error(loc, "'" + name + "': " + type + " '" + block_key + "' has no pin '" +
+                         parts.back() + "' (pins: " + join(bit->second) + ")");
+    return nullptr;
+  }
+
+  void connect_constant(const WireSpec& w, const PinEntry& dest) {
+    const std::string& t = w.source;
+    const char* b = t.data();
+    const char* e = t.data() + t.size();
+    auto bad = [&](std::string_view hint) {
+      diag_.error(w.source_loc, "constant '" + t + "' does not fit " +
+                                    std::string(to_string(dest.ref.type)) + " input '" + w.dest +
+                                    "'" + std::string(hint));
+    };
+    switch (dest.ref.type) {
+      case PinType::kBool:
+        if (t == "true" || t == "false") {
+          dest.ref.as_input<bool>()->set_constant(t == "true");
+        } else {
+          bad(" (use true or false)");
+        }
+        return;
+      case PinType::kInt: {
+        std::int64_t v = 0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec != std::errc{} || p != e) {
+          bad(" (a whole number)");
+        } else {
+          dest.ref.as_input<std::int64_t>()->set_constant(v);
+        }
+        return;
+      }
+      case PinType::kReal: {
+        double v = 0.0;
+        auto [p, ec] = std::from_chars(b, e, v);
+        if (ec != std::errc{} || p != e || !std::isfinite(v)) {
+          bad(" (a finite number)");
+        } else {
+          dest.ref.as_input<double>()->set_constant(v);
+        }
+        return;
+      }
+    }
+  }
+
+  void wire() {
+    for (const ProgramSpec& ps : cfg_.programs) {
+      for (const WireSpec& w : ps.wires) {
+        const PinEntry* dest = resolve(ps.name, w.dest, w.dest_loc, false);
+        if (dest == nullptr) {
+          continue;
+        }
+        if (dest->ref.dir != PinDir::kInput) {
+          diag_.error(w.dest_loc, "'" + w.dest +
+                                      "' is an output: a wire goes into an input (dest: source)");
+          continue;
+        }
+        if (!w.source_is_name) {
+          connect_constant(w, *dest);
+          continue;
+        }
+        const PinEntry* src = resolve(ps.name, w.source, w.source_loc, true);
+        if (src == nullptr) {
+          continue;
+        }
+        if (src->ref.dir != PinDir::kOutput) {
+          diag_.error(w.source_loc, "'" + w.source + "' is an input: a wire's source must be "
+                                                     "an output");
+          continue;
+        }
+        if (src->ref.type != dest->ref.type) {
+          diag_.error(w.source_loc, "type mismatch: '" + w.dest + "' is " +
+                                        std::string(to_string(dest->ref.type)) + " but '" +
+                                        w.source + "' is " +
+                                        std::string(to_string(src->ref.type)));
+          continue;
+        }
+        switch (src->ref.type) {
+          case PinType::kBool:
+            dest->ref.as_input<bool>()->connect(*src->ref.as_output<bool>());
+            break;
+          case PinType::kInt:
+            dest->ref.as_input<std::int64_t>()->connect(*src->ref.as_output<std::int64_t>());
+            break;
+          case PinType::kReal:
+            dest->ref.as_input<double>()->connect(*src->ref.as_output<double>());
+            break;
+        }
+      }
+    }
+  }
+
+  void register_params(const std::string& prefix, Block& block, Task* owner) {
+    ParamLister pl;
+    block.visit_params(pl);
+    for (std::uint32_t i = 0; i < pl.fields.size(); ++i) {
+      Variable v;
+      v.name = prefix + "." + pl.fields[i].name;
+      v.kind = VarKind::kParam;
+      v.block = &block;
+      v.param_index = i;
+      v.param_type = pl.fields[i].type;
+      v.unit = pl.fields[i].unit;
+      v.owner = owner;
+      if (!rt_->variables_.add(std::move(v))) {
+        diag_.error(SourceLoc{cfg_.path, 0, 0},
+                    "variable '" + prefix + "." + pl.fields[i].name +
+                        "' is both a pin and a parameter (block type bug)");
+      }
+    }
+  }
+
+  void register_variables() {
+    for (const auto& [name, pin] : pins_) {
+      Variable v;
+      v.name = name;
+      v.kind = pin.ref.dir == PinDir::kInput ? VarKind::kInput : VarKind::kOutput;
+      v.pin = pin.ref;
+      v.unit = pin.unit;
+      v.owner = pin.owner;
+      rt_->variables_.add(std::move(v));
+    }
+    if (rt_->driver_) {
+      register_params("io", *rt_->driver_, io_task_);
+    }
+    for (auto& prog : rt_->programs_) {
+      Task* owner = program_task_.count(prog->name()) ? program_task_[prog->name()] : nullptr;
+      for (const Program::Entry& e : prog->blocks()) {
+        register_params(e.full_name, *e.block, owner);
+      }
+    }
+  }
+
+  void make_trace() {
+    std::map<Task*, std::vector<std::pair<std::string, PinRef>>> per_task;
+    std::vector<Task*> order;
+    for (const NameRef& n : cfg_.trace.variables) {
+      const Variable* v = rt_->variables_.find(n.name);
+      if (v == nullptr) {
+        diag_.error(n.loc, "trace: unknown variable '" + n.name + "'");
+        continue;
+      }
+      if (!v->is_pin()) {
+        diag_.error(n.loc, "trace: '" + n.name + "' is a parameter; only pins are traced");
+        continue;
+      }
+      if (v->owner == nullptr) {
+        continue;
+      }
+      if (per_task.count(v->owner) == 0) {
+        order.push_back(v->owner);
+      }
+      auto& vars = per_task[v->owner];
+      if (vars.size() == kMaxTraceVarsPerTask) {
+        diag_.error(n.loc, "trace: more than " + std::to_string(kMaxTraceVarsPerTask) +
+                               " variables on task '" + v->owner->name() + "'");
+        continue;
+      }
+      vars.emplace_back(n.name, v->pin);
+    }
+    if (!diag_.empty()) {
+      return;
+    }
+    // Channels in task order so the CSV columns follow the config's task list.
+    for (auto& t : rt_->tasks_) {
+      auto it = per_task.find(t.get());
+      if (it == per_task.end()) {
+        continue;
+      }
+      const std::uint32_t ch = rt_->trace_.add_channel(t->name(), it->second,
+                                                       cfg_.trace.capacity);
+      t->attach_trace(rt_->trace_, ch);
+      rt_->has_trace_ = true;
+    }
+  }
+
+  void finish() {
+    if (rt_->driver_) {
+      rt_->driver_->commit_params();
+      rt_->driver_->activate();
+    }
+    for (auto& prog : rt_->programs_) {
+      for (const Program::Entry& e : prog->blocks()) {
+        e.block->commit_params();
+      }
+      prog->activate();
+    }
+  }
+
+  void make_retain() {
+    const RetainSpec& rs = cfg_.retain;
+    if (rs.file.empty()) {
+      return;
+    }
+    std::vector<RetainStore::Variable> vars;
+    VariableRegistry& reg = rt_->variables_;
+    for (const NameRef& n : rs.variables) {
+      const Variable* v = reg.find(n.name);
+      if (v == nullptr) {
+        diag_.error(n.loc, "retain: unknown variable '" + n.name + "'");
+        continue;
+      }
+      if (v->kind == VarKind::kInput) {
+        diag_.error(n.loc, "retain: '" + n.name +
+                               "' is an input (wired); retain outputs or parameters");
+        continue;
+      }
+      RetainType type = RetainType::kReal;
+      if (v->is_pin()) {
+        type = v->pin.type == PinType::kBool  ? RetainType::kBool
+               : v->pin.type == PinType::kInt ? RetainType::kInt
+                                              : RetainType::kReal;
+      } else if (v->param_type == ParamType::kBool) {
+        type = RetainType::kBool;
+      } else if (v->param_type == ParamType::kInt) {
+        type = RetainType::kInt;
+      } else if (v->param_type == ParamType::kString || v->param_type == ParamType::kDuration) {
+        diag_.error(n.loc, "retain: parameter '" + n.name + "' is " +
+                               std::string(v->type_name()) + "; retain BOOL, LINT or LREAL");
+        continue;
+      }
+      std::string name = n.name;
+      vars.push_back({name, type, [&reg, name, type]() {
+                        RetainValue rv{};
+                        rv.type = type;
+                        const double x = reg.read(name).value_or(0.0);
+                        rv.b = x != 0.0;
+                        rv.i = static_cast<std::int64_t>(x);
+                        rv.r = x;
+                        return rv;
+                      }});
+    }
+    if (!diag_.empty()) {
+      return;
+    }
+    if (options_.load_retain) {
+      RetainLoadResult loaded = load_retain_file(rs.file);
+      rt_->retain_warning_ = loaded.warning;
+      for (const auto& [name, value] : loaded.values) {
+        restore(name, value);
+      }
+    }
+    rt_->retain_ = std::make_unique<RetainStore>(rs.file, rs.min_interval, std::move(vars));
+  }
+
+  void restore(const std::string& name, const RetainValue& value) {
+    const Variable* v = rt_->variables_.find(name);
+    bool listed = std::any_of(cfg_.retain.variables.begin(), cfg_.retain.variables.end(),
+                              [&](const NameRef& n) { return n.name == name; });
+    if (v == nullptr || !listed) {
+      spdlog::warn("retain: '{}' in {} is not a retained variable of this config; ignored",
+                   name, cfg_.retain.file);
+      return;
+    }
+    const double x = value.type == RetainType::kBool  ? (value.b ? 1.0 : 0.0)
+                     : value.type == RetainType::kInt ? static_cast<double>(value.i)
+                                                      : value.r;
+    if (!v->is_pin()) {
+      VarStatus st = rt_->variables_.write(name, x, /*apply_now=*/true);
+      if (!st) {
+        spdlog::warn("retain: '{}' not restored: {}", name, st.message);
+      }
+      return;
+    }
+    switch (v->pin.type) {
+      case PinType::kBool:
+        v->pin.as_output<bool>()->set(x != 0.0);
+        break;
+      case PinType::kInt:
+        v->pin.as_output<std::int64_t>()->set(static_cast<std::int64_t>(x));
+        break;
+      case PinType::kReal:
+        v->pin.as_output<double>()->set(x);
+        break;
+    }
+  }
+
+  const Config& cfg_;
+  const BlockRegistry& block_types_;
+  const DriverRegistry& driver_types_;
+  const BuildOptions& options_;
+  DiagnosticSink diag_;
+  std::unique_ptr<Runtime> rt_;
+  std::map<std::string, Task*> program_task_;
+  std::map<std::string, Task*> tasks_by_name_;
+  Task* io_task_{nullptr};
+  std::map<std::string, PinEntry> pins_;
+  std::map<std::string, std::vector<std::string>> block_pin_names_;
+  std::map<std::string, std::string> block_types_by_name_;
+};
+
+std::unique_ptr<Runtime> Runtime::build(const Config& cfg, const BlockRegistry& blocks,
+                                        const DriverRegistry& drivers,
+                                        const BuildOptions& options) {
+  return RuntimeBuilder(cfg, blocks, drivers, options).build();
+}
+
+}  // namespace edm::rt

@@ -1,0 +1,151 @@
+#include "edm/runtime/scheduler.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
+
+#include "edm/runtime/scheduling.hpp"
+
+namespace edm::rt {
+
+namespace {
+
+constexpr std::size_t kPrefaultStackBytes = 256 * 1024;
+constexpr Duration kStartLead = std::chrono::milliseconds(20);
+
+// Touches the stack the RT loop will use so it never page-faults mid-cycle.
+[[gnu::noinline]] void prefault_stack() {
+  volatile unsigned char buf[kPrefaultStackBytes];
+  for (std::size_t i = 0; i < kPrefaultStackBytes; i += 4096) {
+    buf[i] = 0;
+  }
+  (void)buf[0];
+}
+
+}  // namespace
+
+std::string lock_memory() {
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    return std::string("mlockall failed (") + std::strerror(errno) +
+           "): page faults may add latency; run as root or raise RLIMIT_MEMLOCK";
+  }
+  return {};
+}
+
+void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& clock) {
+  clock_ = &clock;
+  stop_.store(false);
+  const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+  for (const Task* t : tasks) {
+    if (t->spec().cpu && (*t->spec().cpu >= cpus || *t->spec().cpu >= CPU_SETSIZE)) {
+      throw std::runtime_error("task '" + t->name() + "': cpu " +
+                               std::to_string(*t->spec().cpu) + " is not available (" +
+                               std::to_string(cpus) + " online)");
+    }
+  }
+  // One common, millisecond-aligned origin keeps tasks phase-locked like a PLC's.
+  const std::int64_t ms = 1'000'000;
+  const TimePoint t0{((clock.now() + kStartLead).count() / ms + 1) * ms};
+  for (Task* t : tasks) {
+    threads_.emplace_back([this, t, t0] { task_main(*t, t0); });
+  }
+}
+
+void RealTimeScheduler::stop() {
+  stop_.store(true);
+  for (std::thread& th : threads_) {
+    if (th.joinable()) {
+      th.join();
+    }
+  }
+  threads_.clear();
+}
+
+void RealTimeScheduler::task_main(Task& task, TimePoint t0) noexcept {
+  const TaskSpec& spec = task.spec();
+  // Signals go to the controlling thread, never into an RT cycle.
+  sigset_t block;
+  sigemptyset(&block);
+  sigaddset(&block, SIGINT);
+  sigaddset(&block, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &block, nullptr);
+  pthread_setname_np(pthread_self(), spec.name.substr(0, 15).c_str());
+  sched_param sp{};
+  sp.sched_priority = fifo_priority(spec.priority);
+  const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  if (rc != 0) {
+    degraded_.store(true);
+    if (!warned_.exchange(true)) {
+      spdlog::warn(
+          "SCHED_FIFO refused ({}): tasks run under SCHED_OTHER and release jitter will be "
+          "large. Run as root, with CAP_SYS_NICE, or raise RLIMIT_RTPRIO.",
+          std::strerror(rc));
+    }
+  }
+  if (spec.cpu) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(static_cast<std::size_t>(*spec.cpu), &set);
+    if (pthread_setaffinity_np(pthread_self(), sizeof set, &set) != 0) {
+      spdlog::warn("task '{}': could not pin to cpu {}", spec.name, *spec.cpu);
+    }
+  }
+  prefault_stack();
+
+  TimePoint release = t0;
+  while (!stop_.load(std::memory_order_relaxed)) {
+    RealClock::sleep_until(release);
+    if (stop_.load(std::memory_order_relaxed)) {
+      break;
+    }
+    const TimePoint end = task.run_cycle(release, *clock_);
+    const NextRelease n = next_release(release, end, spec.interval, spec.overrun);
+    if (n.overrun) {
+      task.stats().record_overrun(n.omitted);
+    }
+    release = n.release;
+  }
+}
+
+VirtualScheduler::VirtualScheduler(std::vector<Task*> tasks, VirtualClock& clock)
+    : tasks_(std::move(tasks)), next_(tasks_.size(), clock.now()), clock_(&clock) {}
+
+void VirtualScheduler::run_until(TimePoint end, const std::function<void()>& between_cycles,
+                                 const std::atomic<bool>* stop) {
+  while (stop == nullptr || !stop->load(std::memory_order_relaxed)) {
+    std::size_t pick = tasks_.size();
+    for (std::size_t i = 0; i < tasks_.size(); ++i) {
+      if (pick == tasks_.size() || next_[i] < next_[pick] ||
+          (next_[i] == next_[pick] &&
+           tasks_[i]->spec().priority < tasks_[pick]->spec().priority)) {
+        pick = i;
+      }
+    }
+    if (pick == tasks_.size() || next_[pick] >= end) {
+      break;
+    }
+    Task& task = *tasks_[pick];
+    const TimePoint release = next_[pick];
+    clock_->advance_to(release);
+    const TimePoint done = task.run_cycle(release, *clock_);
+    const NextRelease n = next_release(release, done, task.spec().interval, task.spec().overrun);
+    if (n.overrun) {
+      task.stats().record_overrun(n.omitted);
+    }
+    next_[pick] = n.release;
+    if (between_cycles) {
+      between_cycles();
+    }
+  }
+  clock_->advance_to(end);
+}
+
+}  // namespace edm::rt

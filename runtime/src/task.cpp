@@ -1,0 +1,109 @@
+#include "edm/runtime/task.hpp"
+
+#include "edm/runtime/trace.hpp"
+
+namespace edm::rt {
+
+Task::Task(TaskSpec spec, Machine& machine)
+    : spec_(std::move(spec)),
+      machine_(&machine),
+      watchdog_(spec_.watchdog),
+      dt_s_(to_seconds(spec_.interval)) {}
+
+bool Task::post_param_write(const ParamWrite& w) {
+  std::lock_guard lock(producer_mutex_);
+  return param_writes_.push(w);
+}
+
+void Task::apply_pending_param_writes() noexcept {
+  ParamWrite w;
+  while (param_writes_.pop(w)) {
+    w.block->apply_param(w.index, w.value);
+  }
+}
+
+void Task::on_safe_state(MachineState s) noexcept {
+  const SafeStateRequest r{s, machine_->last_cause()};
+  // The driver first: the generator goes off before any program reacts.
+  if (driver_ != nullptr) {
+    driver_->enter_safe_state(r);
+  }
+  for (Program* p : programs_) {
+    p->enter_safe_state(r);
+  }
+}
+
+void Task::enter_safe_state_now(const SafeStateRequest& r) noexcept {
+  if (driver_ != nullptr) {
+    driver_->enter_safe_state(r);
+  }
+  for (Program* p : programs_) {
+    p->enter_safe_state(r);
+  }
+}
+
+TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
+  const TimePoint start = clock.now();
+  apply_pending_param_writes();
+
+  const std::uint64_t epoch = machine_->safe_epoch();
+  const MachineState state = machine_->state();
+  if (epoch != seen_safe_epoch_) {
+    seen_safe_epoch_ = epoch;
+    if (is_safe_state(state)) {
+      on_safe_state(state);
+    }
+  }
+
+  const std::uint64_t cycle = cycle_.load(std::memory_order_relaxed);
+  const CycleContext ctx{release, spec_.interval, dt_s_, cycle, state, &clock};
+
+  if (driver_ != nullptr) {
+    driver_->read_inputs(ctx);
+    const IoFault f = driver_->fault();
+    if (f.code != 0 && !driver_faulted_) {
+      Alarm a;
+      a.code = AlarmCode::kIoFault;
+      a.time = release;
+      a.source = "io";
+      a.text = f.text;
+      a.value = f.code;
+      machine_->raise(a);
+    }
+    driver_faulted_ = f.code != 0;
+  }
+  for (Program* p : programs_) {
+    p->run(ctx);
+  }
+  if (driver_ != nullptr) {
+    driver_->write_outputs(ctx);
+  }
+  if (trace_ != nullptr) {
+    trace_->sample(trace_channel_, release, cycle);
+  }
+
+  const TimePoint end = clock.now();
+  const Duration exec = end - start;
+  stats_.record_cycle(start - release, exec);
+  if (watchdog_.check(exec) == WatchdogVerdict::kTrip) {
+    Alarm a;
+    a.time = end;
+    a.source = spec_.name.c_str();
+    a.value = to_micros(exec);
+    if (spec_.watchdog.action == WatchdogAction::kFault) {
+      a.code = AlarmCode::kWatchdog;
+      a.severity = AlarmSeverity::kFault;
+      a.text = "watchdog: cycle execution time exceeded";
+    } else {
+      a.code = AlarmCode::kWatchdogWarning;
+      a.severity = AlarmSeverity::kWarning;
+      a.text = "watchdog warning: cycle execution time exceeded";
+      watchdog_warnings_.fetch_add(1, std::memory_order_relaxed);
+    }
+    machine_->raise(a);
+  }
+  cycle_.store(cycle + 1, std::memory_order_relaxed);
+  return end;
+}
+
+}  // namespace edm::rt
