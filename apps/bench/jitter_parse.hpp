@@ -7,12 +7,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace edm::bench {
 
@@ -72,7 +71,7 @@ struct CyclictestReport {
   std::uint64_t bucketed{0};           // "# Total:" (samples inside the histogram)
   std::uint64_t overflows{0};          // "# Histogram Overflows:" (samples >= N us)
   std::uint64_t min_us{0};
-  std::uint64_t max_us{0};             // truncated to whole us, like every cyclictest value
+  std::uint64_t max_us{0};  // truncated to whole us, like every cyclictest value
 
   [[nodiscard]] std::uint64_t samples() const { return bucketed + overflows; }
 
@@ -84,8 +83,8 @@ struct CyclictestReport {
     if (n == 0) {
       return 0.0;
     }
-    auto rank = static_cast<std::uint64_t>(std::ceil(std::clamp(q, 0.0, 1.0) *
-                                                     static_cast<double>(n)));
+    auto rank =
+        static_cast<std::uint64_t>(std::ceil(std::clamp(q, 0.0, 1.0) * static_cast<double>(n)));
     rank = std::clamp<std::uint64_t>(rank, 1, n);
     std::uint64_t seen = 0;
     for (std::size_t k = 0; k < buckets.size(); ++k) {
@@ -158,8 +157,8 @@ inline std::optional<CyclictestReport> parse_cyclictest(std::string_view out, st
       const auto bucket = words.size() == 2 ? parse_uint(words[0]) : std::nullopt;
       const auto count = words.size() == 2 ? parse_uint(words[1]) : std::nullopt;
       if (!bucket || !count || *bucket != report.buckets.size()) {
-        error = "line " + std::to_string(line_no) + ": not a one-thread histogram line in order: '" +
-                std::string(line) + "'";
+        error = "line " + std::to_string(line_no) +
+                ": not a one-thread histogram line in order: '" + std::string(line) + "'";
         return std::nullopt;
       }
       report.buckets.push_back(*count);
@@ -181,8 +180,9 @@ inline std::optional<CyclictestReport> parse_cyclictest(std::string_view out, st
     }
   }
   if (report.buckets.empty() || !have_total || !have_max || !have_overflows) {
-    error = "no complete histogram (need histogram lines, '# Total:', '# Max Latencies:' and "
-            "'# Histogram Overflows:'; was cyclictest run with -h?)";
+    error =
+        "no complete histogram (need histogram lines, '# Total:', '# Max Latencies:' and "
+        "'# Histogram Overflows:'; was cyclictest run with -h?)";
     return std::nullopt;
   }
   std::uint64_t sum = 0;

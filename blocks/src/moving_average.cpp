@@ -82,8 +82,7 @@ rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept 
   return rt::BlockStatus::kOk;
 }
 
-std::vector<rt::ParamError> MovingAverage::stage_param(std::size_t index,
-                                                       const rt::ParamValue& v) {
+std::vector<rt::ParamError> MovingAverage::stage_param(std::size_t index, const rt::ParamValue& v) {
   if (index == kWindowIndex) {
     return {{"window", "cannot change at run time (it sizes the buffer); reload the config"}};
   }

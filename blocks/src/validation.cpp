@@ -32,8 +32,8 @@ void require_ordered(std::vector<rt::ParamError>& errs, std::string_view lo_fiel
 
 void require_task_period(std::vector<rt::ParamError>& errs, rt::Duration period) {
   if (period.count() <= 0) {
-    errs.push_back({"", "needs a task with a period > 0 (got " + std::to_string(period.count()) +
-                            "ns)"});
+    errs.push_back(
+        {"", "needs a task with a period > 0 (got " + std::to_string(period.count()) + "ns)"});
   }
 }
 

@@ -28,9 +28,9 @@ std::int64_t LatencyHistogram::quantile(double q) const noexcept {
   // Rank = ceil(q * total), but 0.07 * 100 is 7.000000000000001: snap near-integers first.
   const double exact_rank = clamped_q * static_cast<double>(total);
   const double nearest = std::round(exact_rank);
-  const double rounded_rank =
-      std::abs(exact_rank - nearest) <= 1e-9 * std::max(1.0, exact_rank) ? nearest
-                                                                         : std::ceil(exact_rank);
+  const double rounded_rank = std::abs(exact_rank - nearest) <= 1e-9 * std::max(1.0, exact_rank)
+                                  ? nearest
+                                  : std::ceil(exact_rank);
   const auto rank = std::clamp<std::uint64_t>(static_cast<std::uint64_t>(rounded_rank), 1, total);
 
   std::uint64_t seen = 0;

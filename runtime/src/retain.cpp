@@ -1,7 +1,9 @@
 #include "edm/runtime/retain.hpp"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <pthread.h>
+#include <spdlog/spdlog.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,9 +17,6 @@
 #include <stdexcept>
 #include <system_error>
 #include <utility>
-
-#include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 namespace edm::rt {
 namespace {
@@ -170,8 +169,7 @@ std::string dir_of(const std::string& path) {
 }
 
 TimePoint steady_now() {
-  return std::chrono::duration_cast<Duration>(
-      std::chrono::steady_clock::now().time_since_epoch());
+  return std::chrono::duration_cast<Duration>(std::chrono::steady_clock::now().time_since_epoch());
 }
 
 }  // namespace
@@ -282,8 +280,8 @@ RetainLoadResult parse_retain_file(std::string_view text) noexcept {
     const std::size_t body_bytes = text.size() - end_line.size() - 1;
     const std::uint32_t computed = crc32_ieee(text.substr(0, body_bytes));
     if (stored != computed) {
-      return fail(fmt::format("checksum mismatch (stored {:08x}, computed {:08x})", stored,
-                              computed));
+      return fail(
+          fmt::format("checksum mismatch (stored {:08x}, computed {:08x})", stored, computed));
     }
     RetainLoadResult result;
     for (std::size_t n = 1; n + 1 < lines.size(); ++n) {
@@ -457,7 +455,8 @@ RetainStore::RetainStore(std::string path, Duration min_interval, std::vector<Va
       throw std::invalid_argument(fmt::format("retain: duplicate variable '{}'", v.name));
     }
     if (!v.read) {
-      throw std::invalid_argument(fmt::format("retain: variable '{}' has no read function", v.name));
+      throw std::invalid_argument(
+          fmt::format("retain: variable '{}' has no read function", v.name));
     }
     current_.push_back(RetainValue{v.type, false, 0, 0.0});
   }
@@ -513,7 +512,8 @@ bool RetainStore::poll(TimePoint now) noexcept {
     if (written_ && *written_ == current_) {
       return false;
     }
-    if (last_attempt_ && now - *last_attempt_ < min_interval_) {
+    // A `now` before the last attempt means a new time line (e.g. virtual, then real): no wait.
+    if (last_attempt_ && now >= *last_attempt_ && now - *last_attempt_ < min_interval_) {
       return false;
     }
     last_attempt_ = now;
@@ -553,6 +553,11 @@ void RetainStore::start(Duration poll_period) {
   {
     const std::lock_guard lock(thread_mutex_);
     stop_requested_ = false;
+  }
+  {
+    // The thread polls on the steady clock; earlier polls may have used another time line.
+    const std::lock_guard lock(mutex_);
+    last_attempt_.reset();
   }
   stopped_ = false;
   thread_ = std::thread([this, poll_period] { run(poll_period); });

@@ -19,7 +19,7 @@ namespace edm::rt {
 namespace {
 
 constexpr std::size_t kPrefaultStackBytes = 256 * 1024;
-constexpr Duration kStartLead = std::chrono::milliseconds(20);
+constexpr Duration kStartLead = std::chrono::milliseconds(5);
 
 // Touches the stack the RT loop will use so it never page-faults mid-cycle.
 [[gnu::noinline]] void prefault_stack() {
@@ -51,16 +51,28 @@ void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& 
                                std::to_string(cpus) + " online)");
     }
   }
+  ready_.store(0);
+  t0_ns_.store(0);
+  for (Task* t : tasks) {
+    threads_.emplace_back([this, t] { task_main(*t); });
+  }
+  // The origin is chosen only once every thread runs at its RT priority with a pre-faulted
+  // stack, so the first release is not late because of our own start-up.
+  while (ready_.load() < tasks.size()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
   // One common, millisecond-aligned origin keeps tasks phase-locked like a PLC's.
   const std::int64_t ms = 1'000'000;
-  const TimePoint t0{((clock.now() + kStartLead).count() / ms + 1) * ms};
-  for (Task* t : tasks) {
-    threads_.emplace_back([this, t, t0] { task_main(*t, t0); });
-  }
+  t0_ns_.store(((clock.now() + kStartLead).count() / ms + 1) * ms);
+  t0_ns_.notify_all();
 }
 
 void RealTimeScheduler::stop() {
   stop_.store(true);
+  if (t0_ns_.load() == 0) {
+    t0_ns_.store(1);  // release threads still waiting for an origin (start() failed midway)
+    t0_ns_.notify_all();
+  }
   for (std::thread& th : threads_) {
     if (th.joinable()) {
       th.join();
@@ -69,7 +81,7 @@ void RealTimeScheduler::stop() {
   threads_.clear();
 }
 
-void RealTimeScheduler::task_main(Task& task, TimePoint t0) noexcept {
+void RealTimeScheduler::task_main(Task& task) noexcept {
   const TaskSpec& spec = task.spec();
   // Signals go to the controlling thread, never into an RT cycle.
   sigset_t block;
@@ -99,8 +111,10 @@ void RealTimeScheduler::task_main(Task& task, TimePoint t0) noexcept {
     }
   }
   prefault_stack();
+  ready_.fetch_add(1);
+  t0_ns_.wait(0);
 
-  TimePoint release = t0;
+  TimePoint release{t0_ns_.load()};
   while (!stop_.load(std::memory_order_relaxed)) {
     RealClock::sleep_until(release);
     if (stop_.load(std::memory_order_relaxed)) {
@@ -136,7 +150,7 @@ void VirtualScheduler::run_until(TimePoint end, const std::function<void()>& bet
     const TimePoint release = next_[pick];
     clock_->advance_to(release);
     const TimePoint done = task.run_cycle(release, *clock_);
-    const NextRelease n = next_release(release, done, task.spec().interval, task.spec().overrun);
+    const NextRelease n = rt::next_release(release, done, task.spec().interval, task.spec().overrun);
     if (n.overrun) {
       task.stats().record_overrun(n.omitted);
     }

@@ -229,7 +229,7 @@ std::optional<MapView> Reader::map(const Value& v, std::initializer_list<std::st
                  (v.node.IsNull() ? " (write {} for an empty map)" : ""));
     return std::nullopt;
   }
-  MapView m{v, {}};
+  MapView m{v, {}, {}};
   std::unordered_map<std::string, int> first_line;  // every key seen, known or not
   for (auto it = v.node.begin(); it != v.node.end(); ++it) {
     const YAML::Node& key_node = it->first;
@@ -266,6 +266,7 @@ std::optional<MapView> Reader::map(const Value& v, std::initializer_list<std::st
         }
         if (best_d <= 2 && best_d < key.size()) {
           msg += ", did you mean '" + std::string(best) + "'?";
+          m.suggested.emplace_back(best);
         }
       }
       msg += " (allowed keys: " + join(allowed) + ")";
@@ -304,7 +305,9 @@ std::optional<std::vector<Value>> Reader::list(const Value& v) {
 
 const Field* Reader::require(const MapView& m, std::string_view key) {
   const Field* f = m.find(key);
-  if (f == nullptr) {
+  // A misspelt required key was already reported with a suggestion; one message is enough.
+  if (f == nullptr &&
+      std::find(m.suggested.begin(), m.suggested.end(), key) == m.suggested.end()) {
     error(m.self, "missing required key '" + std::string(key) + "'");
   }
   return f;

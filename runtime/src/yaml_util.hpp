@@ -4,7 +4,15 @@
 // carry on with the next key (errors are collected, not thrown).
 // Non-RT (allocates, uses yaml-cpp); thread-compatible (one Reader per parse).
 
+// GCC 12 reports false -Wdangling-pointer positives inside yaml-cpp 0.7's node iterators.
+#pragma GCC diagnostic push
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic ignored "-Wdangling-pointer"
+#endif
+#include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
+#pragma GCC diagnostic pop
 
 #include <cstdint>
 #include <initializer_list>
@@ -49,6 +57,7 @@ struct Field {
 struct MapView {
   Value self;
   std::vector<Field> fields;  // file order, first occurrence of each key only
+  std::vector<std::string> suggested;  // keys offered as "did you mean" for unknown keys
 
   [[nodiscard]] const Field* find(std::string_view key) const noexcept;
 };
@@ -72,7 +81,8 @@ class Reader {
                              std::string_view duplicate_note = {});
   /// The node as a list of elements (paths "path[i]").
   std::optional<std::vector<Value>> list(const Value& v);
-  /// Reports "path: missing required key 'key'" at the map when the key is absent.
+  /// Reports "path: missing required key 'key'" at the map when the key is absent (unless an
+  /// unknown key was already reported as its likely misspelling).
   const Field* require(const MapView& m, std::string_view key);
 
   /// True if the node is a scalar without an unsupported tag; else reports "expected <what>".

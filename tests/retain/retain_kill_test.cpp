@@ -1,7 +1,5 @@
 // Acceptance test of the atomic write: a writer killed with SIGKILL at random moments never leaves
 // a retain file that fails to load or mixes two iterations.
-#include "edm/runtime/retain.hpp"
-
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
@@ -16,6 +14,8 @@
 #include <random>
 #include <string>
 #include <system_error>
+
+#include "edm/runtime/retain.hpp"
 
 namespace edm::rt {
 namespace {
@@ -45,8 +45,8 @@ class TempDir {
   fs::path path_;
 };
 
-constexpr int kVariables = 200;           // ~7 KB file: several write() pages of work per iteration
-constexpr int kTrials = 60;               // acceptance asks for >= 50 kills
+constexpr int kVariables = 200;  // ~7 KB file: several write() pages of work per iteration
+constexpr int kTrials = 60;      // acceptance asks for >= 50 kills
 constexpr std::int64_t kTrialStride = 1'000'000;  // iteration numbers of trial t: t*stride + 1, ...
 constexpr std::uint64_t kSeed = 0x5EED'0EDB'2024ULL;
 
@@ -158,8 +158,8 @@ TEST(RetainKill9, file_always_loads_whole_and_from_one_iteration) {
     // At least every reported write is visible, and nothing from an earlier trial.
     EXPECT_GE(it, first + reports - 1);
     EXPECT_LT(it, first + kTrialStride);
-    EXPECT_TRUE(loaded.values == iteration_map(it)) << "file mixes iterations (iteration " << it
-                                                    << ")";
+    EXPECT_TRUE(loaded.values == iteration_map(it))
+        << "file mixes iterations (iteration " << it << ")";
   }
   RecordProperty("kills_leaving_temp", kills_leaving_temp);
   std::printf("[ info ] %d kills, %d mid-write (temp left), iteration ~%lld us\n", kTrials,

@@ -1,5 +1,3 @@
-#include "edm/runtime/retain.hpp"
-
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -13,6 +11,8 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "edm/runtime/retain.hpp"
 
 namespace edm::rt {
 namespace {
@@ -58,7 +58,8 @@ struct Plant {
          }},
         {"drill.electrode.length_left", RetainType::kReal,
          [this] { return RetainValue::make_real(length_mm.load()); }},
-        {"drill.seq.done", RetainType::kBool, [this] { return RetainValue::make_bool(done.load()); }},
+        {"drill.seq.done", RetainType::kBool,
+         [this] { return RetainValue::make_bool(done.load()); }},
     };
   }
 };
@@ -109,6 +110,15 @@ TEST_F(RetainStoreTest, changes_are_rate_limited_by_min_interval) {
   EXPECT_EQ(holes_on_disk(path_), 3);
   EXPECT_EQ(store.writes(), 3U);
   EXPECT_EQ(store.write_failures(), 0U);
+}
+
+TEST_F(RetainStoreTest, time_going_backwards_starts_a_new_time_line) {
+  RetainStore store(path_, seconds(1), plant_.variables());
+  EXPECT_TRUE(store.poll(std::chrono::hours(1000)));  // e.g. a long virtual run
+  plant_.holes = 1;
+  EXPECT_FALSE(store.poll(std::chrono::hours(1000) + milliseconds(10)));
+  EXPECT_TRUE(store.poll(seconds(5)));  // steady clock after boot: must not wait 1000 h
+  EXPECT_EQ(holes_on_disk(path_), 1);
 }
 
 TEST_F(RetainStoreTest, unchanged_values_are_never_rewritten) {
@@ -197,9 +207,7 @@ TEST_F(RetainStoreTest, stop_of_running_thread_flushes_last_values) {
 }
 
 TEST_F(RetainStoreTest, start_removes_stale_temp_files) {
-  {
-    std::ofstream(path_ + ".tmp.4194304") << "partial";
-  }
+  { std::ofstream(path_ + ".tmp.4194304") << "partial"; }
   RetainStore store(path_, seconds(1), plant_.variables());
   store.start(std::chrono::hours(1));
   store.stop();
@@ -267,9 +275,9 @@ TEST_F(RetainStoreTest, bad_configuration_is_refused_at_construction) {
                std::invalid_argument);
   EXPECT_THROW(RetainStore(path_, seconds(1), V{{"", RetainType::kInt, read}}),
                std::invalid_argument);
-  EXPECT_THROW(
-      RetainStore(path_, seconds(1), V{{"a", RetainType::kInt, read}, {"a", RetainType::kInt, read}}),
-      std::invalid_argument);
+  EXPECT_THROW(RetainStore(path_, seconds(1),
+                           V{{"a", RetainType::kInt, read}, {"a", RetainType::kInt, read}}),
+               std::invalid_argument);
   EXPECT_THROW(RetainStore(path_, seconds(1), V{{"a", RetainType::kInt, nullptr}}),
                std::invalid_argument);
   EXPECT_THROW(RetainStore(path_, seconds(-1), V{}), std::invalid_argument);

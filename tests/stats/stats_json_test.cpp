@@ -1,6 +1,7 @@
 #include "edm/runtime/stats_json.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cctype>
 #include <chrono>
@@ -121,8 +122,7 @@ class JsonChecker {
   bool number() {
     const std::size_t start = pos_;
     eat('-');
-    if (eat('0')) {
-    } else if (!digits()) {
+    if (!eat('0') && !digits()) {  // no leading zeros
       return false;
     }
     if (eat('.') && !digits()) {
@@ -160,7 +160,8 @@ class JsonChecker {
     return false;
   }
   void skip_ws() {
-    while (pos_ < text_.size() && std::string_view(" \t\r\n").find(text_[pos_]) != std::string_view::npos) {
+    while (pos_ < text_.size() &&
+           std::string_view(" \t\r\n").find(text_[pos_]) != std::string_view::npos) {
       ++pos_;
     }
   }
@@ -201,7 +202,7 @@ TaskStatsReport sample_task() {
   t.stats.cycles = 4000;
   t.stats.overruns = 3;
   t.stats.omitted_cycles = 5;
-  t.stats.exec = {12.0, 14.5, 14.1234, 20.0005, 31.25};
+  t.stats.exec = {12.0, 14.5, 14.1234, 20.0006, 31.25};
   t.stats.latency = {1.0, 2.5, 2.25, 9.9999, 12.0};
   return t;
 }
@@ -258,9 +259,9 @@ TEST(StatsJson, several_tasks_in_order_and_valid) {
   ASSERT_NE(slow_at, std::string::npos);
   EXPECT_LT(gap, slow_at);
   EXPECT_NE(json.find("\"interval_us\": 40000.000"), std::string::npos);
-  for (const char* key : {"\"interval_us\"", "\"priority\"", "\"cycles\"", "\"overruns\"",
-                          "\"omitted_cycles\"", "\"exec_us\"", "\"latency_us\"", "\"min\"",
-                          "\"avg\"", "\"p50\"", "\"p99\"", "\"max\""}) {
+  for (const char* key :
+       {"\"interval_us\"", "\"priority\"", "\"cycles\"", "\"overruns\"", "\"omitted_cycles\"",
+        "\"exec_us\"", "\"latency_us\"", "\"min\"", "\"avg\"", "\"p50\"", "\"p99\"", "\"max\""}) {
     std::size_t count = 0;
     for (std::size_t at = json.find(key); at != std::string::npos; at = json.find(key, at + 1)) {
       ++count;
@@ -299,10 +300,10 @@ TEST(StatsJson, checker_rejects_broken_documents) {
 }
 
 TEST(StatsJson, writes_file) {
+  // Per-process name: parallel ctest runs of this test must not share the file.
   const std::filesystem::path path =
       std::filesystem::temp_directory_path() /
-      ("edm_stats_json_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-       "_" + std::to_string(reinterpret_cast<std::uintptr_t>(&path)) + ".json");
+      ("edm_stats_json_test_" + std::to_string(::getpid()) + ".json");
   const std::vector<TaskStatsReport> tasks{sample_task()};
   write_stats_json_file(path.string(), tasks);
   std::ifstream in(path, std::ios::binary);

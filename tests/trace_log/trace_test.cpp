@@ -95,7 +95,8 @@ TEST(TraceRecorder, records_exact_values_and_times_of_real_int_and_bool_pins) {
   std::ostringstream out;
   EXPECT_EQ(rec.drain(out), 4u);
   const Csv csv = parse_csv(out.str());
-  EXPECT_EQ(csv.header, (Row{"t_s", "task", "cycle", "gap.ctl.td_us", "gap.ctl.count", "gap.ctl.on"}));
+  EXPECT_EQ(csv.header,
+            (Row{"t_s", "task", "cycle", "gap.ctl.td_us", "gap.ctl.count", "gap.ctl.on"}));
   ASSERT_EQ(csv.rows.size(), 4u);
 
   const std::vector<std::string> t_s{"0.000000000", "0.001000000", "1234.567890123", "2.000000000"};
@@ -240,6 +241,7 @@ TEST(TraceRecorder, file_writer_has_written_every_sample_when_stop_returns) {
   EXPECT_EQ(csv.header, (Row{"t_s", "task", "cycle", "task.p.n"}));
   ASSERT_EQ(csv.rows.size(), static_cast<std::size_t>(kSamples));
   EXPECT_EQ(rec.dropped(), 0u);
+  EXPECT_FALSE(rec.write_failed());
   for (std::int64_t i = 0; i < kSamples; ++i) {
     const Row& r = csv.rows[static_cast<std::size_t>(i)];
     ASSERT_EQ(r.size(), 4u);
@@ -261,6 +263,18 @@ TEST(TraceRecorder, file_writer_reports_an_unopenable_path) {
     EXPECT_NE(what.find("No such file or directory"), std::string::npos) << what;
   }
   rec.stop();  // no writer: no-op
+}
+
+TEST(TraceRecorder, file_writer_flags_a_failed_write_without_throwing) {
+  Output<double> x{0.25};
+  TraceRecorder rec;
+  const auto ch = rec.add_channel("t", {{"t.x", PinRef::of(x)}}, 64);
+  rec.start_file_writer("/dev/full");  // opens fine, every write fails with ENOSPC
+  for (std::uint64_t i = 0; i < 50; ++i) {
+    rec.sample(ch, TimePoint{static_cast<std::int64_t>(i)}, i);
+  }
+  EXPECT_NO_THROW(rec.stop());
+  EXPECT_TRUE(rec.write_failed());
 }
 
 TEST(TraceRecorder, concurrent_producer_and_drain_lose_nothing_but_counted_drops) {
@@ -288,8 +302,9 @@ TEST(TraceRecorder, concurrent_producer_and_drain_lose_nothing_but_counted_drops
   long long previous = -1;
   for (const Row& r : csv.rows) {
     const long long cycle = std::stoll(r[2]);
-    EXPECT_GT(cycle, previous);  // push order survives
-    EXPECT_EQ(std::stod(r[3]), static_cast<double>(cycle));  // value read in the same cycle
+    // Push order survives, and each value was read in the cycle of its row.
+    EXPECT_GT(cycle, previous);
+    EXPECT_EQ(std::stod(r[3]), static_cast<double>(cycle));
     previous = cycle;
   }
 }

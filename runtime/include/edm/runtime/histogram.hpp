@@ -88,7 +88,7 @@ class LatencyHistogram {
   std::atomic<std::uint64_t> max_ns_{0};
 };
 
-static_assert(LatencyHistogram::kBucketCount == 2304, "64 exact + 64 per power of two up to 2^41");
+static_assert(LatencyHistogram::kBucketCount == 2304, "128 exact + 64 per power of two, 2^7..2^40");
 static_assert(LatencyHistogram::bucket_upper_ns(LatencyHistogram::kBucketCount - 1) ==
                   LatencyHistogram::kMaxTrackedNs,
               "the last bucket ends at kMaxTrackedNs");

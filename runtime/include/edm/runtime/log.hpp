@@ -7,6 +7,7 @@
 // RT threads call rt_log(): it copies a fixed-size record (level, time, two string pointers, four
 // doubles) into a bounded lock-free MPMC queue and returns; a non-RT drain thread formats the
 // records and forwards them to spdlog. A full queue drops the record and counts it.
+// The queue is a fixed array (1024 records) allocated at start-up; nothing allocates afterwards.
 //
 // RT-safe: rt_log(), rt_log_dropped(), RtLogQueue::push(), RtLogQueue::dropped().
 // Non-RT: everything else (init/shutdown allocate, start or join threads, take locks).
@@ -43,7 +44,7 @@ enum class RtLogLevel : std::uint8_t {
 /// string literals or strings that outlive the runtime (never a std::string's c_str()).
 struct RtLogRecord {
   RtLogLevel level{RtLogLevel::kInfo};
-  TimePoint t{0};              // CLOCK_MONOTONIC at the rt_log() call
+  TimePoint t{0};               // CLOCK_MONOTONIC at the rt_log() call
   const char* source{nullptr};  // e.g. the task or block name; may be null
   const char* fmt{nullptr};     // fmt-style format string; the args are doubles ("{:.3f}", "{}")
   std::array<double, 4> args{};
@@ -66,7 +67,8 @@ class RtLogQueue {
   /// RT-safe: lock-free, no allocation, never blocks. Any number of producer threads.
   bool push(const RtLogRecord& rec) noexcept;
 
-  /// Dequeues the oldest record into out; false if empty. Lock-free; normally non-RT.
+  /// Dequeues the oldest record into out; false if empty, or if the next record is still being
+  /// written by a producer (it shows up on a later call). Never waits; normally non-RT.
   bool pop(RtLogRecord& out) noexcept;
 
   /// Non-RT: pops at most max_records queued records and calls fn(const RtLogRecord&) for each,
@@ -89,7 +91,7 @@ class RtLogQueue {
   }
 
  private:
-  struct Impl;  // keeps Boost.Lockfree out of this header
+  struct Impl;  // the ring (about 72 KiB), allocated once by the constructor
   std::unique_ptr<Impl> impl_;
   std::atomic<std::uint64_t> dropped_{0};
 };

@@ -122,16 +122,18 @@ class RetainStore {
 
   /// Reads every variable; writes when a value differs from the last written set (or nothing was
   /// written yet) and at least min_interval passed since the last write attempt. `now` is on any
-  /// monotonic time line (virtual time in tests). Returns true if it wrote. A failed write is
-  /// logged and counted (retried at the next allowed poll), never thrown.
+  /// monotonic time line (virtual time in tests); a `now` earlier than the last attempt is taken
+  /// as a new time line and does not wait. Returns true if it wrote. A failed write is logged and
+  /// counted (retried at the next allowed poll), never thrown.
   bool poll(TimePoint now) noexcept;
 
   /// Writes now, ignoring min_interval, if anything changed since the last write (or nothing was
   /// written yet). Returns true if it wrote. Failures as in poll().
   bool flush() noexcept;
 
-  /// Removes stale temp files, then starts a thread calling poll(steady clock) right away and then
-  /// every poll_period until stop(). Throws std::logic_error if already running,
+  /// Removes stale temp files, forgets the time of the last attempt (poll() calls made before may
+  /// have used another time line), then starts a thread calling poll(steady clock) right away and
+  /// then every poll_period until stop(). Throws std::logic_error if already running,
   /// std::invalid_argument if poll_period <= 0.
   void start(Duration poll_period);
 
@@ -157,12 +159,12 @@ class RetainStore {
   const Duration min_interval_;
   const std::vector<Variable> vars_;
 
-  std::mutex mutex_;  // guards everything below up to the thread members
-  std::vector<RetainValue> current_;                    // last good read, parallel to vars_
-  std::vector<bool> type_mismatch_logged_;              // log a bad read() once per variable
-  std::optional<std::vector<RetainValue>> written_;     // what the file holds (as we wrote it)
-  std::optional<TimePoint> last_attempt_;               // for min_interval
-  std::uint64_t failure_streak_{0};                     // to log a failing disk without spamming
+  std::mutex mutex_;                        // guards everything below up to the thread members
+  std::vector<RetainValue> current_;        // last good read, parallel to vars_
+  std::vector<bool> type_mismatch_logged_;  // log a bad read() once per variable
+  std::optional<std::vector<RetainValue>> written_;  // what the file holds (as we wrote it)
+  std::optional<TimePoint> last_attempt_;            // for min_interval
+  std::uint64_t failure_streak_{0};                  // to log a failing disk without spamming
 
   std::atomic<std::uint64_t> writes_{0};
   std::atomic<std::uint64_t> write_failures_{0};

@@ -43,13 +43,15 @@ class RealTimeScheduler {
   [[nodiscard]] bool degraded() const noexcept { return degraded_.load(); }
 
  private:
-  void task_main(Task& task, TimePoint t0) noexcept;
+  void task_main(Task& task) noexcept;
 
   const RealClock* clock_{nullptr};
   std::vector<std::thread> threads_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> degraded_{false};
   std::atomic<bool> warned_{false};
+  std::atomic<std::size_t> ready_{0};       // threads set up and waiting for the origin
+  std::atomic<std::int64_t> t0_ns_{0};      // the common origin; 0 until every thread is ready
 };
 
 class VirtualScheduler {

@@ -24,6 +24,7 @@
 //  - dropped(): RT-safe, any thread.
 
 #include <array>
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -45,17 +46,17 @@ inline constexpr std::size_t kMaxTraceVarsPerTask = 32;
 
 /// One cycle's values of one channel. Trivially copyable: it is copied into the ring as is.
 struct TraceSample {
-  TimePoint release{0};   // scheduled release time of the cycle, ns
+  TimePoint release{0};  // scheduled release time of the cycle, ns
   std::uint64_t cycle{0};
   std::uint32_t channel{0};
-  std::uint32_t n{0};     // number of valid entries in v
+  std::uint32_t n{0};  // number of valid entries in v
   std::array<double, kMaxTraceVarsPerTask> v{};
 };
 
 class TraceRecorder {
  public:
   TraceRecorder();
-  /// Stops the file writer if it runs (write errors are logged, not thrown, here).
+  /// Stops the file writer if it runs.
   ~TraceRecorder();
   TraceRecorder(const TraceRecorder&) = delete;
   TraceRecorder& operator=(const TraceRecorder&) = delete;
@@ -65,8 +66,7 @@ class TraceRecorder {
   /// Returns the channel id (0, 1, ... in call order). Throws std::invalid_argument if there are
   /// more than kMaxTraceVarsPerTask vars, a pin is null, or capacity is not a power of two;
   /// std::logic_error once the CSV header has been written (the columns are fixed then).
-  std::uint32_t add_channel(std::string task_name,
-                            std::vector<std::pair<std::string, PinRef>> vars,
+  std::uint32_t add_channel(std::string task_name, std::vector<std::pair<std::string, PinRef>> vars,
                             std::size_t capacity);
 
   /// Reads each variable of the channel (read_pin_as_double) and pushes one sample; a full ring
@@ -84,8 +84,14 @@ class TraceRecorder {
   void start_file_writer(const std::string& path);
 
   /// Non-RT: stops the file writer, drains what is left, closes the file. No-op without a
-  /// writer. Throws std::runtime_error if writing the file failed (e.g. disk full).
+  /// writer. Does not throw on a failed write (the shutdown path must go on): it logs an error
+  /// and write_failed() turns true.
   void stop();
+
+  /// True once writing the trace file has failed (e.g. disk full). Any thread.
+  [[nodiscard]] bool write_failed() const noexcept {
+    return write_failed_.load(std::memory_order_relaxed);
+  }
 
   /// Samples dropped on full rings: total over channels, or for one channel (0 if unknown).
   /// RT-safe, any thread.
@@ -113,6 +119,7 @@ class TraceRecorder {
   std::thread writer_;
   std::ofstream file_;
   std::string file_path_;
+  std::atomic<bool> write_failed_{false};
 };
 
 }  // namespace edm::rt

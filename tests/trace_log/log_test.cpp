@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <spdlog/spdlog.h>
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <set>
@@ -103,6 +104,39 @@ TEST(RtLogQueue, concurrent_producers_lose_nothing_within_capacity) {
     seen.emplace(t, i);
   }
   EXPECT_EQ(seen.size(), static_cast<std::size_t>(kThreads * kPerThread));
+}
+
+TEST(RtLogQueue, concurrent_producers_and_consumer_account_for_every_record) {
+  RtLogQueue q;
+  constexpr int kThreads = 4;
+  constexpr int kPerThread = 5000;  // far beyond the capacity: some records must be dropped
+  std::atomic<int> running{kThreads};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&q, &running, t] {
+      for (int i = 0; i < kPerThread; ++i) {
+        q.push(record(RtLogLevel::kInfo, "worker", "{} {}", t, i));
+      }
+      running.fetch_sub(1);
+    });
+  }
+  std::vector<int> last(kThreads, -1);
+  std::size_t received = 0;
+  const auto take = [&](const RtLogRecord& r) {
+    const auto t = static_cast<std::size_t>(r.args[0]);
+    const int i = static_cast<int>(r.args[1]);
+    EXPECT_GT(i, last[t]) << "per-producer order broken";
+    last[t] = i;
+    ++received;
+  };
+  while (running.load() > 0) {
+    q.drain(take);
+  }
+  for (auto& th : threads) {
+    th.join();
+  }
+  q.drain(take);
+  EXPECT_EQ(received + q.dropped(), static_cast<std::size_t>(kThreads * kPerThread));
 }
 
 TEST(RtLogFormat, bad_format_string_returns_the_raw_format_instead_of_throwing) {

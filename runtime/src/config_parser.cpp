@@ -1,0 +1,273 @@
+// Config parser: YAML → Config structs, checking structure, keys, types, ranges and the
+// cross-references between sections (task ↔ program). Block types, parameters and wire endpoints
+// are the builder's job. All problems are collected and thrown together, sorted by position.
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <system_error>
+#include <unordered_map>
+
+#include "config_parser_impl.hpp"
+
+namespace edm::rt {
+
+namespace config_detail {
+
+void Parser::parse_document(const YAML::Node& root, Config& cfg) {
+  Value top{root, r_.loc(root), ""};
+  if (top.loc.line == 0) {
+    top.loc = {r_.file(), 1, 1};
+  }
+  if (root.IsNull()) {
+    r_.error(top, "the file is empty (expected a map with version, machine, tasks and programs)");
+    return;
+  }
+  if (!root.IsMap()) {
+    r_.error(top, "the top level must be a map (version, machine, tasks, programs, ...), got " +
+                      Reader::describe(root));
+    return;
+  }
+  auto m = r_.map(top, {"version", "machine", "conditions", "tasks", "programs", "trace",
+                        "bridge", "retain"});
+  if (const Field* f = r_.require(*m, "version")) {
+    auto v = r_.integer(f->value, 0, INT64_MAX);
+    if (!v) {
+      return;  // the rest may follow another schema
+    }
+    if (*v != 1) {
+      r_.error(f->value,
+               "unsupported version " + f->value.node.Scalar() + " (this edmplc reads version 1)");
+      return;
+    }
+    cfg.version = 1;
+  }
+  if (const Field* f = r_.require(*m, "machine")) {
+    parse_machine(f->value, cfg.machine);
+  }
+  if (const Field* f = m->find("conditions")) {
+    if (auto items = r_.list(f->value)) {
+      UniqueNames e_numbers;
+      for (const Value& item : *items) {
+        ConditionSpec c;
+        const SourceLoc e_loc = parse_condition(item, c);
+        if (c.e >= 1) {
+          if (const SourceLoc* first = e_numbers.add(std::to_string(c.e), e_loc)) {
+            r_.error(e_loc, item.path + ".E",
+                     "duplicate condition E" + std::to_string(c.e) + " (first at line " +
+                         line_of(*first) + ")");
+          }
+        }
+        cfg.conditions.push_back(std::move(c));
+      }
+    }
+  }
+  task_names_complete_ = task_programs_complete_ = false;
+  if (const Field* f = r_.require(*m, "tasks")) {
+    if (auto items = r_.list(f->value)) {
+      task_names_complete_ = task_programs_complete_ = true;
+      if (items->empty()) {
+        r_.error(f->value, "must list at least one task");
+      }
+      UniqueNames names;
+      for (const Value& item : *items) {
+        TaskSpec t;
+        parse_task(item, t);
+        if (!t.name.empty()) {
+          if (const SourceLoc* first = names.add(t.name, t.name_loc)) {
+            r_.error(t.name_loc, item.path + ".name",
+                     "duplicate task name '" + t.name + "' (first at line " + line_of(*first) +
+                         ")");
+          }
+        }
+        cfg.tasks.push_back(std::move(t));
+      }
+    }
+  }
+  program_names_complete_ = false;
+  if (const Field* f = r_.require(*m, "programs")) {
+    if (auto items = r_.list(f->value)) {
+      program_names_complete_ = true;
+      if (items->empty()) {
+        r_.error(f->value, "must list at least one program");
+      }
+      UniqueNames names;
+      for (const Value& item : *items) {
+        ProgramSpec p;
+        parse_program(item, p);
+        if (!p.name.empty()) {
+          if (const SourceLoc* first = names.add(p.name, p.name_loc)) {
+            r_.error(p.name_loc, item.path + ".name",
+                     "duplicate program name '" + p.name + "' (first at line " + line_of(*first) +
+                         ")");
+          }
+        }
+        cfg.programs.push_back(std::move(p));
+      }
+    }
+  }
+  if (const Field* f = m->find("trace")) {
+    parse_trace(f->value, cfg.trace);
+  }
+  if (const Field* f = m->find("bridge")) {
+    parse_bridge(f->value, cfg.bridge);
+  }
+  if (const Field* f = m->find("retain")) {
+    parse_retain(f->value, cfg.retain);
+  }
+  cross_check(cfg);
+}
+
+void Parser::cross_check(const Config& cfg) {
+  if (cfg.machine.io.task && task_names_complete_) {
+    const NameRef& ref = *cfg.machine.io.task;
+    const bool found = std::any_of(cfg.tasks.begin(), cfg.tasks.end(),
+                                   [&](const TaskSpec& t) { return t.name == ref.name; });
+    if (!found) {
+      r_.error(ref.loc, "machine.io.task", "unknown task '" + ref.name + "'");
+    }
+  }
+  std::unordered_map<std::string, const ProgramSpec*> programs;
+  for (const ProgramSpec& p : cfg.programs) {
+    programs.emplace(p.name, &p);
+  }
+  // program name → the task that runs it and where it was listed
+  std::unordered_map<std::string, std::pair<const TaskSpec*, SourceLoc>> owner;
+  for (const TaskSpec& t : cfg.tasks) {
+    for (const NameRef& ref : t.programs) {
+      if (programs.count(ref.name) == 0) {
+        if (program_names_complete_) {
+          r_.error(ref.loc, "task '" + t.name + "'", "unknown program '" + ref.name + "'");
+        }
+        continue;
+      }
+      const auto [it, inserted] = owner.emplace(ref.name, std::make_pair(&t, ref.loc));
+      if (!inserted) {
+        r_.error(ref.loc, "task '" + t.name + "'",
+                 "program '" + ref.name + "' is already assigned to task '" +
+                     it->second.first->name + "' (line " + line_of(it->second.second) +
+                     "); a program instance runs in exactly one task");
+      }
+    }
+  }
+  if (task_programs_complete_ && task_names_complete_) {
+    for (const ProgramSpec& p : cfg.programs) {
+      if (!p.name.empty() && owner.count(p.name) == 0) {
+        r_.error(p.name_loc, "program '" + p.name + "'", "not assigned to any task");
+      }
+    }
+  }
+}
+
+}  // namespace config_detail
+
+namespace {
+
+/// Sees where a document starts and ignores everything else.
+class DocumentProbe : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark& mark) override { start = mark; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+
+  YAML::Mark start;
+};
+
+/// Where a second document starts, if there is one. Not YAML::LoadAll: yaml-cpp 0.7 loops
+/// forever (allocating) on a stray top-level ',' because each "document" consumes nothing.
+std::optional<YAML::Mark> second_document_mark(const std::string& text) {
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentProbe probe;
+  if (!parser.HandleNextDocument(probe) || !parser.HandleNextDocument(probe)) {
+    return std::nullopt;
+  }
+  return probe.start;
+}
+
+// Past this, more messages only bury the first ones, which are usually the cause.
+constexpr std::size_t kMaxDiagnostics = 100;
+// A config is a few KiB; anything this large is the wrong file.
+constexpr std::size_t kMaxFileBytes = std::size_t{16} << 20;
+
+}  // namespace
+
+Config parse_config_text(const std::string& text, const std::string& path) {
+  DiagnosticSink sink;
+  Config cfg;
+  cfg.path = path;
+  config_detail::Parser parser(path, sink);
+  config_detail::Reader reader(path, sink);
+  YAML::Node root;
+  bool loaded = false;
+  try {
+    root = YAML::Load(text);
+    loaded = true;
+    if (const auto second = second_document_mark(text)) {
+      const SourceLoc at = reader.loc(*second);
+      sink.error(at.line != 0 ? at : SourceLoc{path, 1, 1},
+                 "unexpected content after the first YAML document (one document per file)");
+    }
+  } catch (const YAML::DeepRecursion& e) {
+    sink.error(reader.loc(e.mark), "YAML nesting is too deep");
+  } catch (const YAML::Exception& e) {
+    sink.error(reader.loc(e.mark), "YAML syntax error: " + e.msg);
+  }
+  if (loaded) {
+    parser.parse_document(root, cfg);
+  }
+  if (sink.empty()) {
+    return cfg;
+  }
+  std::vector<Diagnostic> diags = sink.diagnostics();
+  std::stable_sort(diags.begin(), diags.end(), [](const Diagnostic& a, const Diagnostic& b) {
+    return a.loc.line != b.loc.line ? a.loc.line < b.loc.line : a.loc.col < b.loc.col;
+  });
+  if (diags.size() > kMaxDiagnostics) {
+    const std::size_t more = diags.size() - kMaxDiagnostics;
+    SourceLoc at = diags[kMaxDiagnostics].loc;
+    diags.resize(kMaxDiagnostics);
+    diags.push_back({at, std::to_string(more) + " more errors not shown"});
+  }
+  throw ConfigError(std::move(diags));
+}
+
+Config parse_config_file(const std::string& path) {
+  const auto fail = [&](const std::string& what, int err) {
+    throw ConfigError({{{path, 0, 0}, what + ": " + std::generic_category().message(err)}});
+  };
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                       &std::fclose);
+  if (!file) {
+    fail("cannot open", errno);
+  }
+  std::string text;
+  char buf[65536];
+  while (true) {
+    const std::size_t n = std::fread(buf, 1, sizeof buf, file.get());
+    text.append(buf, n);
+    if (text.size() > kMaxFileBytes) {
+      throw ConfigError({{{path, 0, 0}, "file is larger than 16 MiB; is this a config?"}});
+    }
+    if (n < sizeof buf) {
+      if (std::ferror(file.get()) != 0) {
+        fail("cannot read", errno);
+      }
+      break;
+    }
+  }
+  return parse_config_text(text, path);
+}
+
+}  // namespace edm::rt

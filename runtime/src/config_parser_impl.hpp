@@ -1,0 +1,87 @@
+#pragma once
+// Private to the config parser: the Parser class shared by config_parser.cpp (document, cross
+// references, entry points) and config_sections.cpp (one function per section).
+// Non-RT; thread-compatible (one Parser per parse).
+
+#include <climits>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "edm/runtime/config.hpp"
+#include "yaml_util.hpp"
+
+namespace edm::rt::config_detail {
+
+using yaml_util::Field;
+using yaml_util::MapView;
+using yaml_util::Reader;
+using yaml_util::ScalarKind;
+using yaml_util::Value;
+
+constexpr std::int64_t kMaxInt = INT_MAX;
+constexpr std::int64_t kMaxLineBytes = std::int64_t{16} << 20;
+
+inline std::string line_of(const SourceLoc& loc) { return std::to_string(loc.line); }
+
+class UniqueNames {
+ public:
+  /// Returns the first location if `name` was seen before.
+  const SourceLoc* add(const std::string& name, const SourceLoc& loc) {
+    const auto [it, inserted] = first_.emplace(name, loc);
+    return inserted ? nullptr : &it->second;
+  }
+  [[nodiscard]] bool contains(const std::string& name) const { return first_.count(name) != 0; }
+
+ private:
+  std::unordered_map<std::string, SourceLoc> first_;
+};
+
+class Parser {
+ public:
+  Parser(const std::string& path, DiagnosticSink& sink) : r_(path, sink) {}
+
+  void parse_document(const YAML::Node& root, Config& cfg);
+
+ private:
+  void parse_machine(const Value& v, MachineSpec& out);
+  void parse_io(const Value& v, IoSpec& out);
+  // Both return where the entry's identity (axis name, E number) was written, for duplicates.
+  SourceLoc parse_axis(const Value& v, AxisSpec& out);
+  SourceLoc parse_condition(const Value& v, ConditionSpec& out);
+  void parse_task(const Value& v, TaskSpec& out);
+  void parse_watchdog(const Value& v, WatchdogSpec& out);
+  void parse_program(const Value& v, ProgramSpec& out);
+  void parse_block(const Value& v, BlockSpec& out);
+  void parse_params(const Value& v, std::vector<ParamSetting>& out);
+  void parse_wires(const Value& v, std::vector<WireSpec>& out);
+  void parse_trace(const Value& v, TraceSpec& out);
+  void parse_bridge(const Value& v, BridgeSpec& out);
+  void parse_retain(const Value& v, RetainSpec& out);
+  std::vector<NameRef> parse_variable_names(const Value& v);
+  void cross_check(const Config& cfg);
+
+  // Optional-field helpers: read `key` if present and store it on success.
+  std::optional<std::string> identifier(const Value& v, const char* what);
+  void positive(const MapView& m, std::string_view key, double& out);
+  template <class Int>
+  void int_in(const MapView& m, std::string_view key, std::int64_t min, std::int64_t max,
+              Int& out) {
+    if (const Field* f = m.find(key)) {
+      if (auto x = r_.integer(f->value, min, max)) {
+        out = static_cast<Int>(*x);
+      }
+    }
+  }
+
+  Reader r_;
+  // Cross-reference checks stay quiet when a section could not be read, to avoid cascades.
+  bool task_names_complete_{true};
+  bool task_programs_complete_{true};
+  bool program_names_complete_{true};
+};
+
+}  // namespace edm::rt::config_detail

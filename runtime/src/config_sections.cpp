@@ -1,0 +1,432 @@
+// Config parser, one function per section: keys, types and ranges. See config_parser.cpp.
+
+#include <utility>
+
+#include "config_parser_impl.hpp"
+
+namespace edm::rt::config_detail {
+
+std::optional<std::string> Parser::identifier(const Value& v, const char* what) {
+  auto s = r_.string(v);
+  if (s && !yaml_util::is_identifier(*s)) {
+    r_.error(v, std::string(what) + " '" + *s +
+                    "' is not an identifier (letters, digits and _, not starting with a digit)");
+    return std::nullopt;
+  }
+  return s;
+}
+
+void Parser::positive(const MapView& m, std::string_view key, double& out) {
+  if (const Field* f = m.find(key)) {
+    if (auto x = r_.real(f->value)) {
+      if (*x <= 0.0) {
+        r_.error(f->value, "must be > 0 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out = *x;
+      }
+    }
+  }
+}
+
+void Parser::parse_machine(const Value& v, MachineSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"name", "io", "axes"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = r_.require(*m, "name")) {
+    out.name = r_.string(f->value).value_or("");
+  }
+  out.io.loc = v.loc;
+  out.io.driver_loc = v.loc;
+  if (const Field* f = m->find("io")) {
+    parse_io(f->value, out.io);
+  }
+  if (const Field* f = m->find("axes")) {
+    if (auto items = r_.list(f->value)) {
+      UniqueNames names;
+      for (const Value& item : *items) {
+        AxisSpec a;
+        const SourceLoc name_loc = parse_axis(item, a);
+        if (!a.name.empty()) {
+          if (const SourceLoc* first = names.add(a.name, name_loc)) {
+            r_.error(name_loc, item.path + ".name",
+                     "duplicate axis '" + a.name + "' (first at line " + line_of(*first) + ")");
+          }
+        }
+        out.axes.push_back(std::move(a));
+      }
+    }
+  }
+}
+
+void Parser::parse_io(const Value& v, IoSpec& out) {
+  out.loc = v.loc;
+  out.driver_loc = v.loc;
+  auto m = r_.map(v, {"driver", "task", "params"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = m->find("driver")) {
+    out.driver_loc = f->value.loc;
+    if (auto s = r_.string(f->value)) {
+      out.driver = *s;
+    }
+  }
+  if (const Field* f = m->find("task")) {
+    if (auto s = identifier(f->value, "task name")) {
+      out.task = NameRef{*s, f->value.loc};
+    }
+  }
+  if (const Field* f = m->find("params")) {
+    parse_params(f->value, out.params);
+  }
+}
+
+SourceLoc Parser::parse_axis(const Value& v, AxisSpec& out) {
+  out.loc = v.loc;
+  SourceLoc name_loc = v.loc;
+  auto m = r_.map(v, {"name", "min_mm", "max_mm", "v_max_mm_s", "a_max_mm_s2"});
+  if (!m) {
+    return name_loc;
+  }
+  if (const Field* f = r_.require(*m, "name")) {
+    name_loc = f->value.loc;
+    out.name = r_.choice(f->value, {"X", "Y", "Z"}).value_or("");
+  }
+  std::optional<double> min_mm;
+  std::optional<double> max_mm;
+  if (const Field* f = r_.require(*m, "min_mm")) {
+    min_mm = r_.real(f->value);
+  }
+  const Field* max_field = r_.require(*m, "max_mm");
+  if (max_field != nullptr) {
+    max_mm = r_.real(max_field->value);
+  }
+  if (min_mm && max_mm && *max_mm <= *min_mm) {
+    r_.error(max_field->value, "must be > min_mm (got max_mm " + max_field->value.node.Scalar() +
+                                   " <= min_mm " + m->find("min_mm")->value.node.Scalar() + ")");
+  }
+  out.min_mm = min_mm.value_or(out.min_mm);
+  out.max_mm = max_mm.value_or(out.max_mm);
+  positive(*m, "v_max_mm_s", out.v_max_mm_s);
+  positive(*m, "a_max_mm_s2", out.a_max_mm_s2);
+  return name_loc;
+}
+
+SourceLoc Parser::parse_condition(const Value& v, ConditionSpec& out) {
+  out.loc = v.loc;
+  SourceLoc e_loc = v.loc;
+  auto m = r_.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
+                      "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio"});
+  if (!m) {
+    return e_loc;
+  }
+  if (const Field* f = r_.require(*m, "E")) {
+    e_loc = f->value.loc;
+    out.e = static_cast<int>(r_.integer(f->value, 1, kMaxInt).value_or(0));
+  }
+  if (const Field* f = m->find("name")) {
+    out.name = r_.string(f->value).value_or("");
+  }
+  if (const Field* f = m->find("polarity")) {
+    if (auto s = r_.choice(f->value, {"negative", "positive"})) {
+      out.polarity = *s == "positive" ? Polarity::kPositive : Polarity::kNegative;
+    }
+  }
+  positive(*m, "open_voltage_v", out.open_voltage_v);
+  positive(*m, "peak_current_a", out.peak_current_a);
+  positive(*m, "on_time_us", out.on_time_us);
+  positive(*m, "off_time_us", out.off_time_us);
+  positive(*m, "tdr_us", out.tdr_us);
+  positive(*m, "servo_ref_v", out.servo_ref_v);
+  if (const Field* f = m->find("wear_ratio")) {
+    if (auto x = r_.real(f->value)) {
+      if (*x < 0.0 || *x > 10.0) {
+        r_.error(f->value, "must be in 0..10 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.wear_ratio = *x;
+      }
+    }
+  }
+  return e_loc;
+}
+
+void Parser::parse_task(const Value& v, TaskSpec& out) {
+  out.loc = v.loc;
+  out.name_loc = v.loc;
+  auto m = r_.map(v, {"name", "interval", "priority", "cpu", "overrun", "watchdog", "programs"});
+  if (!m) {
+    task_names_complete_ = task_programs_complete_ = false;
+    return;
+  }
+  if (const Field* f = r_.require(*m, "name")) {
+    out.name_loc = f->value.loc;
+    out.name = identifier(f->value, "task name").value_or("");
+  }
+  if (out.name.empty()) {
+    task_names_complete_ = false;
+  }
+  if (const Field* f = r_.require(*m, "interval")) {
+    if (auto d = r_.duration(f->value)) {
+      if (d->count() <= 0) {
+        r_.error(f->value, "must be > 0 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.interval = *d;
+      }
+    }
+  }
+  int_in(*m, "priority", 0, 31, out.priority);
+  if (const Field* f = m->find("cpu")) {
+    if (auto x = r_.integer(f->value, 0, kMaxInt)) {
+      out.cpu = static_cast<int>(*x);
+    }
+  }
+  if (const Field* f = m->find("overrun")) {
+    if (auto s = r_.choice(f->value, {"skip", "asap"})) {
+      out.overrun = *s == "asap" ? OverrunPolicy::kAsap : OverrunPolicy::kSkip;
+    }
+  }
+  if (const Field* f = m->find("watchdog")) {
+    parse_watchdog(f->value, out.watchdog);
+  }
+  const Field* f = r_.require(*m, "programs");
+  auto items = f != nullptr ? r_.list(f->value) : std::nullopt;
+  if (!items) {
+    task_programs_complete_ = false;
+    return;
+  }
+  if (items->empty()) {
+    r_.error(f->value, "must list at least one program");
+  }
+  for (const Value& item : *items) {
+    if (auto s = r_.string(item)) {
+      out.programs.push_back({*s, item.loc});
+    } else {
+      task_programs_complete_ = false;
+    }
+  }
+}
+
+void Parser::parse_watchdog(const Value& v, WatchdogSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"time", "sensitivity", "action"});
+  if (!m) {
+    return;
+  }
+  out.enabled = true;
+  if (const Field* f = r_.require(*m, "time")) {
+    if (auto d = r_.duration(f->value)) {
+      if (d->count() <= 0) {
+        r_.error(f->value, "must be > 0 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.time = *d;
+      }
+    }
+  }
+  int_in(*m, "sensitivity", 1, kMaxInt, out.sensitivity);
+  if (const Field* f = m->find("action")) {
+    if (auto s = r_.choice(f->value, {"fault", "warn"})) {
+      out.action = *s == "warn" ? WatchdogAction::kWarn : WatchdogAction::kFault;
+    }
+  }
+}
+
+void Parser::parse_program(const Value& v, ProgramSpec& out) {
+  out.loc = v.loc;
+  out.name_loc = v.loc;
+  auto m = r_.map(v, {"name", "blocks", "wires"});
+  if (!m) {
+    program_names_complete_ = false;
+    return;
+  }
+  if (const Field* f = r_.require(*m, "name")) {
+    out.name_loc = f->value.loc;
+    if (auto s = identifier(f->value, "program name")) {
+      // Reserved names still count as known so tasks naming them don't cascade.
+      out.name = *s;
+      if (*s == "io") {
+        r_.error(f->value, "'io' is reserved (it names the process image); pick another name");
+      }
+    }
+  }
+  if (out.name.empty()) {
+    program_names_complete_ = false;
+  }
+  if (const Field* f = m->find("blocks")) {
+    if (auto items = r_.list(f->value)) {
+      UniqueNames names;
+      for (const Value& item : *items) {
+        BlockSpec b;
+        parse_block(item, b);
+        if (!b.name.empty()) {
+          if (const SourceLoc* first = names.add(b.name, b.name_loc)) {
+            r_.error(b.name_loc, item.path + ".name",
+                     "duplicate block name '" + b.name + "' in program '" + out.name +
+                         "' (first at line " + line_of(*first) + ")");
+          }
+        }
+        out.blocks.push_back(std::move(b));
+      }
+    }
+  }
+  if (const Field* f = m->find("wires")) {
+    parse_wires(f->value, out.wires);
+  }
+}
+
+void Parser::parse_block(const Value& v, BlockSpec& out) {
+  out.loc = v.loc;
+  out.name_loc = v.loc;
+  out.type_loc = v.loc;
+  auto m = r_.map(v, {"name", "type", "params"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = r_.require(*m, "name")) {
+    out.name_loc = f->value.loc;
+    if (auto s = identifier(f->value, "block name")) {
+      out.name = *s;
+      if (*s == "io") {
+        r_.error(f->value, "'io' is reserved (it names the process image); pick another name");
+      }
+    }
+  }
+  if (const Field* f = r_.require(*m, "type")) {
+    out.type_loc = f->value.loc;
+    out.type = r_.string(f->value).value_or("");
+  }
+  if (const Field* f = m->find("params")) {
+    parse_params(f->value, out.params);
+  }
+}
+
+void Parser::parse_params(const Value& v, std::vector<ParamSetting>& out) {
+  auto m = r_.map(v, {});
+  if (!m) {
+    return;
+  }
+  for (const Field& f : m->fields) {
+    if (!yaml_util::is_identifier(f.key)) {
+      r_.error(f.key_loc, v.path, "parameter name '" + f.key + "' is not an identifier");
+      continue;
+    }
+    if (!r_.scalar(f.value, "a scalar (number, true/false, duration or string)")) {
+      continue;
+    }
+    out.push_back({f.key, f.value.node.Scalar(), Reader::is_quoted(f.value.node), f.key_loc,
+                   f.value.loc});
+  }
+}
+
+void Parser::parse_wires(const Value& v, std::vector<WireSpec>& out) {
+  auto m = r_.map(v, {}, "; an input can be wired only once");
+  if (!m) {
+    return;
+  }
+  for (const Field& f : m->fields) {
+    if (!yaml_util::is_dotted_name(f.key, 2, 2)) {
+      r_.error(f.key_loc, v.path,
+               "destination '" + f.key + "' must be block.pin or io.pin (an input)");
+      continue;
+    }
+    if (!r_.scalar(f.value, "a source (block.pin, program.block.pin, io.pin or a constant)")) {
+      continue;
+    }
+    WireSpec w{f.key, f.value.node.Scalar(), true, f.key_loc, f.value.loc};
+    const bool quoted = Reader::is_quoted(f.value.node);
+    const ScalarKind kind = quoted ? ScalarKind::kString : yaml_util::classify_plain(w.source);
+    if (kind == ScalarKind::kBool || kind == ScalarKind::kInt || kind == ScalarKind::kReal ||
+        kind == ScalarKind::kNonFinite) {
+      // Constants must be finite and representable; real() says what is wrong otherwise.
+      if (kind != ScalarKind::kBool && !r_.real(f.value)) {
+        continue;
+      }
+      w.source_is_name = false;
+    } else if (!yaml_util::is_dotted_name(w.source, 2, 3)) {
+      r_.error(f.value.loc, v.path,
+               "source '" + w.source + "' of " + f.key +
+                   " must be block.pin, program.block.pin, io.pin, a number or true/false");
+      continue;
+    }
+    out.push_back(std::move(w));
+  }
+}
+
+std::vector<NameRef> Parser::parse_variable_names(const Value& v) {
+  std::vector<NameRef> out;
+  if (auto items = r_.list(v)) {
+    for (const Value& item : *items) {
+      if (auto s = r_.string(item)) {
+        if (yaml_util::is_dotted_name(*s, 2, 3)) {
+          out.push_back({*s, item.loc});
+        } else {
+          r_.error(item, "'" + *s + "' is not a variable name (program.block.pin or io.pin)");
+        }
+      }
+    }
+  }
+  return out;
+}
+
+void Parser::parse_trace(const Value& v, TraceSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"variables", "capacity"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = m->find("variables")) {
+    out.variables = parse_variable_names(f->value);
+  }
+  if (const Field* f = m->find("capacity")) {
+    if (auto x = r_.integer(f->value, 16, 1 << 20)) {
+      if ((*x & (*x - 1)) != 0) {
+        r_.error(f->value, "must be a power of two (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.capacity = static_cast<std::size_t>(*x);
+      }
+    }
+  }
+}
+
+void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions",
+                      "max_line_bytes"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = m->find("bind")) {
+    out.bind = r_.string(f->value).value_or(out.bind);
+  }
+  int_in(*m, "port", 0, 65535, out.port);
+  if (const Field* f = m->find("token_file")) {
+    out.token_file = r_.string(f->value).value_or("");
+  }
+  if (const Field* f = m->find("viewer_token_file")) {
+    out.viewer_token_file = r_.string(f->value).value_or("");
+  }
+  int_in(*m, "max_sessions", 1, 64, out.max_sessions);
+  int_in(*m, "max_line_bytes", 1024, kMaxLineBytes, out.max_line_bytes);
+}
+
+void Parser::parse_retain(const Value& v, RetainSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"file", "min_interval", "variables"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = r_.require(*m, "file")) {
+    out.file = r_.string(f->value).value_or("");
+  }
+  if (const Field* f = m->find("min_interval")) {
+    if (auto d = r_.duration(f->value)) {
+      out.min_interval = *d;
+    }
+  }
+  if (const Field* f = m->find("variables")) {
+    out.variables = parse_variable_names(f->value);
+  }
+}
+
+}  // namespace edm::rt::config_detail

@@ -1,0 +1,154 @@
+// Every file in tests/configs/bad/ states its first error on line 1:
+//   # expect: LINE:COL: <substring of the message>
+// The parser (in process) and `edmplc --check` (as a subprocess) must both report exactly that.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "edm/runtime/config.hpp"
+
+namespace edm::rt {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BadCase {
+  std::string path;
+  std::string name;  // file stem, for test names
+  int line{0};
+  int col{0};
+  std::string message;  // substring expected in the first diagnostic
+  std::string header;   // line 1 as written, for failure messages
+};
+
+std::vector<BadCase> load_cases() {
+  std::vector<BadCase> cases;
+  std::error_code ec;
+  const fs::path dir = fs::path(EDM_TEST_DATA_DIR) / "configs" / "bad";
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (e.path().extension() != ".yaml") {
+      continue;
+    }
+    BadCase c;
+    c.path = e.path().string();
+    c.name = e.path().stem().string();
+    std::replace_if(
+        c.name.begin(), c.name.end(), [](char ch) { return std::isalnum(ch) == 0; }, '_');
+    std::ifstream in(e.path());
+    std::getline(in, c.header);
+    const std::string prefix = "# expect: ";
+    if (c.header.rfind(prefix, 0) == 0) {
+      // "LINE:COL: message"; a malformed header leaves line 0 and fails the test below.
+      const std::string rest = c.header.substr(prefix.size());
+      const std::size_t c1 = rest.find(':');
+      const std::size_t c2 = c1 == std::string::npos ? c1 : rest.find(':', c1 + 1);
+      if (c2 != std::string::npos && c2 + 2 <= rest.size()) {
+        c.line = std::atoi(rest.substr(0, c1).c_str());
+        c.col = std::atoi(rest.substr(c1 + 1, c2 - c1 - 1).c_str());
+        c.message = rest.substr(c2 + 2);
+      }
+    }
+    cases.push_back(std::move(c));
+  }
+  std::sort(cases.begin(), cases.end(),
+            [](const BadCase& a, const BadCase& b) { return a.name < b.name; });
+  return cases;
+}
+
+const std::vector<BadCase>& cases() {
+  static const std::vector<BadCase> kCases = load_cases();
+  return kCases;
+}
+
+std::string case_name(const ::testing::TestParamInfo<BadCase>& info) { return info.param.name; }
+
+TEST(BadConfigs, directory_holds_at_least_fifteen_cases) { EXPECT_GE(cases().size(), 15u); }
+
+class BadConfigParse : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadConfigParse, first_diagnostic_matches_expectation) {
+  const BadCase& c = GetParam();
+  ASSERT_GT(c.line, 0) << c.path << ": line 1 must be '# expect: LINE:COL: message', got '"
+                       << c.header << "'";
+  ASSERT_FALSE(c.message.empty()) << c.path;
+  try {
+    parse_config_file(c.path);
+    FAIL() << c.path << " parsed without error";
+  } catch (const ConfigError& e) {
+    ASSERT_FALSE(e.diagnostics().empty());
+    const Diagnostic& d = e.diagnostics().front();
+    EXPECT_EQ(d.loc.file, c.path);
+    EXPECT_EQ(d.loc.line, c.line) << d.str();
+    EXPECT_EQ(d.loc.col, c.col) << d.str();
+    EXPECT_NE(d.message.find(c.message), std::string::npos)
+        << "expected '" << c.message << "' in: " << d.str();
+    EXPECT_EQ(std::string(e.what()), d.str());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, BadConfigParse, ::testing::ValuesIn(cases()), case_name);
+
+struct CommandResult {
+  int exit_code{-1};
+  std::string output;
+};
+
+// Runs a shell command, capturing stdout and stderr together.
+CommandResult run_command(const std::string& command) {
+  CommandResult r;
+  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
+  if (p == nullptr) {
+    return r;
+  }
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) {
+    r.output.append(buf.data(), n);
+  }
+  const int status = ::pclose(p);
+  if (status != -1 && WIFEXITED(status)) {
+    r.exit_code = WEXITSTATUS(status);
+  }
+  return r;
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char ch : s) {
+    out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  }
+  return out + "'";
+}
+
+class BadConfigCheck : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadConfigCheck, edmplc_check_reports_it_and_exits_2) {
+  const BadCase& c = GetParam();
+  ASSERT_GT(c.line, 0) << c.path;
+  // timeout: a hang is a failure (exit 124), not a stuck test run.
+  const CommandResult r = run_command("timeout 20 " + shell_quote(EDM_EDMPLC_PATH) + " --check --config " +
+                    shell_quote(c.path));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  const std::string where =
+      c.path + ":" + std::to_string(c.line) + ":" + std::to_string(c.col) + ":";
+  EXPECT_NE(r.output.find(where), std::string::npos) << "expected '" << where << "' in:\n"
+                                                     << r.output;
+  EXPECT_NE(r.output.find(c.message), std::string::npos) << "expected '" << c.message
+                                                         << "' in:\n"
+                                                         << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, BadConfigCheck, ::testing::ValuesIn(cases()), case_name);
+
+}  // namespace
+}  // namespace edm::rt

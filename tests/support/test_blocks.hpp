@@ -1,0 +1,154 @@
+#pragma once
+// Blocks used only by tests: they record what the scheduler did and inject execution time.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/type_registry.hpp"
+
+namespace edm::test {
+
+/// One entry per update(): which block, its release and the clock's time when it ran.
+struct RunRecord {
+  const char* who;
+  rt::TimePoint release;
+  rt::TimePoint started;
+  std::uint64_t cycle;
+  rt::MachineState state;
+};
+
+/// Shared log of RunRecords (reserved up front so recording never allocates).
+inline std::vector<RunRecord>& run_log() {
+  static std::vector<RunRecord> log;
+  return log;
+}
+
+/// Records each update into run_log(); `tag` names it.
+struct RecorderParams {
+  std::string tag{"rec"};
+  void visit(rt::ParamVisitor& v) { v.param("tag", tag); }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const { return {}; }
+};
+class Recorder final : public rt::BlockWithParams<RecorderParams> {
+ public:
+  void visit_pins(rt::PinVisitor& v) override { v.output("count", count_); }
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
+    auto& log = run_log();
+    if (log.size() < log.capacity()) {
+      log.push_back({params_.tag.c_str(), ctx.release, ctx.clock->now(), ctx.cycle, ctx.state});
+    }
+    count_.set(count_.get() + 1);
+    return rt::BlockStatus::kOk;
+  }
+  int safe_entries{0};
+  void enter_safe_state(const rt::SafeStateRequest&) noexcept override { ++safe_entries; }
+
+ private:
+  rt::Output<std::int64_t> count_;
+};
+
+/// Charges execution time to the virtual clock: cost_us on cycles [from_cycle, from_cycle +
+/// cycles) (cycles < 0: forever). Lets tests inject overruns deterministically.
+struct CostParams {
+  double cost_us{0.0};
+  std::int64_t from_cycle{0};
+  std::int64_t cycles{-1};
+  void visit(rt::ParamVisitor& v) {
+    v.param("cost_us", cost_us, "us");
+    v.param("from_cycle", from_cycle);
+    v.param("cycles", cycles);
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const { return {}; }
+};
+class Cost final : public rt::BlockWithParams<CostParams> {
+ public:
+  void visit_pins(rt::PinVisitor& /*v*/) override {}
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
+    const auto c = static_cast<std::int64_t>(ctx.cycle);
+    const bool active =
+        c >= params_.from_cycle && (params_.cycles < 0 || c < params_.from_cycle + params_.cycles);
+    if (active && ctx.clock != nullptr && ctx.clock->kind() == rt::ClockKind::kVirtual) {
+      auto* vc = const_cast<rt::VirtualClock*>(static_cast<const rt::VirtualClock*>(ctx.clock));
+      vc->advance(rt::Duration{static_cast<std::int64_t>(params_.cost_us * 1000.0)});
+    }
+    return rt::BlockStatus::kOk;
+  }
+};
+
+/// out = in + 1 each cycle (REAL), and an LINT cycle counter; flags a fault when in is NaN.
+class AddOne final : public rt::Block {
+ public:
+  void visit_pins(rt::PinVisitor& v) override {
+    v.input("in", in_);
+    v.output("out", out_);
+    v.input("flag", flag_);
+    v.output("ticks", ticks_);
+  }
+  rt::BlockStatus update(const rt::CycleContext&) noexcept override {
+    const double x = in_.get();
+    ticks_.set(ticks_.get() + 1);
+    if (x != x) {
+      return rt::BlockStatus::kFault;
+    }
+    out_.set(x + 1.0);
+    return rt::BlockStatus::kOk;
+  }
+
+ private:
+  rt::Input<double> in_;
+  rt::Output<double> out_;
+  rt::Input<bool> flag_;
+  rt::Output<std::int64_t> ticks_;
+};
+
+/// A block with every parameter type, for parameter reading/writing tests.
+struct AllParams {
+  double gain{1.0};
+  std::int64_t count{3};
+  bool enabled{true};
+  rt::Duration hold{std::chrono::milliseconds(5)};
+  std::string label{"x"};
+  void visit(rt::ParamVisitor& v) {
+    v.param("gain", gain, "1", "must be in [0, 100]");
+    v.param("count", count);
+    v.param("enabled", enabled);
+    v.param("hold", hold, "s");
+    v.param("label", label);
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const {
+    std::vector<rt::ParamError> errs;
+    rt::require_range(errs, "gain", gain, 0.0, 100.0);
+    if (count < 1) {
+      errs.push_back({"count", "must be >= 1"});
+    }
+    return errs;
+  }
+};
+class ParamProbe final : public rt::BlockWithParams<AllParams> {
+ public:
+  void visit_pins(rt::PinVisitor& v) override { v.output("gain_seen", gain_seen_); }
+  rt::BlockStatus update(const rt::CycleContext&) noexcept override {
+    gain_seen_.set(params_.gain);
+    return rt::BlockStatus::kOk;
+  }
+  int changes{0};
+
+ protected:
+  void params_changed() noexcept override { ++changes; }
+
+ private:
+  rt::Output<double> gain_seen_;
+};
+
+inline void register_test_blocks(rt::BlockRegistry& r) {
+  r.add<Recorder>("Recorder");
+  r.add<Cost>("Cost");
+  r.add<AddOne>("AddOne");
+  r.add<ParamProbe>("ParamProbe");
+}
+
+}  // namespace edm::test
