@@ -218,6 +218,9 @@ int main(int argc, char** argv) {
   ro.stop = &g_stop;
   ro.trace_out = opt.trace_out;
   int code = kExitOk;
+  spdlog::info("running {} task(s) on the {} clock{}", rt->tasks().size(),
+               opt.clock == edm::rt::ClockKind::kReal ? "real" : "virtual",
+               opt.run_for ? " for " + edm::rt::format_duration(*opt.run_for) : "");
   try {
     const edm::rt::RunSummary s = rt->run(ro);
     if (s.trace_dropped > 0) {

@@ -1,6 +1,8 @@
 #include "edm/runtime/runtime.hpp"
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <thread>
@@ -64,10 +66,10 @@ RunSummary Runtime::run(const RunOptions& options) {
   if (options.clock == ClockKind::kVirtual) {
     VirtualClock clock;
     std::ofstream trace_file;
-    if (!options.trace_out.empty()) {
+    if (!options.trace_out.empty() && has_trace_) {
       trace_file.open(options.trace_out, std::ios::out | std::ios::trunc);
       if (!trace_file) {
-        throw std::runtime_error("cannot write trace file '" + options.trace_out + "'");
+        throw std::runtime_error(options.trace_out + ": " + std::strerror(errno));
       }
     }
     VirtualScheduler sched(tasks, clock);

@@ -231,8 +231,9 @@ std::optional<MapView> Reader::map(const Value& v, std::initializer_list<std::st
   }
   MapView m{v, {}, {}};
   std::unordered_map<std::string, int> first_line;  // every key seen, known or not
-  for (auto it = v.node.begin(); it != v.node.end(); ++it) {
-    const YAML::Node& key_node = it->first;
+  // Range-for keeps yaml-cpp's by-value iterator_value alive; it->first would dangle.
+  for (const auto& kv : v.node) {
+    const YAML::Node& key_node = kv.first;
     SourceLoc key_loc = loc(key_node);
     if (key_loc.line == 0) {
       key_loc = v.loc;
@@ -273,7 +274,7 @@ std::optional<MapView> Reader::map(const Value& v, std::initializer_list<std::st
       error(key_loc, v.path, msg);
       continue;
     }
-    const YAML::Node& value = it->second;
+    const YAML::Node& value = kv.second;
     SourceLoc value_loc = loc(value);
     // An empty value's mark is the next token, often on a later line: point at the key instead.
     if (value_loc.line == 0 || (value.IsNull() && value_loc.line != key_loc.line)) {
@@ -293,12 +294,12 @@ std::optional<std::vector<Value>> Reader::list(const Value& v) {
   std::vector<Value> out;
   out.reserve(v.node.size());
   std::size_t i = 0;
-  for (auto it = v.node.begin(); it != v.node.end(); ++it, ++i) {
-    SourceLoc l = loc(*it);
+  for (const auto& element : v.node) {
+    SourceLoc l = loc(element);
     if (l.line == 0) {
       l = v.loc;
     }
-    out.push_back({*it, l, v.path + "[" + std::to_string(i) + "]"});
+    out.push_back({element, l, v.path + "[" + std::to_string(i++) + "]"});
   }
   return out;
 }

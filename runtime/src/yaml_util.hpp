@@ -4,15 +4,9 @@
 // carry on with the next key (errors are collected, not thrown).
 // Non-RT (allocates, uses yaml-cpp); thread-compatible (one Reader per parse).
 
-// GCC 12 reports false -Wdangling-pointer positives inside yaml-cpp 0.7's node iterators.
-#pragma GCC diagnostic push
-#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
-#pragma GCC diagnostic ignored "-Wdangling-pointer"
-#endif
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
-#pragma GCC diagnostic pop
 
 #include <cstdint>
 #include <initializer_list>

@@ -12,6 +12,7 @@
 // RT-safe: update(), params_changed(). Not thread-safe: the owning task calls every member except
 // the pins (see pin.hpp).
 
+#include <cstdint>
 #include <vector>
 
 #include "edm/runtime/block.hpp"
