@@ -1,6 +1,7 @@
 // Config parser: YAML → Config structs, checking structure, keys, types, ranges and the
 // cross-references between sections (task ↔ program). Block types, parameters and wire endpoints
 // are the builder's job. All problems are collected and thrown together, sorted by position.
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <system_error>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "config_parser_impl.hpp"
 
@@ -30,8 +32,8 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
                       Reader::describe(root));
     return;
   }
-  auto m = r_.map(top, {"version", "machine", "conditions", "tasks", "programs", "trace",
-                        "bridge", "retain"});
+  auto m = r_.map(
+      top, {"version", "machine", "conditions", "tasks", "programs", "trace", "bridge", "retain"});
   if (const Field* f = r_.require(*m, "version")) {
     auto v = r_.integer(f->value, 0, INT64_MAX);
     if (!v) {
@@ -77,9 +79,9 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
         parse_task(item, t);
         if (!t.name.empty()) {
           if (const SourceLoc* first = names.add(t.name, t.name_loc)) {
-            r_.error(t.name_loc, item.path + ".name",
-                     "duplicate task name '" + t.name + "' (first at line " + line_of(*first) +
-                         ")");
+            r_.error(
+                t.name_loc, item.path + ".name",
+                "duplicate task name '" + t.name + "' (first at line " + line_of(*first) + ")");
           }
         }
         cfg.tasks.push_back(std::move(t));
@@ -99,9 +101,9 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
         parse_program(item, p);
         if (!p.name.empty()) {
           if (const SourceLoc* first = names.add(p.name, p.name_loc)) {
-            r_.error(p.name_loc, item.path + ".name",
-                     "duplicate program name '" + p.name + "' (first at line " + line_of(*first) +
-                         ")");
+            r_.error(
+                p.name_loc, item.path + ".name",
+                "duplicate program name '" + p.name + "' (first at line " + line_of(*first) + ")");
           }
         }
         cfg.programs.push_back(std::move(p));
@@ -129,9 +131,9 @@ void Parser::cross_check(const Config& cfg) {
       r_.error(ref.loc, "machine.io.task", "unknown task '" + ref.name + "'");
     }
   }
-  std::unordered_map<std::string, const ProgramSpec*> programs;
+  std::unordered_set<std::string> programs;
   for (const ProgramSpec& p : cfg.programs) {
-    programs.emplace(p.name, &p);
+    programs.insert(p.name);
   }
   // program name → the task that runs it and where it was listed
   std::unordered_map<std::string, std::pair<const TaskSpec*, SourceLoc>> owner;
@@ -139,7 +141,8 @@ void Parser::cross_check(const Config& cfg) {
     for (const NameRef& ref : t.programs) {
       if (programs.count(ref.name) == 0) {
         if (program_names_complete_) {
-          r_.error(ref.loc, "task '" + t.name + "'", "unknown program '" + ref.name + "'");
+          r_.error(ref.loc, "task '" + t.name + "'",
+                   "unknown program " + yaml_util::quote(ref.name));
         }
         continue;
       }

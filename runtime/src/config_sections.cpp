@@ -9,8 +9,8 @@ namespace edm::rt::config_detail {
 std::optional<std::string> Parser::identifier(const Value& v, const char* what) {
   auto s = r_.string(v);
   if (s && !yaml_util::is_identifier(*s)) {
-    r_.error(v, std::string(what) + " '" + *s +
-                    "' is not an identifier (letters, digits and _, not starting with a digit)");
+    r_.error(v, std::string(what) + " " + yaml_util::quote(*s) +
+                    " is not an identifier (letters, digits and _, not starting with a digit)");
     return std::nullopt;
   }
   return s;
@@ -308,14 +308,15 @@ void Parser::parse_params(const Value& v, std::vector<ParamSetting>& out) {
   }
   for (const Field& f : m->fields) {
     if (!yaml_util::is_identifier(f.key)) {
-      r_.error(f.key_loc, v.path, "parameter name '" + f.key + "' is not an identifier");
+      r_.error(f.key_loc, v.path,
+               "parameter name " + yaml_util::quote(f.key) + " is not an identifier");
       continue;
     }
     if (!r_.scalar(f.value, "a scalar (number, true/false, duration or string)")) {
       continue;
     }
-    out.push_back({f.key, f.value.node.Scalar(), Reader::is_quoted(f.value.node), f.key_loc,
-                   f.value.loc});
+    out.push_back(
+        {f.key, f.value.node.Scalar(), Reader::is_quoted(f.value.node), f.key_loc, f.value.loc});
   }
 }
 
@@ -326,8 +327,9 @@ void Parser::parse_wires(const Value& v, std::vector<WireSpec>& out) {
   }
   for (const Field& f : m->fields) {
     if (!yaml_util::is_dotted_name(f.key, 2, 2)) {
-      r_.error(f.key_loc, v.path,
-               "destination '" + f.key + "' must be block.pin or io.pin (an input)");
+      r_.error(
+          f.key_loc, v.path,
+          "destination " + yaml_util::quote(f.key) + " must be block.pin or io.pin (an input)");
       continue;
     }
     if (!r_.scalar(f.value, "a source (block.pin, program.block.pin, io.pin or a constant)")) {
@@ -345,7 +347,7 @@ void Parser::parse_wires(const Value& v, std::vector<WireSpec>& out) {
       w.source_is_name = false;
     } else if (!yaml_util::is_dotted_name(w.source, 2, 3)) {
       r_.error(f.value.loc, v.path,
-               "source '" + w.source + "' of " + f.key +
+               "source " + yaml_util::quote(w.source) + " of " + f.key +
                    " must be block.pin, program.block.pin, io.pin, a number or true/false");
       continue;
     }
@@ -361,7 +363,8 @@ std::vector<NameRef> Parser::parse_variable_names(const Value& v) {
         if (yaml_util::is_dotted_name(*s, 2, 3)) {
           out.push_back({*s, item.loc});
         } else {
-          r_.error(item, "'" + *s + "' is not a variable name (program.block.pin or io.pin)");
+          r_.error(item,
+                   yaml_util::quote(*s) + " is not a variable name (program.block.pin or io.pin)");
         }
       }
     }
@@ -391,8 +394,8 @@ void Parser::parse_trace(const Value& v, TraceSpec& out) {
 
 void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions",
-                      "max_line_bytes"});
+  auto m = r_.map(
+      v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions", "max_line_bytes"});
   if (!m) {
     return;
   }

@@ -456,16 +456,9 @@ class RuntimeBuilder {
                                std::string(v->type_name()) + "; retain BOOL, LINT or LREAL");
         continue;
       }
-      std::string name = n.name;
-      vars.push_back({name, type, [&reg, name, type]() {
-                        RetainValue rv{};
-                        rv.type = type;
-                        const double x = reg.read(name).value_or(0.0);
-                        rv.b = x != 0.0;
-                        rv.i = static_cast<std::int64_t>(x);
-                        rv.r = x;
-                        return rv;
-                      }});
+      const Variable* var = v;
+      vars.push_back(
+          {n.name, type, [&reg, var, type]() { return read_retained(reg, *var, type); }});
     }
     if (!diag_.empty()) {
       return;
@@ -480,6 +473,31 @@ class RuntimeBuilder {
     rt_->retain_ = std::make_unique<RetainStore>(rs.file, rs.min_interval, std::move(vars));
   }
 
+  // Reads a retained variable with its exact type (LINT stays exact beyond 2^53).
+  static RetainValue read_retained(const VariableRegistry& reg, const Variable& v,
+                                   RetainType type) {
+    if (v.is_pin()) {
+      switch (v.pin.type) {
+        case PinType::kBool:
+          return RetainValue::make_bool(v.pin.as_output<bool>()->get());
+        case PinType::kInt:
+          return RetainValue::make_int(v.pin.as_output<std::int64_t>()->get());
+        case PinType::kReal:
+          return RetainValue::make_real(v.pin.as_output<double>()->get());
+      }
+    }
+    const ParamValue p = reg.read_param(v.name).value_or(ParamValue{});
+    switch (type) {
+      case RetainType::kBool:
+        return RetainValue::make_bool(p.b);
+      case RetainType::kInt:
+        return RetainValue::make_int(p.i);
+      case RetainType::kReal:
+        return RetainValue::make_real(p.r);
+    }
+    return {};
+  }
+
   void restore(const std::string& name, const RetainValue& value) {
     const Variable* v = rt_->variables_.find(name);
     bool listed = std::any_of(cfg_.retain.variables.begin(), cfg_.retain.variables.end(),
@@ -489,11 +507,26 @@ class RuntimeBuilder {
                    name, cfg_.retain.file);
       return;
     }
-    const double x = value.type == RetainType::kBool  ? (value.b ? 1.0 : 0.0)
-                     : value.type == RetainType::kInt ? static_cast<double>(value.i)
-                                                      : value.r;
+    // The config may have changed since the file was written: only restore a value of the same
+    // type, and never a non-finite real into a controller.
+    const std::string_view want = v->type_name();
+    const std::string_view have = value.type == RetainType::kBool  ? "BOOL"
+                                  : value.type == RetainType::kInt ? "LINT"
+                                                                   : "LREAL";
+    if (want != have) {
+      spdlog::warn("retain: '{}' is {} in the file but {} in the config; not restored", name, have,
+                   want);
+      return;
+    }
+    if (value.type == RetainType::kReal && !std::isfinite(value.r)) {
+      spdlog::warn("retain: '{}' holds a non-finite value; not restored", name);
+      return;
+    }
     if (!v->is_pin()) {
-      VarStatus st = rt_->variables_.write(name, x, /*apply_now=*/true);
+      const ParamValue pv = value.type == RetainType::kBool  ? ParamValue::of_bool(value.b)
+                            : value.type == RetainType::kInt ? ParamValue::of_int(value.i)
+                                                             : ParamValue::of_real(value.r);
+      VarStatus st = rt_->variables_.write(name, pv, /*apply_now=*/true);
       if (!st) {
         spdlog::warn("retain: '{}' not restored: {}", name, st.message);
       }
@@ -501,13 +534,13 @@ class RuntimeBuilder {
     }
     switch (v->pin.type) {
       case PinType::kBool:
-        v->pin.as_output<bool>()->set(x != 0.0);
+        v->pin.as_output<bool>()->set(value.b);
         break;
       case PinType::kInt:
-        v->pin.as_output<std::int64_t>()->set(static_cast<std::int64_t>(x));
+        v->pin.as_output<std::int64_t>()->set(value.i);
         break;
       case PinType::kReal:
-        v->pin.as_output<double>()->set(x);
+        v->pin.as_output<double>()->set(value.r);
         break;
     }
   }

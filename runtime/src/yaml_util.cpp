@@ -109,6 +109,8 @@ std::string join(std::initializer_list<std::string_view> items) {
   return out;
 }
 
+}  // namespace
+
 std::string quote(std::string_view text) {
   // Control bytes would garble a terminal; long values would drown the message.
   std::string out = "'";
@@ -122,8 +124,6 @@ std::string quote(std::string_view text) {
   out += "'";
   return out;
 }
-
-}  // namespace
 
 ScalarKind classify_plain(std::string_view text) noexcept {
   if (text.empty() || text == "~" || text == "null" || text == "Null" || text == "NULL") {
@@ -195,9 +195,7 @@ SourceLoc Reader::loc(const YAML::Mark& mark) const {
   return {file_, mark.line + 1, mark.column + 1};
 }
 
-void Reader::error(const Value& at, const std::string& message) {
-  error(at.loc, at.path, message);
-}
+void Reader::error(const Value& at, const std::string& message) { error(at.loc, at.path, message); }
 
 void Reader::error(const SourceLoc& at, const std::string& path, const std::string& message) {
   sink_.error(at, path.empty() ? message : path + ": " + message);
@@ -307,8 +305,7 @@ std::optional<std::vector<Value>> Reader::list(const Value& v) {
 const Field* Reader::require(const MapView& m, std::string_view key) {
   const Field* f = m.find(key);
   // A misspelt required key was already reported with a suggestion; one message is enough.
-  if (f == nullptr &&
-      std::find(m.suggested.begin(), m.suggested.end(), key) == m.suggested.end()) {
+  if (f == nullptr && std::find(m.suggested.begin(), m.suggested.end(), key) == m.suggested.end()) {
     error(m.self, "missing required key '" + std::string(key) + "'");
   }
   return f;
@@ -345,8 +342,8 @@ std::optional<std::int64_t> Reader::integer(const Value& v, std::int64_t min, st
   const std::string& text = v.node.Scalar();
   const ScalarKind kind = is_quoted(v.node) ? ScalarKind::kString : classify_plain(text);
   if (kind != ScalarKind::kInt) {
-    error(v, "expected an integer, got " + std::string(kind == ScalarKind::kString ? "the string " : "") +
-                 quote(text));
+    error(v, "expected an integer, got " +
+                 std::string(kind == ScalarKind::kString ? "the string " : "") + quote(text));
     return std::nullopt;
   }
   const std::string_view digits = strip_plus(text);
@@ -376,8 +373,8 @@ std::optional<double> Reader::real(const Value& v) {
     return std::nullopt;
   }
   if (kind != ScalarKind::kInt && kind != ScalarKind::kReal) {
-    error(v, "expected a number, got " + std::string(kind == ScalarKind::kString ? "the string " : "") +
-                 quote(text));
+    error(v, "expected a number, got " +
+                 std::string(kind == ScalarKind::kString ? "the string " : "") + quote(text));
     return std::nullopt;
   }
   const std::string_view digits = strip_plus(text);
@@ -398,7 +395,8 @@ std::optional<Duration> Reader::duration(const Value& v) {
   if (!is_quoted(v.node)) {
     const ScalarKind kind = classify_plain(text);
     if (kind == ScalarKind::kInt || kind == ScalarKind::kReal) {
-      error(v, "duration needs a unit, e.g. 1ms (got " + quote(text) + "; units: ns, us, ms, s, min)");
+      error(v,
+            "duration needs a unit, e.g. 1ms (got " + quote(text) + "; units: ns, us, ms, s, min)");
       return std::nullopt;
     }
   }

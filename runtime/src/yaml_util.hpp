@@ -27,6 +27,9 @@ enum class ScalarKind : std::uint8_t { kNull, kBool, kInt, kReal, kNonFinite, kS
 /// Classifies the text of a plain (unquoted) scalar.
 ScalarKind classify_plain(std::string_view text) noexcept;
 
+/// Text for a message: in single quotes, control bytes as '?', cut after 40 characters.
+std::string quote(std::string_view text);
+
 /// [A-Za-z_][A-Za-z0-9_]*
 bool is_identifier(std::string_view s) noexcept;
 
@@ -50,7 +53,7 @@ struct Field {
 /// A map whose keys were checked: scalars, unique, and (when a key set was given) known.
 struct MapView {
   Value self;
-  std::vector<Field> fields;  // file order, first occurrence of each key only
+  std::vector<Field> fields;           // file order, first occurrence of each key only
   std::vector<std::string> suggested;  // keys offered as "did you mean" for unknown keys
 
   [[nodiscard]] const Field* find(std::string_view key) const noexcept;
@@ -88,7 +91,8 @@ class Reader {
   std::optional<double> real(const Value& v);
   std::optional<Duration> duration(const Value& v);
   /// One of `choices` (quoted or plain), e.g. "skip"/"asap".
-  std::optional<std::string> choice(const Value& v, std::initializer_list<std::string_view> choices);
+  std::optional<std::string> choice(const Value& v,
+                                    std::initializer_list<std::string_view> choices);
 
   /// True if the scalar was written quoted (or tagged !!str): a string, whatever its text.
   [[nodiscard]] static bool is_quoted(const YAML::Node& node);

@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <string>
 #include <string_view>
@@ -106,7 +107,13 @@ class BlockHarness {
     ctx.period = period_;
     ctx.dt_s = dt_s();
     ctx.cycle = cycle_;
-    ctx.release = rt::TimePoint{period_ * static_cast<std::int64_t>(cycle_)};
+    // Saturates instead of overflowing for the huge cycle counts some tests jump to.
+    const auto max_cycle = period_.count() <= 0
+                               ? std::uint64_t{0}
+                               : static_cast<std::uint64_t>(
+                                     std::numeric_limits<std::int64_t>::max() / period_.count());
+    ctx.release =
+        cycle_ <= max_cycle ? period_ * static_cast<std::int64_t>(cycle_) : rt::TimePoint::max();
     ctx.state = rt::MachineState::kRunning;
     ++cycle_;
     return block_.update(ctx);

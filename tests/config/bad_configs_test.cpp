@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,9 @@ struct BadCase {
   std::string message;  // substring expected in the first diagnostic
   std::string header;   // line 1 as written, for failure messages
 };
+
+// Keeps gtest/ctest names readable instead of a byte dump of the struct.
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.path; }
 
 std::vector<BadCase> load_cases() {
   std::vector<BadCase> cases;
@@ -136,15 +140,14 @@ TEST_P(BadConfigCheck, edmplc_check_reports_it_and_exits_2) {
   const BadCase& c = GetParam();
   ASSERT_GT(c.line, 0) << c.path;
   // timeout: a hang is a failure (exit 124), not a stuck test run.
-  const CommandResult r = run_command("timeout 20 " + shell_quote(EDM_EDMPLC_PATH) + " --check --config " +
-                    shell_quote(c.path));
+  const CommandResult r = run_command("timeout 20 " + shell_quote(EDM_EDMPLC_PATH) +
+                                      " --check --config " + shell_quote(c.path));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   const std::string where =
       c.path + ":" + std::to_string(c.line) + ":" + std::to_string(c.col) + ":";
   EXPECT_NE(r.output.find(where), std::string::npos) << "expected '" << where << "' in:\n"
                                                      << r.output;
-  EXPECT_NE(r.output.find(c.message), std::string::npos) << "expected '" << c.message
-                                                         << "' in:\n"
+  EXPECT_NE(r.output.find(c.message), std::string::npos) << "expected '" << c.message << "' in:\n"
                                                          << r.output;
 }
 

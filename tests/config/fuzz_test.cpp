@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -15,7 +16,11 @@
 namespace edm::rt {
 namespace {
 
-constexpr int kCases = 500;
+// EDM_CONFIG_FUZZ_CASES=50000 for a longer local run.
+int case_count(int fallback) {
+  const char* env = std::getenv("EDM_CONFIG_FUZZ_CASES");
+  return env != nullptr && std::atoi(env) > 0 ? std::atoi(env) : fallback;
+}
 constexpr std::uint64_t kSeed = 0x5eed'ed3f'00c0'ffeeULL;
 const std::string kPath = "fuzz.yaml";
 
@@ -101,8 +106,9 @@ TEST(ConfigFuzz, mutations_of_full_config_fail_cleanly) {
   ASSERT_FALSE(good.empty());
   ASSERT_NO_THROW(parse_config_text(good, kPath));
   std::mt19937_64 rng(kSeed);
+  const int cases = case_count(500);
   int rejected = 0;
-  for (int i = 0; i < kCases; ++i) {
+  for (int i = 0; i < cases; ++i) {
     std::string text = good;
     const int rounds = 1 + static_cast<int>(rng() % 3);
     for (int k = 0; k < rounds; ++k) {
@@ -111,13 +117,14 @@ TEST(ConfigFuzz, mutations_of_full_config_fail_cleanly) {
     rejected += check_parse(text, i) ? 1 : 0;
   }
   // Guards against a mutator that silently stopped mutating.
-  EXPECT_GT(rejected, kCases / 10);
-  EXPECT_LT(rejected, kCases);
+  EXPECT_GT(rejected, cases / 10);
+  EXPECT_LT(rejected, cases);
 }
 
 TEST(ConfigFuzz, random_bytes_fail_cleanly) {
   std::mt19937_64 rng(kSeed + 1);
-  for (int i = 0; i < 200; ++i) {
+  const int cases = case_count(200);
+  for (int i = 0; i < cases; ++i) {
     std::string text(rng() % 512, '\0');
     for (char& c : text) {
       c = static_cast<char>(rng() & 0xff);

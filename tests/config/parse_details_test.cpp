@@ -77,7 +77,7 @@ TEST(ParseFile, directory_is_an_error_not_an_empty_config) {
 TEST(Collect, several_errors_reported_in_file_order) {
   const auto d = errors_of(
       "version: 1\n"
-      "machine: {name: m, colour: red}\n"                                  // 2: unknown key
+      "machine: {name: m, colour: red}\n"  // 2: unknown key
       "tasks:\n"
       "  - {name: fast, interval: 1ms, priority: 99, programs: [p, q]}\n"  // 4: range, unknown q
       "programs:\n"
@@ -198,8 +198,8 @@ TEST(Hostile, alias_bomb_is_not_expanded) {
   std::string text = "a0: &a0 [x, x, x, x, x, x, x, x, x]\n";
   for (int i = 1; i < 30; ++i) {
     const std::string p = "*a" + std::to_string(i - 1);
-    text += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [" + p + ", " + p + ", " +
-            p + ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + "]\n";
+    text += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [" + p + ", " + p + ", " + p +
+            ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + "]\n";
   }
   const auto start = std::chrono::steady_clock::now();
   const auto d = errors_of(text);
@@ -242,11 +242,11 @@ TEST(Hostile, encodings_and_line_endings) {
                 .machine.name,
             "m");
   // Invalid UTF-8 in a free-form string is kept as written; in an identifier it is an error.
-  EXPECT_EQ(parse_config_text("version: 1\nmachine: {name: \"m\xff\"}\n" + kTasks +
-                                  "programs: [{name: p}]\n",
-                              "t")
-                .machine.name,
-            "m\xff");
+  EXPECT_EQ(
+      parse_config_text(
+          "version: 1\nmachine: {name: \"m\xff\"}\n" + kTasks + "programs: [{name: p}]\n", "t")
+          .machine.name,
+      "m\xff");
   EXPECT_FALSE(errors_of(kHead + "tasks: [{name: \"f\xc3\", interval: 1ms, programs: [p]}]\n" +
                          "programs: [{name: p}]\n")
                    .empty());

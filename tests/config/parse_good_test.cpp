@@ -45,20 +45,20 @@ TEST_F(FullConfigTest, machine_io_and_axes) {
   EXPECT_EQ(cfg_.path, kFullPath);
   EXPECT_EQ(cfg_.version, 1);
   EXPECT_EQ(cfg_.machine.name, "drill-sim");
-  EXPECT_EQ(cfg_.machine.loc.line, 4);
+  EXPECT_EQ(cfg_.machine.loc.line, 5);
   EXPECT_EQ(cfg_.machine.io.driver, "loopback");
-  EXPECT_EQ(cfg_.machine.io.driver_loc.line, 6);
+  EXPECT_EQ(cfg_.machine.io.driver_loc.line, 7);
   EXPECT_EQ(cfg_.machine.io.driver_loc.col, 13);
   ASSERT_TRUE(cfg_.machine.io.task.has_value());
   EXPECT_EQ(cfg_.machine.io.task->name, "fast");
-  EXPECT_EQ(cfg_.machine.io.task->loc.line, 7);
+  EXPECT_EQ(cfg_.machine.io.task->loc.line, 8);
 
   const auto& params = cfg_.machine.io.params;
   ASSERT_EQ(params.size(), 5u);
   EXPECT_EQ(params[0].key, "channels");  // file order is kept
   EXPECT_EQ(params[0].value, "4");
   EXPECT_FALSE(params[0].quoted);
-  EXPECT_EQ(params[0].key_loc.line, 8);
+  EXPECT_EQ(params[0].key_loc.line, 9);
   EXPECT_EQ(params[0].key_loc.col, 14);
   EXPECT_EQ(params[0].value_loc.col, 24);
   EXPECT_EQ(find_param(params, "seed")->value, "42");
@@ -81,7 +81,7 @@ TEST_F(FullConfigTest, machine_io_and_axes) {
   EXPECT_DOUBLE_EQ(z.max_mm, 5.5);
   EXPECT_DOUBLE_EQ(z.v_max_mm_s, 10.0);
   EXPECT_DOUBLE_EQ(z.a_max_mm_s2, 500.0);
-  EXPECT_EQ(z.loc.line, 11);
+  EXPECT_EQ(z.loc.line, 12);
   EXPECT_EQ(z.loc.col, 7);
 }
 
@@ -108,14 +108,14 @@ TEST_F(FullConfigTest, conditions_with_defaults) {
   EXPECT_DOUBLE_EQ(finish.open_voltage_v, defaults.open_voltage_v);
   EXPECT_DOUBLE_EQ(finish.on_time_us, defaults.on_time_us);
   EXPECT_DOUBLE_EQ(finish.wear_ratio, defaults.wear_ratio);
-  EXPECT_EQ(finish.loc.line, 15);
+  EXPECT_EQ(finish.loc.line, 16);
 }
 
 TEST_F(FullConfigTest, tasks) {
   ASSERT_EQ(cfg_.tasks.size(), 2u);
   const TaskSpec& fast = cfg_.tasks[0];
   EXPECT_EQ(fast.name, "fast");
-  EXPECT_EQ(fast.name_loc.line, 20);
+  EXPECT_EQ(fast.name_loc.line, 21);
   EXPECT_EQ(fast.name_loc.col, 11);
   EXPECT_EQ(fast.interval, microseconds(250));
   EXPECT_EQ(fast.priority, 0);
@@ -128,7 +128,7 @@ TEST_F(FullConfigTest, tasks) {
   EXPECT_EQ(fast.watchdog.action, WatchdogAction::kWarn);
   ASSERT_EQ(fast.programs.size(), 1u);
   EXPECT_EQ(fast.programs[0].name, "gap");
-  EXPECT_EQ(fast.programs[0].loc.line, 26);
+  EXPECT_EQ(fast.programs[0].loc.line, 27);
   EXPECT_EQ(fast.programs[0].loc.col, 16);
 
   const TaskSpec& slow = cfg_.tasks[1];
@@ -150,11 +150,11 @@ TEST_F(FullConfigTest, programs_blocks_params_and_wires) {
   ASSERT_EQ(cfg_.programs.size(), 3u);
   const ProgramSpec& gap = cfg_.programs[0];
   EXPECT_EQ(gap.name, "gap");
-  EXPECT_EQ(gap.name_loc.line, 33);
+  EXPECT_EQ(gap.name_loc.line, 34);
   ASSERT_EQ(gap.blocks.size(), 2u);
   EXPECT_EQ(gap.blocks[0].name, "lp");
   EXPECT_EQ(gap.blocks[0].type, "LowPass");
-  EXPECT_EQ(gap.blocks[0].type_loc.line, 35);
+  EXPECT_EQ(gap.blocks[0].type_loc.line, 36);
   EXPECT_EQ(gap.blocks[0].type_loc.col, 26);
   ASSERT_EQ(gap.blocks[0].params.size(), 1u);
   EXPECT_EQ(gap.blocks[0].params[0].key, "tau");
@@ -164,15 +164,15 @@ TEST_F(FullConfigTest, programs_blocks_params_and_wires) {
   const BlockSpec& ctl = gap.blocks[1];
   EXPECT_EQ(ctl.name, "ctl");
   EXPECT_EQ(ctl.type, "GapControllerP");
-  EXPECT_EQ(ctl.name_loc.line, 36);
-  EXPECT_EQ(ctl.loc.line, 36);
+  EXPECT_EQ(ctl.name_loc.line, 37);
+  EXPECT_EQ(ctl.loc.line, 37);
   ASSERT_EQ(ctl.params.size(), 3u);
   EXPECT_EQ(find_param(ctl.params, "kp")->value, "0.8");
   const ParamSetting* label = find_param(ctl.params, "label");
   ASSERT_NE(label, nullptr);
   EXPECT_EQ(label->value, "1.0");
   EXPECT_TRUE(label->quoted);  // "1.0" quoted is a string, not a number
-  EXPECT_EQ(label->value_loc.line, 40);
+  EXPECT_EQ(label->value_loc.line, 41);
   EXPECT_EQ(find_param(ctl.params, "enabled")->value, "true");
 
   ASSERT_EQ(gap.wires.size(), 5u);
@@ -180,7 +180,7 @@ TEST_F(FullConfigTest, programs_blocks_params_and_wires) {
   ASSERT_NE(in, nullptr);
   EXPECT_EQ(in->source, "io.ai0");
   EXPECT_TRUE(in->source_is_name);
-  EXPECT_EQ(in->dest_loc.line, 43);
+  EXPECT_EQ(in->dest_loc.line, 44);
   EXPECT_EQ(in->dest_loc.col, 7);
   EXPECT_EQ(in->source_loc.col, 14);
   EXPECT_TRUE(find_wire(gap, "ctl.in")->source_is_name);
@@ -204,7 +204,7 @@ TEST_F(FullConfigTest, trace_bridge_retain) {
   ASSERT_EQ(cfg_.trace.variables.size(), 2u);
   EXPECT_EQ(cfg_.trace.variables[0].name, "gap.lp.out");
   EXPECT_EQ(cfg_.trace.variables[1].name, "io.ai0");
-  EXPECT_EQ(cfg_.trace.variables[1].loc.line, 56);
+  EXPECT_EQ(cfg_.trace.variables[1].loc.line, 57);
   EXPECT_EQ(cfg_.trace.variables[1].loc.col, 27);
   EXPECT_EQ(cfg_.trace.capacity, 4096u);
 

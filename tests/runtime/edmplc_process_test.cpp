@@ -106,6 +106,19 @@ TEST_F(EdmplcProcess, RetainedValueIsRestoredOnRestart) {
   EXPECT_NEAR(r.values.at("p.integ.out").r, 0.25, 1e-12);
 }
 
+TEST_F(EdmplcProcess, RetainedValueOfTheWrongTypeOrNonFiniteIsNotRestored) {
+  const std::string path = (dir_ / "retain.dat").string();
+  for (const rt::RetainValue& stale :
+       {rt::RetainValue::make_int(5), rt::RetainValue::make_real(std::nan(""))}) {
+    rt::write_retain_file_atomic(path, {{"p.integ.out", stale}});
+    Child c(args({"--clock", "virtual", "--run-for", "250ms"}));
+    ASSERT_EQ(c.wait(), 0) << c.output();
+    EXPECT_NE(c.output().find("not restored"), std::string::npos) << c.output();
+    const rt::RetainLoadResult r = rt::load_retain_file(path);
+    EXPECT_NEAR(r.values.at("p.integ.out").r, 0.25, 1e-12) << "started from the default 0";
+  }
+}
+
 TEST_F(EdmplcProcess, VirtualClockTracesAreByteIdentical) {
   std::string first;
   for (int run = 0; run < 2; ++run) {
