@@ -8,7 +8,8 @@
 // only the fraction in [0, 1) is turned into an angle. The phase stays accurate to ~1e-15 rad
 // at any cycle count below 2^53 (over 285 000 years at 1 kHz).
 //
-// Frequencies at or above the Nyquist rate 1/(2·dt) alias (sampling, not a bug).
+// Frequencies at or above the Nyquist rate 1/(2·dt) alias (sampling, not a bug). The cycle count
+// counts executed cycles: a slot omitted after an overrun delays the sine by one period dt.
 // RT-safe: update(), params_changed(). Not thread-safe: the owning task calls every member except
 // the pins (see pin.hpp).
 

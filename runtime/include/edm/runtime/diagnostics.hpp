@@ -2,6 +2,7 @@
 // Located error messages for configuration files: "file:line:col: message".
 // Non-RT; thread-compatible.
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,9 +42,14 @@ class DiagnosticSink {
   }
   [[nodiscard]] bool empty() const noexcept { return diags_.empty(); }
   [[nodiscard]] const std::vector<Diagnostic>& diagnostics() const noexcept { return diags_; }
+  /// Throws every diagnostic, in file order (line, then column; stable for equal places).
   void throw_if_any() const {
     if (!diags_.empty()) {
-      throw ConfigError(diags_);
+      std::vector<Diagnostic> sorted = diags_;
+      std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
+        return a.loc.line != b.loc.line ? a.loc.line < b.loc.line : a.loc.col < b.loc.col;
+      });
+      throw ConfigError(std::move(sorted));
     }
   }
 
