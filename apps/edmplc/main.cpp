@@ -3,6 +3,8 @@
 // retain flushed, statistics and trace written. Exit codes: 0 ok, 1 runtime failure or alarm,
 // 2 bad input. See docs/runtime.md.
 
+#include <spdlog/spdlog.h>
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -11,8 +13,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-
-#include <spdlog/spdlog.h>
 
 #include "edm/blocks/register.hpp"
 #include "edm/runtime/config.hpp"
@@ -198,9 +198,8 @@ int main(int argc, char** argv) {
   if (!rt->retain_warning().empty()) {
     spdlog::warn("retain: {} — starting from defaults", rt->retain_warning());
   }
-  const int bridge_port = opt.bridge_port.value_or(rt->config().bridge.loc.line != 0
-                                                       ? rt->config().bridge.port
-                                                       : 0);
+  const int bridge_port =
+      opt.bridge_port.value_or(rt->config().bridge.loc.line != 0 ? rt->config().bridge.port : 0);
   if (bridge_port != 0) {
     spdlog::warn("bridge: not yet available in this build (port {} requested); running without",
                  bridge_port);

@@ -28,7 +28,7 @@ void Limiter::visit_pins(rt::PinVisitor& v) {
 std::vector<rt::ParamError> Limiter::configure(const rt::BlockSetup& setup) {
   std::vector<rt::ParamError> errs;
   require_task_period(errs, setup.period);
-  dt_s_ = seconds_of(setup.period);
+  dt_s_ = rt::to_seconds(setup.period);
   compute_step();
   return errs;
 }

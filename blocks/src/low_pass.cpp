@@ -8,7 +8,7 @@ namespace edm::blocks {
 
 std::vector<rt::ParamError> LowPassParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_positive(errs, "tau", seconds_of(tau));
+  rt::require_positive(errs, "tau", rt::to_seconds(tau));
   require_finite(errs, "initial", initial);
   return errs;
 }

@@ -100,8 +100,22 @@ void require_non_negative(std::vector<ParamError>& errs, std::string_view field,
 void require_range(std::vector<ParamError>& errs, std::string_view field, double v, double lo,
                    double hi) {
   if (!(v >= lo && v <= hi)) {
-    errs.push_back({std::string(field),
-                    "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")"});
+    errs.push_back(
+        {std::string(field), "must be in [" + num(lo) + ", " + num(hi) + "] (got " + num(v) + ")"});
+  }
+}
+
+void require_finite(std::vector<ParamError>& errs, std::string_view field, double v) {
+  if (!std::isfinite(v)) {
+    errs.push_back({std::string(field), "must be a finite number (got " + num(v) + ")"});
+  }
+}
+
+void require_ordered(std::vector<ParamError>& errs, std::string_view lo_field, double lo,
+                     std::string_view hi_field, double hi) {
+  if (!(lo <= hi)) {
+    errs.push_back({std::string(hi_field), "must be >= " + std::string(lo_field) + " (got " +
+                                               num(hi) + " < " + num(lo) + ")"});
   }
 }
 

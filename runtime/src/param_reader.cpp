@@ -31,8 +31,7 @@ class SettingsReader final : public ParamVisitor {
  private:
   void bad(const ParamSetting& s, std::string_view type, std::string_view hint) {
     diag_.error(s.value_loc, std::string(what_) + ": parameter '" + s.key + "' is " +
-                                 std::string(type) + ", got '" + s.value + "'" +
-                                 std::string(hint));
+                                 std::string(type) + ", got '" + s.value + "'" + std::string(hint));
   }
 
   void convert(const ParamSetting& s, ParamRef ref) {
@@ -70,8 +69,7 @@ class SettingsReader final : public ParamVisitor {
       case ParamType::kDuration: {
         DurationParse d = parse_duration(t);
         if (!d.value) {
-          diag_.error(s.value_loc,
-                      std::string(what_) + ": parameter '" + s.key + "': " + d.error);
+          diag_.error(s.value_loc, std::string(what_) + ": parameter '" + s.key + "': " + d.error);
         } else {
           *static_cast<Duration*>(ref.field) = *d.value;
         }
@@ -88,15 +86,15 @@ class SettingsReader final : public ParamVisitor {
   DiagnosticSink& diag_;
 };
 
-std::string join(const std::vector<std::string>& v) {
+}  // namespace
+
+std::string join_names(const std::vector<std::string>& names) {
   std::string out;
-  for (const auto& s : v) {
+  for (const auto& s : names) {
     out += (out.empty() ? "" : ", ") + s;
   }
   return out.empty() ? "none" : out;
 }
-
-}  // namespace
 
 void read_params(Block& block, const std::vector<ParamSetting>& settings, std::string_view what,
                  DiagnosticSink& diag) {
@@ -105,7 +103,7 @@ void read_params(Block& block, const std::vector<ParamSetting>& settings, std::s
   for (const ParamSetting& s : settings) {
     if (r.used.count(s.key) == 0) {
       diag.error(s.key_loc, std::string(what) + ": unknown parameter '" + s.key +
-                                "' (parameters: " + join(r.names) + ")");
+                                "' (parameters: " + join_names(r.names) + ")");
     }
   }
 }
@@ -120,8 +118,7 @@ void report_param_errors(const std::vector<ParamError>& errs,
         loc = s.value_loc;
       }
     }
-    diag.error(loc, std::string(what) + ": " + (e.field.empty() ? "" : e.field + " ") +
-                        e.message);
+    diag.error(loc, std::string(what) + ": " + (e.field.empty() ? "" : e.field + " ") + e.message);
   }
 }
 

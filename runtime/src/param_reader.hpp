@@ -12,6 +12,9 @@
 
 namespace edm::rt {
 
+/// "a, b, c" ("none" for an empty list), for messages that list what would have been valid.
+std::string join_names(const std::vector<std::string>& names);
+
 /// Sets every field named in `settings`, converting text to the field's type; reports bad
 /// values at the value and unknown keys at the key. `what` names the owner in messages
 /// (e.g. "block 'lp' (LowPass)").

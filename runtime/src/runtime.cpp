@@ -1,13 +1,13 @@
 #include "edm/runtime/runtime.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <thread>
-
-#include <spdlog/spdlog.h>
 
 #include "edm/runtime/scheduler.hpp"
 
@@ -110,8 +110,9 @@ RunSummary Runtime::run(const RunOptions& options) {
     }
     RealTimeScheduler sched;
     sched.start(tasks, clock);
-    const TimePoint deadline = options.run_for ? clock.now() + *options.run_for
-                                               : TimePoint{std::numeric_limits<std::int64_t>::max()};
+    const TimePoint deadline = options.run_for
+                                   ? clock.now() + *options.run_for
+                                   : TimePoint{std::numeric_limits<std::int64_t>::max()};
     // The controlling thread only watches the time and the stop flag; the tasks do the work.
     while (!stop_requested() && clock.now() < deadline) {
       drain_alarms();

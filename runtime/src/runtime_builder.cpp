@@ -1,12 +1,12 @@
 // Builds a Runtime from a parsed Config: driver, blocks, parameters, wires, tasks, variables,
 // trace channels and the retain store. Every problem is reported as file:line:col.
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <map>
-
-#include <spdlog/spdlog.h>
 
 #include "edm/runtime/runtime.hpp"
 #include "param_reader.hpp"
@@ -73,14 +73,6 @@ std::vector<std::string> split(const std::string& s) {
   }
 }
 
-std::string join(const std::vector<std::string>& v) {
-  std::string out;
-  for (const auto& s : v) {
-    out += (out.empty() ? "" : ", ") + s;
-  }
-  return out.empty() ? "none" : out;
-}
-
 }  // namespace
 
 class RuntimeBuilder {
@@ -137,7 +129,7 @@ class RuntimeBuilder {
     rt_->driver_ = driver_types_.create(io.driver);
     if (!rt_->driver_) {
       diag_.error(io.driver_loc, "machine.io.driver: unknown I/O driver '" + io.driver +
-                                     "' (known: " + join(driver_types_.names()) + ")");
+                                     "' (known: " + join_names(driver_types_.names()) + ")");
       return;
     }
     const std::string what = "I/O driver '" + io.driver + "'";
@@ -173,7 +165,7 @@ class RuntimeBuilder {
         std::unique_ptr<Block> block = block_types_.create(bs.type);
         if (!block) {
           diag_.error(bs.type_loc, "block '" + bs.name + "': unknown block type '" + bs.type +
-                                       "' (known: " + join(block_types_.names()) + ")");
+                                       "' (known: " + join_names(block_types_.names()) + ")");
           continue;
         }
         const std::string what = "block '" + bs.name + "' (" + bs.type + ")";
@@ -204,8 +196,8 @@ class RuntimeBuilder {
   }
 
   // Resolves a wire endpoint to a pin entry, reporting what is wrong at loc.
-  const PinEntry* resolve(const std::string& program, const std::string& name,
-                          const SourceLoc& loc, bool allow_other_program) {
+  const PinEntry* resolve(const std::string& program, const std::string& name, const SourceLoc& loc,
+                          bool allow_other_program) {
     std::vector<std::string> parts = split(name);
     std::string key;
     std::string block_key;
@@ -236,7 +228,7 @@ class RuntimeBuilder {
     }
     std::string type = block_key == "io" ? "I/O driver" : block_types_by_name_[block_key];
     diag_.error(loc, "'" + name + "': " + type + " '" + block_key + "' has no pin '" +
-                         parts.back() + "' (pins: " + join(bit->second) + ")");
+                         parts.back() + "' (pins: " + join_names(bit->second) + ")");
     return nullptr;
   }
 
@@ -288,8 +280,8 @@ class RuntimeBuilder {
           continue;
         }
         if (dest->ref.dir != PinDir::kInput) {
-          diag_.error(w.dest_loc, "'" + w.dest +
-                                      "' is an output: a wire goes into an input (dest: source)");
+          diag_.error(w.dest_loc,
+                      "'" + w.dest + "' is an output: a wire goes into an input (dest: source)");
           continue;
         }
         if (!w.source_is_name) {
@@ -301,15 +293,15 @@ class RuntimeBuilder {
           continue;
         }
         if (src->ref.dir != PinDir::kOutput) {
-          diag_.error(w.source_loc, "'" + w.source + "' is an input: a wire's source must be "
-                                                     "an output");
+          diag_.error(w.source_loc, "'" + w.source +
+                                        "' is an input: a wire's source must be "
+                                        "an output");
           continue;
         }
         if (src->ref.type != dest->ref.type) {
           diag_.error(w.source_loc, "type mismatch: '" + w.dest + "' is " +
                                         std::string(to_string(dest->ref.type)) + " but '" +
-                                        w.source + "' is " +
-                                        std::string(to_string(src->ref.type)));
+                                        w.source + "' is " + std::string(to_string(src->ref.type)));
           continue;
         }
         switch (src->ref.type) {
@@ -404,8 +396,7 @@ class RuntimeBuilder {
       if (it == per_task.end()) {
         continue;
       }
-      const std::uint32_t ch = rt_->trace_.add_channel(t->name(), it->second,
-                                                       cfg_.trace.capacity);
+      const std::uint32_t ch = rt_->trace_.add_channel(t->name(), it->second, cfg_.trace.capacity);
       t->attach_trace(rt_->trace_, ch);
       rt_->has_trace_ = true;
     }
@@ -438,8 +429,8 @@ class RuntimeBuilder {
         continue;
       }
       if (v->kind == VarKind::kInput) {
-        diag_.error(n.loc, "retain: '" + n.name +
-                               "' is an input (wired); retain outputs or parameters");
+        diag_.error(n.loc,
+                    "retain: '" + n.name + "' is an input (wired); retain outputs or parameters");
         continue;
       }
       RetainType type = RetainType::kReal;
@@ -452,8 +443,8 @@ class RuntimeBuilder {
       } else if (v->param_type == ParamType::kInt) {
         type = RetainType::kInt;
       } else if (v->param_type == ParamType::kString || v->param_type == ParamType::kDuration) {
-        diag_.error(n.loc, "retain: parameter '" + n.name + "' is " +
-                               std::string(v->type_name()) + "; retain BOOL, LINT or LREAL");
+        diag_.error(n.loc, "retain: parameter '" + n.name + "' is " + std::string(v->type_name()) +
+                               "; retain BOOL, LINT or LREAL");
         continue;
       }
       const Variable* var = v;
@@ -503,8 +494,8 @@ class RuntimeBuilder {
     bool listed = std::any_of(cfg_.retain.variables.begin(), cfg_.retain.variables.end(),
                               [&](const NameRef& n) { return n.name == name; });
     if (v == nullptr || !listed) {
-      spdlog::warn("retain: '{}' in {} is not a retained variable of this config; ignored",
-                   name, cfg_.retain.file);
+      spdlog::warn("retain: '{}' in {} is not a retained variable of this config; ignored", name,
+                   cfg_.retain.file);
       return;
     }
     // The config may have changed since the file was written: only restore a value of the same

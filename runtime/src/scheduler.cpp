@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <spdlog/spdlog.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -9,8 +10,6 @@
 #include <csignal>
 #include <cstring>
 #include <stdexcept>
-
-#include <spdlog/spdlog.h>
 
 #include "edm/runtime/scheduling.hpp"
 
@@ -46,9 +45,8 @@ void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& 
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
   for (const Task* t : tasks) {
     if (t->spec().cpu && (*t->spec().cpu >= cpus || *t->spec().cpu >= CPU_SETSIZE)) {
-      throw std::runtime_error("task '" + t->name() + "': cpu " +
-                               std::to_string(*t->spec().cpu) + " is not available (" +
-                               std::to_string(cpus) + " online)");
+      throw std::runtime_error("task '" + t->name() + "': cpu " + std::to_string(*t->spec().cpu) +
+                               " is not available (" + std::to_string(cpus) + " online)");
     }
   }
   ready_.store(0);
@@ -138,8 +136,7 @@ void VirtualScheduler::run_until(TimePoint end, const std::function<void()>& bet
     std::size_t pick = tasks_.size();
     for (std::size_t i = 0; i < tasks_.size(); ++i) {
       if (pick == tasks_.size() || next_[i] < next_[pick] ||
-          (next_[i] == next_[pick] &&
-           tasks_[i]->spec().priority < tasks_[pick]->spec().priority)) {
+          (next_[i] == next_[pick] && tasks_[i]->spec().priority < tasks_[pick]->spec().priority)) {
         pick = i;
       }
     }
@@ -150,7 +147,8 @@ void VirtualScheduler::run_until(TimePoint end, const std::function<void()>& bet
     const TimePoint release = next_[pick];
     clock_->advance_to(release);
     const TimePoint done = task.run_cycle(release, *clock_);
-    const NextRelease n = rt::next_release(release, done, task.spec().interval, task.spec().overrun);
+    const NextRelease n =
+        rt::next_release(release, done, task.spec().interval, task.spec().overrun);
     if (n.overrun) {
       task.stats().record_overrun(n.omitted);
     }

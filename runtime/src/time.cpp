@@ -57,8 +57,8 @@ DurationParse parse_duration(std::string_view text) {
   double dummy = 0.0;
   auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), dummy);
   if (ec == std::errc{} && end == t.data() + t.size()) {
-    return {std::nullopt, "duration '" + std::string(text) +
-                              "' needs a unit (ns, us, ms, s, min), e.g. 1ms"};
+    return {std::nullopt,
+            "duration '" + std::string(text) + "' needs a unit (ns, us, ms, s, min), e.g. 1ms"};
   }
   return {std::nullopt, "'" + std::string(text) + "' is not a duration (e.g. 250us, 1ms, 2s)"};
 }

@@ -115,8 +115,7 @@ VarStatus VariableRegistry::write(std::string_view name, double value, bool appl
   return write(name, *pv, apply_now);
 }
 
-VarStatus VariableRegistry::write(std::string_view name, const ParamValue& value,
-                                  bool apply_now) {
+VarStatus VariableRegistry::write(std::string_view name, const ParamValue& value, bool apply_now) {
   const Variable* v = find(name);
   if (v == nullptr) {
     return {VarResult::kNotFound, "no variable '" + std::string(name) + "'"};
@@ -136,8 +135,7 @@ VarStatus VariableRegistry::write(std::string_view name, const ParamValue& value
   if (!errs.empty()) {
     std::string msg = "'" + std::string(name) + "': ";
     for (std::size_t i = 0; i < errs.size(); ++i) {
-      msg += (i ? "; " : "") + (errs[i].field.empty() ? "" : errs[i].field + " ") +
-             errs[i].message;
+      msg += (i ? "; " : "") + (errs[i].field.empty() ? "" : errs[i].field + " ") + errs[i].message;
     }
     return {VarResult::kInvalid, msg};
   }

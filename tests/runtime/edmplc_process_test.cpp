@@ -70,8 +70,8 @@ TEST_F(EdmplcProcess, SigtermStopsInOrderAndWritesStatsTraceAndRetain) {
   for (int sig : {SIGTERM, SIGINT}) {
     SCOPED_TRACE(sig);
     fs::remove(dir_ / "retain.dat");
-    Child c(args({"--clock", "real", "--stats-out", (dir_ / "stats.json").string(),
-                  "--trace-out", (dir_ / "trace.csv").string()}));
+    Child c(args({"--clock", "real", "--stats-out", (dir_ / "stats.json").string(), "--trace-out",
+                  (dir_ / "trace.csv").string()}));
     ASSERT_TRUE(c.wait_for_output("running 1 task(s)")) << c.output();
     c.signal(sig);
     EXPECT_EQ(c.wait(), 0) << c.output();

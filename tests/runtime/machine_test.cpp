@@ -1,12 +1,12 @@
 // The machine state machine: every (state, command) pair against the documented table, and
 // fault/e-stop priorities.
 
+#include "edm/runtime/machine.hpp"
+
 #include <gtest/gtest.h>
 
 #include <map>
 #include <thread>
-
-#include "edm/runtime/machine.hpp"
 
 namespace edm::test {
 namespace {
@@ -48,19 +48,19 @@ TEST(Machine, EveryStateCommandPairFollowsTheDocumentedTable) {
   // The table of docs/runtime.md: allowed transitions; everything else is kInvalidState and
   // leaves the state unchanged (estop in ESTOP is accepted and changes nothing).
   const std::map<std::pair<S, C>, S> allowed = {
-      {{S::kOff, C::kPowerOn}, S::kReady},       {{S::kReady, C::kStart}, S::kRunning},
-      {{S::kRunning, C::kHold}, S::kHold},       {{S::kHold, C::kResume}, S::kRunning},
-      {{S::kRunning, C::kStop}, S::kReady},      {{S::kHold, C::kStop}, S::kReady},
-      {{S::kFault, C::kReset}, S::kReady},       {{S::kEstop, C::kReset}, S::kReady},
-      {{S::kReady, C::kPowerOff}, S::kOff},      {{S::kOff, C::kPowerOff}, S::kOff},
-      {{S::kFault, C::kPowerOff}, S::kOff},      {{S::kEstop, C::kPowerOff}, S::kOff},
-      {{S::kOff, C::kEstop}, S::kEstop},         {{S::kReady, C::kEstop}, S::kEstop},
-      {{S::kRunning, C::kEstop}, S::kEstop},     {{S::kHold, C::kEstop}, S::kEstop},
-      {{S::kFault, C::kEstop}, S::kEstop},       {{S::kEstop, C::kEstop}, S::kEstop},
+      {{S::kOff, C::kPowerOn}, S::kReady},   {{S::kReady, C::kStart}, S::kRunning},
+      {{S::kRunning, C::kHold}, S::kHold},   {{S::kHold, C::kResume}, S::kRunning},
+      {{S::kRunning, C::kStop}, S::kReady},  {{S::kHold, C::kStop}, S::kReady},
+      {{S::kFault, C::kReset}, S::kReady},   {{S::kEstop, C::kReset}, S::kReady},
+      {{S::kReady, C::kPowerOff}, S::kOff},  {{S::kOff, C::kPowerOff}, S::kOff},
+      {{S::kFault, C::kPowerOff}, S::kOff},  {{S::kEstop, C::kPowerOff}, S::kOff},
+      {{S::kOff, C::kEstop}, S::kEstop},     {{S::kReady, C::kEstop}, S::kEstop},
+      {{S::kRunning, C::kEstop}, S::kEstop}, {{S::kHold, C::kEstop}, S::kEstop},
+      {{S::kFault, C::kEstop}, S::kEstop},   {{S::kEstop, C::kEstop}, S::kEstop},
   };
   const S states[] = {S::kOff, S::kReady, S::kRunning, S::kHold, S::kFault, S::kEstop};
-  const C commands[] = {C::kPowerOn, C::kStart, C::kHold,     C::kResume,
-                        C::kStop,    C::kReset, C::kEstop,    C::kPowerOff};
+  const C commands[] = {C::kPowerOn, C::kStart, C::kHold,  C::kResume,
+                        C::kStop,    C::kReset, C::kEstop, C::kPowerOff};
   for (S s : states) {
     for (C c : commands) {
       rt::Machine m;
@@ -163,8 +163,7 @@ TEST(Machine, ConcurrentCommandsAndFaultsEndInAConsistentState) {
   t2.join();
   EXPECT_EQ(m.safe_epoch(), static_cast<std::uint64_t>(faults_entered.load()));
   const MachineState s = m.state();
-  EXPECT_TRUE(s == MachineState::kReady || s == MachineState::kRunning ||
-              s == MachineState::kHold);
+  EXPECT_TRUE(s == MachineState::kReady || s == MachineState::kRunning || s == MachineState::kHold);
 }
 
 }  // namespace

@@ -1,12 +1,13 @@
 // Task release order, counts and times under the virtual clock; overrun policies; watchdog.
 
+#include "edm/runtime/scheduling.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/scheduler.hpp"
-#include "edm/runtime/scheduling.hpp"
 #include "support/runtime_fixture.hpp"
 
 namespace edm::test {
@@ -243,9 +244,9 @@ TEST_F(VirtualRun, SkipVersusAsapOmittedCycles) {
 
 struct WatchdogCase {
   const char* name;
-  const char* cost;            // Cost block params
+  const char* cost;  // Cost block params
   bool expect_fault;
-  std::uint64_t fault_cycle;   // cycle whose end trips the watchdog
+  std::uint64_t fault_cycle;  // cycle whose end trips the watchdog
 };
 
 class WatchdogSemantics : public VirtualRun, public ::testing::WithParamInterface<WatchdogCase> {};
@@ -279,8 +280,8 @@ INSTANTIATE_TEST_SUITE_P(
         WatchdogCase{"ExactlyTimeIsNotOver", "cost_us: 1000", false, 0},
         WatchdogCase{"SingleOverTimeTimesSensitivity", "cost_us: 3001, from_cycle: 1, cycles: 1",
                      true, 1},
-        WatchdogCase{"SingleJustUnderThreeTimes", "cost_us: 2999, from_cycle: 1, cycles: 1",
-                     false, 0}),
+        WatchdogCase{"SingleJustUnderThreeTimes", "cost_us: 2999, from_cycle: 1, cycles: 1", false,
+                     0}),
     [](const auto& tpi) { return std::string(tpi.param.name); });
 
 TEST_F(VirtualRun, WatchdogWarnCountsButDoesNotFault) {

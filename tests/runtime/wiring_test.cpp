@@ -22,8 +22,8 @@ tasks:
 programs:
   - name: p
     blocks:
-)" + blocks + "    wires:\n" +
-         wires + R"(  - name: q
+)" + blocks +
+         "    wires:\n" + wires + R"(  - name: q
     blocks:
       - {name: b, type: AddOne}
 )";
@@ -65,8 +65,9 @@ TEST(Wiring, ForwardWireSeesThisCycleBackwardWireThePreviousOne) {
 
 TEST(Wiring, ConstantAndCrossProgramAndLoopback) {
   // q.b is wired from io.ai1, which returns p.a.out one cycle later through the loopback.
-  std::string cfg = with_program(kChain, "      a.in: 41.5\n      b.in: q.b.out\n"
-                                         "      io.ao1: a.out\n");
+  std::string cfg = with_program(kChain,
+                                 "      a.in: 41.5\n      b.in: q.b.out\n"
+                                 "      io.ao1: a.out\n");
   cfg += "    wires:\n      b.in: io.ai1\n";
   auto r = build_from_text(cfg);
   Stepper s(*r);
@@ -116,7 +117,8 @@ INSTANTIATE_TEST_SUITE_P(
         WireError{"UnknownProgram", "      a.in: zz.b.out\n", 13, 13, "unknown program 'zz'"},
         WireError{"UnknownIoPin", "      a.in: io.ai9\n", 13, 13, "has no pin 'ai9'"},
         WireError{"IoOutputAsDest", "      io.ai0: a.out\n", 13, 7, "is an output"},
-        WireError{"TooManyParts", "      a.in: p.a.b.out\n", 13, 13, "must be block.pin, program.block.pin, io.pin"}),
+        WireError{"TooManyParts", "      a.in: p.a.b.out\n", 13, 13,
+                  "must be block.pin, program.block.pin, io.pin"}),
     [](const auto& tpi) { return std::string(tpi.param.name); });
 
 TEST(BuildErrors, UnknownBlockTypeListsTheKnownOnes) {
@@ -124,8 +126,7 @@ TEST(BuildErrors, UnknownBlockTypeListsTheKnownOnes) {
       build_error(with_program("      - {name: a, type: AddOnee}\n", "      {}\n"));
   EXPECT_EQ(d.loc.line, 10);
   EXPECT_EQ(d.loc.col, 25);
-  EXPECT_NE(d.message.find("unknown block type 'AddOnee' (known: "), std::string::npos)
-      << d.str();
+  EXPECT_NE(d.message.find("unknown block type 'AddOnee' (known: "), std::string::npos) << d.str();
   EXPECT_NE(d.message.find("AddOne,"), std::string::npos) << d.str();
 }
 
@@ -137,8 +138,7 @@ TEST(BuildErrors, BadParameterValuesAreReportedAtTheValue) {
   rt::Diagnostic d = err("gain: fast");
   EXPECT_EQ(d.loc.line, 10);
   EXPECT_EQ(d.loc.col, 52);
-  EXPECT_NE(d.message.find("parameter 'gain' is LREAL, got 'fast'"), std::string::npos)
-      << d.str();
+  EXPECT_NE(d.message.find("parameter 'gain' is LREAL, got 'fast'"), std::string::npos) << d.str();
   d = err("count: 2.5");
   EXPECT_NE(d.message.find("'count' is LINT"), std::string::npos) << d.str();
   d = err("enabled: 1");
@@ -189,8 +189,8 @@ TEST(Forcing, ForcedInputIgnoresItsWire) {
 }
 
 TEST(Forcing, RefusesParametersUnknownNamesAndValuesOfTheWrongType) {
-  auto r = build_from_text(with_program(
-      kChain + "      - {name: c, type: ParamProbe}\n", "      {}\n"));
+  auto r =
+      build_from_text(with_program(kChain + "      - {name: c, type: ParamProbe}\n", "      {}\n"));
   auto& v = r->variables();
   EXPECT_EQ(v.force("p.c.gain", 1.0).result, rt::VarResult::kWrongKind);
   EXPECT_EQ(v.force("p.zz.out", 1.0).result, rt::VarResult::kNotFound);
@@ -202,8 +202,8 @@ TEST(Forcing, RefusesParametersUnknownNamesAndValuesOfTheWrongType) {
 }
 
 TEST(ParameterWrites, AreValidatedThenAppliedAtTheNextCycleStart) {
-  auto r = build_from_text(with_program(
-      "      - {name: c, type: ParamProbe, params: {gain: 2}}\n", "      {}\n"));
+  auto r = build_from_text(
+      with_program("      - {name: c, type: ParamProbe, params: {gain: 2}}\n", "      {}\n"));
   Stepper s(*r);
   auto& v = r->variables();
   s.step();
@@ -231,8 +231,8 @@ TEST(ParameterWrites, AreValidatedThenAppliedAtTheNextCycleStart) {
 }
 
 TEST(ParameterWrites, AFullQueueAnswersBusyAndLosesNothingAccepted) {
-  auto r = build_from_text(with_program(
-      "      - {name: c, type: ParamProbe, params: {gain: 2}}\n", "      {}\n"));
+  auto r = build_from_text(
+      with_program("      - {name: c, type: ParamProbe, params: {gain: 2}}\n", "      {}\n"));
   Stepper s(*r);
   auto& v = r->variables();
   std::size_t accepted = 0;

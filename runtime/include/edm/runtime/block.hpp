@@ -27,10 +27,10 @@ enum class BlockStatus : std::int8_t { kOk = 0, kSaturated = 1, kFault = -1 };
 
 /// What a block sees each cycle. RT-safe to read.
 struct CycleContext {
-  TimePoint release{};      // scheduled release time of this cycle (on the task's grid)
-  Duration period{};        // the task interval
-  double dt_s{0.0};         // the task interval in seconds
-  std::uint64_t cycle{0};   // cycle number of the task, from 0
+  TimePoint release{};     // scheduled release time of this cycle (on the task's grid)
+  Duration period{};       // the task interval
+  double dt_s{0.0};        // the task interval in seconds
+  std::uint64_t cycle{0};  // cycle number of the task, from 0
   MachineState state{MachineState::kReady};
   const Clock* clock{nullptr};
 };

@@ -25,8 +25,8 @@ struct NameRef {
 /// converts them to the parameter's type (and reports type errors at value_loc).
 struct ParamSetting {
   std::string key;
-  std::string value;      // the scalar's text
-  bool quoted{false};     // the scalar was quoted ("1.0" is then a string, not a number)
+  std::string value;   // the scalar's text
+  bool quoted{false};  // the scalar was quoted ("1.0" is then a string, not a number)
   SourceLoc key_loc;
   SourceLoc value_loc;
 };
@@ -44,8 +44,8 @@ struct BlockSpec {
 /// `block.pin`, `program.block.pin` or `io.pin` (an output), or a constant.
 struct WireSpec {
   std::string dest;
-  std::string source;          // text of the scalar
-  bool source_is_name{true};   // false: a constant (number or true/false)
+  std::string source;         // text of the scalar
+  bool source_is_name{true};  // false: a constant (number or true/false)
   SourceLoc dest_loc;
   SourceLoc source_loc;
 };
@@ -63,17 +63,17 @@ enum class OverrunPolicy : std::uint8_t { kSkip, kAsap };
 
 struct WatchdogSpec {
   bool enabled{false};
-  Duration time{};            // > 0 when enabled
-  int sensitivity{1};         // >= 1
+  Duration time{};     // > 0 when enabled
+  int sensitivity{1};  // >= 1
   WatchdogAction action{WatchdogAction::kFault};
   SourceLoc loc;
 };
 
 struct TaskSpec {
   std::string name;
-  Duration interval{};        // > 0
-  int priority{0};            // 0 = highest, 0..31
-  std::optional<int> cpu;     // >= 0
+  Duration interval{};     // > 0
+  int priority{0};         // 0 = highest, 0..31
+  std::optional<int> cpu;  // >= 0
   WatchdogSpec watchdog;
   OverrunPolicy overrun{OverrunPolicy::kSkip};
   std::vector<NameRef> programs;  // in execution order
@@ -90,11 +90,11 @@ struct IoSpec {
 };
 
 struct AxisSpec {
-  std::string name;           // X, Y or Z
+  std::string name;  // X, Y or Z
   double min_mm{0.0};
-  double max_mm{0.0};         // > min_mm
-  double v_max_mm_s{10.0};    // > 0
-  double a_max_mm_s2{1000.0}; // > 0
+  double max_mm{0.0};          // > min_mm
+  double v_max_mm_s{10.0};     // > 0
+  double a_max_mm_s2{1000.0};  // > 0
   SourceLoc loc;
 };
 
@@ -109,16 +109,16 @@ enum class Polarity : std::uint8_t { kNegative, kPositive };
 
 /// A machining condition (selected by E number).
 struct ConditionSpec {
-  int e{0};                    // >= 1, unique
+  int e{0};  // >= 1, unique
   std::string name;
   Polarity polarity{Polarity::kNegative};
   double open_voltage_v{120.0};
   double peak_current_a{10.0};
   double on_time_us{20.0};
   double off_time_us{40.0};
-  double tdr_us{8.0};          // reference ignition delay for the gap controller
-  double servo_ref_v{40.0};    // reference mean gap voltage for voltage-based servos
-  double wear_ratio{0.0};      // electrode volume / workpiece volume, 0..10
+  double tdr_us{8.0};        // reference ignition delay for the gap controller
+  double servo_ref_v{40.0};  // reference mean gap voltage for voltage-based servos
+  double wear_ratio{0.0};    // electrode volume / workpiece volume, 0..10
   SourceLoc loc;
 };
 
@@ -130,16 +130,16 @@ struct TraceSpec {
 
 struct BridgeSpec {
   std::string bind{"127.0.0.1"};
-  int port{7730};                   // 0 = no bridge
-  std::string token_file;           // operator role
-  std::string viewer_token_file;    // viewer role
+  int port{7730};                 // 0 = no bridge
+  std::string token_file;         // operator role
+  std::string viewer_token_file;  // viewer role
   int max_sessions{8};
   std::size_t max_line_bytes{1u << 20};
   SourceLoc loc;
 };
 
 struct RetainSpec {
-  std::string file;                 // empty = no retain store
+  std::string file;                                // empty = no retain store
   Duration min_interval{std::chrono::seconds(1)};  // rate limit of on-change writes
   std::vector<NameRef> variables;
   SourceLoc loc;

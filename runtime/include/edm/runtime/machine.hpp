@@ -13,10 +13,9 @@
 // Thread-safety: every member is lock-free and may be called from any thread, RT included.
 
 #include <atomic>
+#include <boost/lockfree/queue.hpp>
 #include <cstdint>
 #include <string_view>
-
-#include <boost/lockfree/queue.hpp>
 
 #include "edm/runtime/time.hpp"
 
@@ -45,16 +44,16 @@ constexpr bool is_safe_state(MachineState s) noexcept {
 /// Alarm codes. Stable numbers: they travel over the bridge and into logs.
 enum class AlarmCode : std::uint16_t {
   kNone = 0,
-  kWatchdog = 100,          // task watchdog fault
-  kWatchdogWarning = 101,   // task watchdog with action: warn
-  kBlockFault = 110,        // a block's update() returned kFault
-  kIoFault = 120,           // the I/O driver reported a fault
-  kEstop = 130,             // emergency stop requested
-  kFollowingError = 140,    // reserved: axis following error
-  kSoftLimit = 141,         // reserved: soft-limit violation
-  kShortCircuit = 150,      // reserved: sustained short circuit after N retracts
-  kElectrodeUsedUp = 160,   // reserved: electrode length exhausted
-  kWireBreak = 170,         // reserved: wire EDM wire break
+  kWatchdog = 100,         // task watchdog fault
+  kWatchdogWarning = 101,  // task watchdog with action: warn
+  kBlockFault = 110,       // a block's update() returned kFault
+  kIoFault = 120,          // the I/O driver reported a fault
+  kEstop = 130,            // emergency stop requested
+  kFollowingError = 140,   // reserved: axis following error
+  kSoftLimit = 141,        // reserved: soft-limit violation
+  kShortCircuit = 150,     // reserved: sustained short circuit after N retracts
+  kElectrodeUsedUp = 160,  // reserved: electrode length exhausted
+  kWireBreak = 170,        // reserved: wire EDM wire break
 };
 
 std::string_view to_string(AlarmCode c) noexcept;

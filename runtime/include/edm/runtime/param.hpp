@@ -94,11 +94,16 @@ ParamValue read_param(const ParamRef& ref) noexcept;
 /// Writes a value into a field of the same type; false on a type mismatch or a string. RT-safe.
 bool write_param(const ParamRef& ref, const ParamValue& v) noexcept;
 
-/// Helpers for validate() implementations.
+/// Helpers for validate() implementations. Range checks alone let NaN through (every comparison
+/// with NaN is false), so call require_finite first for REAL parameters without a range.
 void require_positive(std::vector<ParamError>& errs, std::string_view field, double v);
 void require_non_negative(std::vector<ParamError>& errs, std::string_view field, double v);
 void require_range(std::vector<ParamError>& errs, std::string_view field, double v, double lo,
                    double hi);
+void require_finite(std::vector<ParamError>& errs, std::string_view field, double v);
+/// Adds an error on hi_field unless lo <= hi (e.g. "max" must be >= "min").
+void require_ordered(std::vector<ParamError>& errs, std::string_view lo_field, double lo,
+                     std::string_view hi_field, double hi);
 
 /// Parameters of a block that has none.
 struct NoParams {

@@ -43,7 +43,9 @@ struct PinTypeOf<double> {
 };
 
 template <class T>
-concept PinValue = requires { PinTypeOf<T>::value; };
+concept PinValue = requires {
+  PinTypeOf<T>::value;
+};
 
 template <PinValue T>
 class Output {
@@ -54,10 +56,9 @@ class Output {
 
   /// Writes the block's result (or the forced value while forced). RT-safe.
   void set(T v) noexcept {
-    value_.store(forced_.load(std::memory_order_acquire)
-                     ? force_value_.load(std::memory_order_relaxed)
-                     : v,
-                 std::memory_order_relaxed);
+    value_.store(
+        forced_.load(std::memory_order_acquire) ? force_value_.load(std::memory_order_relaxed) : v,
+        std::memory_order_relaxed);
   }
   /// Current value. RT-safe, any thread.
   [[nodiscard]] T get() const noexcept { return value_.load(std::memory_order_relaxed); }

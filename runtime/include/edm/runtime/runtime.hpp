@@ -33,9 +33,9 @@ struct BuildOptions {
 
 struct RunOptions {
   ClockKind clock{ClockKind::kReal};
-  std::optional<Duration> run_for;            // nullopt: until *stop
-  const std::atomic<bool>* stop{nullptr};     // set by a signal handler
-  std::string trace_out;                      // CSV path; empty: no trace file
+  std::optional<Duration> run_for;         // nullopt: until *stop
+  const std::atomic<bool>* stop{nullptr};  // set by a signal handler
+  std::string trace_out;                   // CSV path; empty: no trace file
 };
 
 struct RunSummary {
@@ -63,9 +63,7 @@ class Runtime {
   [[nodiscard]] Machine& machine() noexcept { return machine_; }
   [[nodiscard]] VariableRegistry& variables() noexcept { return variables_; }
   [[nodiscard]] IoDriver& driver() noexcept { return *driver_; }
-  [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept {
-    return tasks_;
-  }
+  [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept { return tasks_; }
   [[nodiscard]] Program* program(std::string_view name) const;
   [[nodiscard]] TraceRecorder& trace() noexcept { return trace_; }
   [[nodiscard]] RetainStore* retain() noexcept { return retain_.get(); }

@@ -50,8 +50,8 @@ class RealTimeScheduler {
   std::atomic<bool> stop_{false};
   std::atomic<bool> degraded_{false};
   std::atomic<bool> warned_{false};
-  std::atomic<std::size_t> ready_{0};       // threads set up and waiting for the origin
-  std::atomic<std::int64_t> t0_ns_{0};      // the common origin; 0 until every thread is ready
+  std::atomic<std::size_t> ready_{0};   // threads set up and waiting for the origin
+  std::atomic<std::int64_t> t0_ns_{0};  // the common origin; 0 until every thread is ready
 };
 
 class VirtualScheduler {
@@ -64,9 +64,7 @@ class VirtualScheduler {
   void run_until(TimePoint end, const std::function<void()>& between_cycles = {},
                  const std::atomic<bool>* stop = nullptr);
 
-  [[nodiscard]] TimePoint next_release(std::size_t task_index) const {
-    return next_[task_index];
-  }
+  [[nodiscard]] TimePoint next_release(std::size_t task_index) const { return next_[task_index]; }
 
  private:
   std::vector<Task*> tasks_;

@@ -10,9 +10,9 @@
 namespace edm::rt {
 
 struct NextRelease {
-  TimePoint release{};          // when the next cycle is due
-  bool overrun{false};          // the cycle ended after the next grid slot had started
-  std::uint64_t omitted{0};     // grid slots that get no cycle at all
+  TimePoint release{};       // when the next cycle is due
+  bool overrun{false};       // the cycle ended after the next grid slot had started
+  std::uint64_t omitted{0};  // grid slots that get no cycle at all
 };
 
 /// Given a cycle scheduled at `release` that ended at `end`, the next release on the grid

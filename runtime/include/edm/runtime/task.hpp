@@ -10,11 +10,10 @@
 // called from any non-RT thread. stats() may be read from any thread.
 
 #include <atomic>
+#include <boost/lockfree/spsc_queue.hpp>
 #include <cstdint>
 #include <mutex>
 #include <vector>
-
-#include <boost/lockfree/spsc_queue.hpp>
 
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/clock.hpp"

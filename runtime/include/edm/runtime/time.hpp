@@ -30,7 +30,7 @@ DurationParse parse_duration(std::string_view text);
 /// Formats a duration with the largest unit that keeps it exact (e.g. 1500000ns → "1500us").
 std::string format_duration(Duration d);
 
-constexpr double to_seconds(Duration d) noexcept { return static_cast<double>(d.count()) * 1e-9; }
-constexpr double to_micros(Duration d) noexcept { return static_cast<double>(d.count()) * 1e-3; }
+constexpr double to_seconds(Duration d) noexcept { return static_cast<double>(d.count()) / 1e9; }
+constexpr double to_micros(Duration d) noexcept { return static_cast<double>(d.count()) / 1e3; }
 
 }  // namespace edm::rt

@@ -29,9 +29,9 @@ enum class VarKind : std::uint8_t { kInput, kOutput, kParam };
 std::string_view to_string(VarKind k) noexcept;
 
 struct Variable {
-  std::string name;     // program.block.pin | io.pin
+  std::string name;  // program.block.pin | io.pin
   VarKind kind{VarKind::kOutput};
-  PinRef pin{};         // pins
+  PinRef pin{};  // pins
   Block* block{nullptr};
   std::uint32_t param_index{0};
   ParamType param_type{ParamType::kReal};
@@ -45,11 +45,11 @@ struct Variable {
 
 enum class VarResult : std::uint8_t {
   kOk,
-  kNotFound,     // no such variable
-  kWrongKind,    // e.g. writing a pin or forcing a parameter
-  kTypeMismatch, // value does not fit the variable's type
-  kInvalid,      // the block's validate() refused it (message says why)
-  kBusy,         // the task's write queue is full
+  kNotFound,      // no such variable
+  kWrongKind,     // e.g. writing a pin or forcing a parameter
+  kTypeMismatch,  // value does not fit the variable's type
+  kInvalid,       // the block's validate() refused it (message says why)
+  kBusy,          // the task's write queue is full
 };
 
 struct VarStatus {
