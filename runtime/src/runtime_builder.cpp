@@ -501,9 +501,7 @@ class RuntimeBuilder {
     // The config may have changed since the file was written: only restore a value of the same
     // type, and never a non-finite real into a controller.
     const std::string_view want = v->type_name();
-    const std::string_view have = value.type == RetainType::kBool  ? "BOOL"
-                                  : value.type == RetainType::kInt ? "LINT"
-                                                                   : "LREAL";
+    const std::string_view have = to_string(value.type);
     if (want != have) {
       spdlog::warn("retain: '{}' is {} in the file but {} in the config; not restored", name, have,
                    want);

@@ -37,6 +37,9 @@ namespace edm::rt {
 /// IEC names in the file: BOOL, LINT (64-bit int), LREAL (64-bit float).
 enum class RetainType : std::uint8_t { kBool, kInt, kReal };
 
+/// The IEC name written in the file: BOOL, LINT, LREAL.
+[[nodiscard]] std::string_view to_string(RetainType t) noexcept;
+
 /// A retained value; only the field matching `type` is meaningful.
 struct RetainValue {
   RetainType type{RetainType::kBool};
