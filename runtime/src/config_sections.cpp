@@ -326,7 +326,8 @@ void Parser::parse_wires(const Value& v, std::vector<WireSpec>& out) {
     return;
   }
   for (const Field& f : m->fields) {
-    if (!yaml_util::is_dotted_name(f.key, 2, 2)) {
+    // Up to 4 parts: a child pin of a C++ PROGRAM block is block.child.pin (nested: one more).
+    if (!yaml_util::is_dotted_name(f.key, 2, 4)) {
       r_.error(
           f.key_loc, v.path,
           "destination " + yaml_util::quote(f.key) + " must be block.pin or io.pin (an input)");
@@ -345,7 +346,7 @@ void Parser::parse_wires(const Value& v, std::vector<WireSpec>& out) {
         continue;
       }
       w.source_is_name = false;
-    } else if (!yaml_util::is_dotted_name(w.source, 2, 3)) {
+    } else if (!yaml_util::is_dotted_name(w.source, 2, 5)) {
       r_.error(f.value.loc, v.path,
                "source " + yaml_util::quote(w.source) + " of " + f.key +
                    " must be block.pin, program.block.pin, io.pin, a number or true/false");
@@ -360,7 +361,7 @@ std::vector<NameRef> Parser::parse_variable_names(const Value& v) {
   if (auto items = r_.list(v)) {
     for (const Value& item : *items) {
       if (auto s = r_.string(item)) {
-        if (yaml_util::is_dotted_name(*s, 2, 3)) {
+        if (yaml_util::is_dotted_name(*s, 2, 5)) {
           out.push_back({*s, item.loc});
         } else {
           r_.error(item,

@@ -195,40 +195,50 @@ class RuntimeBuilder {
     }
   }
 
-  // Resolves a wire endpoint to a pin entry, reporting what is wrong at loc.
+  [[nodiscard]] bool is_program(const std::string& name) const {
+    return std::any_of(cfg_.programs.begin(), cfg_.programs.end(),
+                       [&](const ProgramSpec& p) { return p.name == name; });
+  }
+
+  // Resolves a wire endpoint to a pin entry, reporting what is wrong at loc. Names: io.pin;
+  // block.pin[.…] in this program (block.child.pin for a C++ PROGRAM's child); and, for sources,
+  // program.block.pin[.…] — a first part that names a program is read as a program.
   const PinEntry* resolve(const std::string& program, const std::string& name, const SourceLoc& loc,
                           bool allow_other_program) {
     std::vector<std::string> parts = split(name);
     std::string key;
     std::string block_key;
-    if (parts.size() == 2) {
-      block_key = parts[0] == "io" ? "io" : program + "." + parts[0];
-      key = block_key + "." + parts[1];
-    } else if (parts.size() == 3 && allow_other_program && parts[0] != "io") {
+    if (parts[0] == "io") {
+      if (parts.size() != 2) {
+        diag_.error(loc, "'" + name + "': I/O pins are named io.pin");
+        return nullptr;
+      }
+      block_key = "io";
+      key = name;
+    } else if (allow_other_program && parts.size() >= 3 && is_program(parts[0])) {
       block_key = parts[0] + "." + parts[1];
       key = name;
     } else {
-      diag_.error(loc, "'" + name + "' is not a pin name (use block.pin, io.pin" +
-                           std::string(allow_other_program ? " or program.block.pin)" : ")"));
-      return nullptr;
+      block_key = program + "." + parts[0];
+      key = program + "." + name;
     }
     if (auto it = pins_.find(key); it != pins_.end()) {
       return &it->second;
     }
     auto bit = block_pin_names_.find(block_key);
     if (bit == block_pin_names_.end()) {
-      if (parts.size() == 3 && program_task_.count(parts[0]) == 0 &&
-          std::none_of(cfg_.programs.begin(), cfg_.programs.end(),
-                       [&](const ProgramSpec& p) { return p.name == parts[0]; })) {
-        diag_.error(loc, "'" + name + "': unknown program '" + parts[0] + "'");
+      if (allow_other_program && parts.size() >= 3 && !is_program(parts[0])) {
+        diag_.error(loc, "'" + name + "': no block '" + parts[0] + "' in program '" + program +
+                             "' and no program '" + parts[0] + "'");
       } else {
         diag_.error(loc, "'" + name + "': unknown block '" + block_key + "'");
       }
       return nullptr;
     }
     std::string type = block_key == "io" ? "I/O driver" : block_types_by_name_[block_key];
-    diag_.error(loc, "'" + name + "': " + type + " '" + block_key + "' has no pin '" +
-                         parts.back() + "' (pins: " + join_names(bit->second) + ")");
+    const std::string pin = key.substr(block_key.size() + 1);
+    diag_.error(loc, "'" + name + "': " + type + " '" + block_key + "' has no pin '" + pin +
+                         "' (pins: " + join_names(bit->second) + ")");
     return nullptr;
   }
 

@@ -185,9 +185,9 @@ TEST(Wires, constants_names_and_rejects) {
             std::string::npos);
   EXPECT_NE(first_error(with_wires("      b.a: .nan\n")).find("finite"), std::string::npos);
   EXPECT_NE(first_error(with_wires("      b.a: 1e999\n")).find("out of range"), std::string::npos);
-  EXPECT_NE(first_error(with_wires("      b.a: a.b.c.d\n")).find("source"), std::string::npos);
+  EXPECT_NE(first_error(with_wires("      b.a: a.b.c.d.e.f\n")).find("source"), std::string::npos);
   EXPECT_NE(first_error(with_wires("      b.a:\n")).find("got nothing"), std::string::npos);
-  EXPECT_NE(first_error(with_wires("      a.b.c: x.y\n")).find("destination 'a.b.c'"),
+  EXPECT_NE(first_error(with_wires("      a.b.c.d.e: x.y\n")).find("destination 'a.b.c.d.e'"),
             std::string::npos);
   EXPECT_NE(first_error(with_wires("      [a]: x.y\n")).find("keys must be plain strings"),
             std::string::npos);

@@ -114,10 +114,13 @@ INSTANTIATE_TEST_SUITE_P(
                   "type mismatch: 'a.in' is LREAL but 'b.ticks' is LINT"},
         WireError{"BoolConstantOnReal", "      a.in: true\n", 13, 13, "does not fit LREAL"},
         WireError{"RealConstantOnBool", "      a.flag: 1.5\n", 13, 15, "does not fit BOOL"},
-        WireError{"UnknownProgram", "      a.in: zz.b.out\n", 13, 13, "unknown program 'zz'"},
+        WireError{"UnknownProgram", "      a.in: zz.b.out\n", 13, 13,
+                  "no block 'zz' in program 'p' and no program 'zz'"},
         WireError{"UnknownIoPin", "      a.in: io.ai9\n", 13, 13, "has no pin 'ai9'"},
         WireError{"IoOutputAsDest", "      io.ai0: a.out\n", 13, 7, "is an output"},
-        WireError{"TooManyParts", "      a.in: p.a.b.out\n", 13, 13,
+        WireError{"NoChildPin", "      a.in: b.x.out\n", 13, 13, "has no pin 'x.out'"},
+        WireError{"IoPinTooDeep", "      a.in: io.ai0.x\n", 13, 13, "I/O pins are named io.pin"},
+        WireError{"TooManyParts", "      a.in: p.a.b.c.d.out\n", 13, 13,
                   "must be block.pin, program.block.pin, io.pin"}),
     [](const auto& tpi) { return std::string(tpi.param.name); });
 

@@ -7,6 +7,7 @@
 
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/clock.hpp"
+#include "edm/runtime/composite_block.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/type_registry.hpp"
 
@@ -144,7 +145,69 @@ class ParamProbe final : public rt::BlockWithParams<AllParams> {
   rt::Output<double> gain_seen_;
 };
 
+/// A C++ PROGRAM type: a two-step sequencer over two child blocks. Step 0 runs `fill` (AddOne
+/// fed back on itself) until its output reaches `target`, then step 1 runs `drain` once per cycle.
+/// `step` (LINT) is its own output; the safe state parks it in step 0.
+struct TwoStepParams {
+  double target{3.0};
+  void visit(rt::ParamVisitor& v) { v.param("target", target); }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const {
+    std::vector<rt::ParamError> errs;
+    rt::require_positive(errs, "target", target);
+    return errs;
+  }
+};
+class TwoStep final : public rt::BlockWithParams<TwoStepParams, rt::CompositeBlock> {
+ public:
+  TwoStep() : fill_(add_child<AddOne>("fill")), drain_(add_child<Recorder>("drain")) {}
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
+    if (rt::is_safe_state(ctx.state)) {
+      return rt::BlockStatus::kOk;  // parked until reset
+    }
+    if (step_.get() == 0) {
+      fill_.update(ctx);
+      if (fill_out_->get() >= params_.target) {
+        step_.set(1);
+      }
+    } else {
+      drain_.update(ctx);
+    }
+    return rt::BlockStatus::kOk;
+  }
+  int safe_entries{0};
+
+ protected:
+  void visit_own_pins(rt::PinVisitor& v) override { v.output("step", step_); }
+  std::vector<rt::ParamError> configure_self(const rt::BlockSetup&) override {
+    // Wire the child's output back to its input, once, in C++.
+    struct Find final : rt::PinVisitor {
+      rt::Input<double>* in{nullptr};
+      rt::Output<double>* out{nullptr};
+      void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
+        if (n == "in") in = r.as_input<double>();
+        if (n == "out") out = r.as_output<double>();
+      }
+    } f;
+    fill_.visit_pins(f);
+    f.in->connect(*f.out);
+    fill_out_ = f.out;
+    return {};
+  }
+  void activate_self() noexcept override { step_.set(0); }
+  void safe_state_self(const rt::SafeStateRequest&) noexcept override {
+    ++safe_entries;
+    step_.set(0);
+  }
+
+ private:
+  AddOne& fill_;
+  Recorder& drain_;
+  rt::Output<double>* fill_out_{nullptr};
+  rt::Output<std::int64_t> step_;
+};
+
 inline void register_test_blocks(rt::BlockRegistry& r) {
+  r.add<TwoStep>("TwoStep");
   r.add<Recorder>("Recorder");
   r.add<Cost>("Cost");
   r.add<AddOne>("AddOne");

@@ -166,6 +166,10 @@ class PinVisitor {
   void output(std::string_view name, Output<T>& pin, std::string_view unit = {}) {
     on_pin(name, PinRef::of(pin), unit);
   }
+  /// Passes on an already type-erased pin (composites re-expose their children's pins).
+  void forward(std::string_view name, PinRef ref, std::string_view unit) {
+    on_pin(name, ref, unit);
+  }
 
  protected:
   virtual void on_pin(std::string_view name, PinRef ref, std::string_view unit) = 0;
