@@ -109,11 +109,10 @@ RunSummary Runtime::run(const RunOptions& options) {
       retain_->start(std::chrono::milliseconds(100));
     }
     RealTimeScheduler sched;
-    sched.start(tasks, clock);
-    const TimePoint deadline = options.run_for
-                                   ? clock.now() + *options.run_for
-                                   : TimePoint{std::numeric_limits<std::int64_t>::max()};
-    // The controlling thread only watches the time and the stop flag; the tasks do the work.
+    sched.start(tasks, clock, options.run_for);
+    // With run_for the tasks stop by themselves at T0 + run_for (exact cycle counts); the
+    // controlling thread only watches the time and the stop flag.
+    const TimePoint deadline = sched.end();
     while (!stop_requested() && clock.now() < deadline) {
       drain_alarms();
       const TimePoint wake = std::min(deadline, clock.now() + std::chrono::milliseconds(20));

@@ -39,7 +39,8 @@ std::string lock_memory() {
   return {};
 }
 
-void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& clock) {
+void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& clock,
+                              std::optional<Duration> run_for) {
   clock_ = &clock;
   stop_.store(false);
   const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
@@ -61,7 +62,9 @@ void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& 
   }
   // One common, millisecond-aligned origin keeps tasks phase-locked like a PLC's.
   const std::int64_t ms = 1'000'000;
-  t0_ns_.store(((clock.now() + kStartLead).count() / ms + 1) * ms);
+  const std::int64_t t0 = ((clock.now() + kStartLead).count() / ms + 1) * ms;
+  end_ns_.store(run_for ? t0 + run_for->count() : std::numeric_limits<std::int64_t>::max());
+  t0_ns_.store(t0);
   t0_ns_.notify_all();
 }
 
@@ -113,7 +116,8 @@ void RealTimeScheduler::task_main(Task& task) noexcept {
   t0_ns_.wait(0);
 
   TimePoint release{t0_ns_.load()};
-  while (!stop_.load(std::memory_order_relaxed)) {
+  const TimePoint stop_at{end_ns_.load()};
+  while (!stop_.load(std::memory_order_relaxed) && release < stop_at) {
     RealClock::sleep_until(release);
     if (stop_.load(std::memory_order_relaxed)) {
       break;
@@ -157,7 +161,9 @@ void VirtualScheduler::run_until(TimePoint end, const std::function<void()>& bet
       between_cycles();
     }
   }
-  clock_->advance_to(end);
+  if (stop == nullptr || !stop->load(std::memory_order_relaxed)) {
+    clock_->advance_to(end);
+  }
 }
 
 }  // namespace edm::rt

@@ -15,6 +15,8 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -34,9 +36,16 @@ class RealTimeScheduler {
   RealTimeScheduler(const RealTimeScheduler&) = delete;
   RealTimeScheduler& operator=(const RealTimeScheduler&) = delete;
 
-  /// Starts one thread per task; all grids start at the same T0 (now + lead time). Throws
-  /// std::runtime_error if a thread cannot be created or a CPU is not available.
-  void start(const std::vector<Task*>& tasks, const RealClock& clock);
+  /// Starts one thread per task; all grids start at the same T0 (now + lead time), chosen once
+  /// every thread is ready. With run_for, each task runs exactly the releases in
+  /// [T0, T0 + run_for) and then its thread ends. Throws std::runtime_error if a CPU is not
+  /// available.
+  void start(const std::vector<Task*>& tasks, const RealClock& clock,
+             std::optional<Duration> run_for = std::nullopt);
+  /// The common origin T0 (valid once start() has returned).
+  [[nodiscard]] TimePoint origin() const noexcept { return TimePoint{t0_ns_.load()}; }
+  /// T0 + run_for, or the far future without run_for.
+  [[nodiscard]] TimePoint end() const noexcept { return TimePoint{end_ns_.load()}; }
   /// Asks every task thread to finish its current cycle, then joins them. Idempotent.
   void stop();
   /// True if any task fell back from SCHED_FIFO to SCHED_OTHER.
@@ -52,6 +61,7 @@ class RealTimeScheduler {
   std::atomic<bool> warned_{false};
   std::atomic<std::size_t> ready_{0};   // threads set up and waiting for the origin
   std::atomic<std::int64_t> t0_ns_{0};  // the common origin; 0 until every thread is ready
+  std::atomic<std::int64_t> end_ns_{std::numeric_limits<std::int64_t>::max()};
 };
 
 class VirtualScheduler {
