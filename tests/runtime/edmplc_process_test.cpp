@@ -88,6 +88,20 @@ TEST_F(EdmplcProcess, SigtermStopsInOrderAndWritesStatsTraceAndRetain) {
   }
 }
 
+TEST_F(EdmplcProcess, RealClockRunForCoversExactlyTheGridSlotsOfTheDuration) {
+  // Whatever the machine's load, every 1 ms slot of [T0, T0 + 200 ms) is a cycle or an omitted
+  // cycle, and none beyond.
+  Child c(args({"--clock", "real", "--run-for", "200ms", "--stats-out",
+                (dir_ / "stats.json").string()}));
+  ASSERT_EQ(c.wait(), 0) << c.output();
+  const std::string stats = slurp(dir_ / "stats.json");
+  auto number_after = [&](const std::string& key) {
+    const auto at = stats.find("\"" + key + "\": ");
+    return std::stoull(stats.substr(at + key.size() + 4));
+  };
+  EXPECT_EQ(number_after("cycles") + number_after("omitted_cycles"), 200u) << stats;
+}
+
 TEST_F(EdmplcProcess, RetainedValueIsRestoredOnRestart) {
   // 250 virtual cycles of 1 ms integrate 1.0 → 0.25; the second run continues from there.
   for (double expected : {0.25, 0.5}) {
