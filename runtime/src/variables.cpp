@@ -98,14 +98,25 @@ std::optional<ParamValue> to_param_value(ParamType t, double x, std::string& why
 
 }  // namespace
 
-VarStatus VariableRegistry::write(std::string_view name, double value, bool apply_now) {
+const Variable* VariableRegistry::find_param(std::string_view name, VarStatus& status) const {
   const Variable* v = find(name);
   if (v == nullptr) {
-    return {VarResult::kNotFound, "no variable '" + std::string(name) + "'"};
+    status = {VarResult::kNotFound, "no variable '" + std::string(name) + "'"};
+    return nullptr;
   }
   if (v->is_pin()) {
-    return {VarResult::kWrongKind,
-            "'" + std::string(name) + "' is a pin: pins are forced, parameters are written"};
+    status = {VarResult::kWrongKind,
+              "'" + std::string(name) + "' is a pin: pins are forced, parameters are written"};
+    return nullptr;
+  }
+  return v;
+}
+
+VarStatus VariableRegistry::write(std::string_view name, double value, bool apply_now) {
+  VarStatus status;
+  const Variable* v = find_param(name, status);
+  if (v == nullptr) {
+    return status;
   }
   std::string why;
   auto pv = to_param_value(v->param_type, value, why);
@@ -116,13 +127,10 @@ VarStatus VariableRegistry::write(std::string_view name, double value, bool appl
 }
 
 VarStatus VariableRegistry::write(std::string_view name, const ParamValue& value, bool apply_now) {
-  const Variable* v = find(name);
+  VarStatus status;
+  const Variable* v = find_param(name, status);
   if (v == nullptr) {
-    return {VarResult::kNotFound, "no variable '" + std::string(name) + "'"};
-  }
-  if (v->is_pin()) {
-    return {VarResult::kWrongKind,
-            "'" + std::string(name) + "' is a pin: pins are forced, parameters are written"};
+    return status;
   }
   if (value.type != v->param_type) {
     return {VarResult::kTypeMismatch, "'" + std::string(name) + "' is " +

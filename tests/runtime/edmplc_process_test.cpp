@@ -91,8 +91,8 @@ TEST_F(EdmplcProcess, SigtermStopsInOrderAndWritesStatsTraceAndRetain) {
 TEST_F(EdmplcProcess, RealClockRunForCoversExactlyTheGridSlotsOfTheDuration) {
   // Whatever the machine's load, every 1 ms slot of [T0, T0 + 200 ms) is a cycle or an omitted
   // cycle, and none beyond.
-  Child c(args({"--clock", "real", "--run-for", "200ms", "--stats-out",
-                (dir_ / "stats.json").string()}));
+  Child c(args(
+      {"--clock", "real", "--run-for", "200ms", "--stats-out", (dir_ / "stats.json").string()}));
   ASSERT_EQ(c.wait(), 0) << c.output();
   const std::string stats = slurp(dir_ / "stats.json");
   auto number_after = [&](const std::string& key) {

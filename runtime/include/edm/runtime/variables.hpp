@@ -82,6 +82,9 @@ class VariableRegistry {
   [[nodiscard]] std::vector<std::string> forced() const;
 
  private:
+  /// The parameter called name, or nullptr with status saying why not.
+  const Variable* find_param(std::string_view name, VarStatus& status) const;
+
   std::vector<Variable> vars_;
   std::unordered_map<std::string, std::size_t> index_;
   mutable std::mutex param_mutex_;  // non-RT only: guards the blocks' shadow parameters
