@@ -20,6 +20,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/stats_json.hpp"
+#include "edm/sim/sim_driver.hpp"
 
 namespace {
 
@@ -160,6 +161,7 @@ int main(int argc, char** argv) {
   edm::blocks::register_builtin_blocks(blocks);
   edm::rt::DriverRegistry drivers;
   edm::rt::register_runtime_drivers(drivers);
+  edm::sim::register_sim_driver(drivers);
 
   std::unique_ptr<edm::rt::Runtime> rt;
   try {

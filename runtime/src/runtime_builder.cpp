@@ -225,6 +225,9 @@ class RuntimeBuilder {
     if (auto it = pins_.find(key); it != pins_.end()) {
       return &it->second;
     }
+    if (block_key == "io" && !rt_->driver_) {
+      return nullptr;  // the unknown driver was reported; its pins would only add noise
+    }
     auto bit = block_pin_names_.find(block_key);
     if (bit == block_pin_names_.end()) {
       if (allow_other_program && parts.size() >= 3 && !is_program(parts[0])) {
@@ -375,6 +378,9 @@ class RuntimeBuilder {
     std::vector<Task*> order;
     for (const NameRef& n : cfg_.trace.variables) {
       const Variable* v = rt_->variables_.find(n.name);
+      if (v == nullptr && !rt_->driver_ && n.name.rfind("io.", 0) == 0) {
+        continue;  // the unknown driver was reported already
+      }
       if (v == nullptr) {
         diag_.error(n.loc, "trace: unknown variable '" + n.name + "'");
         continue;

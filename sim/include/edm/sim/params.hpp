@@ -1,0 +1,155 @@
+#pragma once
+// Parameters of the plant simulator: one flat struct holding every number of PLANT-MODEL.md §6.5,
+// with its unit in its name. The member defaults are the DRILL preset; preset() gives the others.
+// docs/simulator.md lists each one with its source ([src] or [bk]).
+//
+// RT-safety: none of this is RT (strings, vectors); the Plant resolves the struct once at
+// construction. Thread-safety: plain value type; preset() and preset_names() are pure.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "edm/runtime/param.hpp"
+
+namespace edm::sim {
+
+/// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
+/// bump it when a name, a unit, a default or the meaning of a parameter changes.
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/1";
+
+struct SimParams {
+  // --- Generator (§1, §6.5) ---
+  double open_voltage_v{100.0};          // U0
+  double discharge_voltage_v{25.0};      // U_d
+  double arc_voltage_v{15.0};            // U_arc
+  double short_voltage_v{3.0};           // U_sh
+  double peak_current_a{15.0};           // Ip
+  double default_on_time_us{20.0};       // t_on (a command of 0 means this)
+  double default_off_time_us{10.0};      // t_off (a command of 0 means this)
+  double default_arc_off_time_us{10.0};  // t_off_arc after an abnormal pulse (command 0 means this)
+  double wait_time_us{100.0};            // T_wait: no ignition by then -> open pulse
+
+  // --- Ignition delay (§1, §6.2 step 4) ---
+  std::string td_law{"exp"};   // "exp" (sink/drill) or "quadratic" (SPARC WEDM fit)
+  double td_gap_ref_um{20.0};  // g_r
+  double td_tau_ref_us{5.0};   // τ_r
+  double td_len_um{7.0};       // ℓ_g, gap per e-fold of the median
+  double td_tau_min_us{0.5};   // τ_min
+  double td_quad_a_us{0.48};   // quadratic law: τ = a g² + b g + c (g in µm)
+  double td_quad_b_us{-3.69};
+  double td_quad_c_us{14.05};
+  double td_quad_max_gap_um{25.0};  // quadratic law: no ignition beyond this gap
+  double weibull_k{1.0};            // k_W (1 = exponential, SPARC)
+  double td_debris_k{2.0};          // k_cd: debris shortens Td by e^(-k_cd c)
+  double arc_td_max_us{0.5};        // arc delay ~ U(0, this)
+
+  // --- Shorts (§6.2 steps 1-2, SPARC) ---
+  double short_gap_um{2.0};  // g_c: hard short at or below
+  double debris_c0{0.3};     // c_crit = min(c_max, c0 + a_g g)
+  double debris_a_g_per_um{0.02};
+  double debris_c_max{0.95};
+  double debris_k_s{500.0};      // sigmoid steepness
+  double debris_short_us{50.0};  // t_bs, duration of a debris short
+
+  // --- Arcs (§6.2 step 3) ---
+  double arc_p0{0.01};
+  double arc_k_t{0.3};     // weight of the not-yet-deionised channel
+  double deion_us{6.0};    // τ_di
+  double arc_k_c{0.3};     // weight of debris
+  double arc_k_g{0.3};     // weight of a small gap
+  double arc_gap_um{5.0};  // g_a
+  double arc_p_max{0.9};
+
+  // --- Removal and wear (§2, §6.2 step 6) ---
+  double removal_mm3_per_j{3.2e-3};    // η (Kalpakjian), used when crater_ref_um3 == 0
+  double crater_ref_um3{0.0};          // >0: crater table law V = crater_ref (Ip/1 A)^crater_exp
+  double crater_exp{1.167};            // fit of SPARC's 2.2e3 µm³ @ 1 A .. 6e4 µm³ @ 17 A
+  double removal_sigma{0.2};           // σ_v, relative scatter of crater volume
+  double arc_removal_ratio{0.3};       // α_arc
+  double arc_wear_factor{2.0};         // arcs wear the electrode this many times more per volume
+  double wear_ratio{0.6};              // θ, electrode/workpiece volume, negative polarity
+  double wear_ratio_positive{0.05};    // θ for positive polarity [bk]
+  double removal_scale_positive{0.5};  // removal multiplier for positive polarity [bk]
+
+  // --- Tool and workpiece geometry ---
+  std::string tool_kind{"tube"};      // "tube" (drill), "block" (sink), "wire"
+  double tool_od_mm{1.0};             // tube outer diameter
+  double tool_id_mm{0.3};             // tube inner diameter
+  double hole_d_mm{1.1};              // tube: initial hole diameter (wall bins start here)
+  double side_gap_mm{0.07};           // block: side gap per side
+  double tool_width_mm{10.0};         // block
+  double tool_length_mm{10.0};        // block
+  double wire_d_mm{0.25};             // wire diameter D
+  double electrode_length_mm{300.0};  // tube/block length sticking out; consumed by wear
+  double work_thickness_mm{0.0};      // tube/block: through at this depth; 0 = blind (no limit)
+  double start_gap_um{100.0};         // tip above the work surface at start
+
+  // --- Debris and flushing (§6.2 step 7) ---
+  double debris_kappa{0.75};        // κ: c += κ V / V_gap; calibrated [bk], see simulator.md
+  double debris_flush_k{1.0};       // k in e^(-k c) (SPARC)
+  double flush_tau0_ms{5.0};        // τ_f0
+  double flush_depth_mm{5.0};       // h_f: τ_f = τ_f0 (1 + (h/h_f)²); not used for wire
+  double flush_gap_ref_um{25.0};    // g_ref
+  double flush_factor{1.0};         // F of the scenario (0..1)
+  double flush_drop_depth_mm{0.0};  // scenario: beyond this depth F is multiplied by ...
+  double flush_drop_factor{1.0};    // ... this (1 = no drop)
+  double near_tip_zone_mm{1.0};     // ℓ_z, side zone counted in V_gap and in wall bins
+  double jump_dz_mm{1.0};           // Δz_j: a retract longer than this ...
+  double jump_eps{0.0};             // ... multiplies c by (1 - ε_j); 0 = jumps do not flush
+  bool wall_sparks{false};          // tube: the 64 wall bins compete with the front (orbit)
+
+  // --- Axes (§3, §6.3) ---
+  double axis_wn_rad_s{200.0};  // ω_n of the position loop
+  double axis_zeta{0.55};       // ζ
+  double v_max_mm_s{30.0};      // feed limit (toward the work, and x/y)
+  double v_jump_mm_s{150.0};    // retract limit (away from the work)
+  double a_max_mm_s2{2000.0};   // acceleration limit of the reference
+  double encoder_um{0.1};       // q_z, position quantum of the reported positions
+  double axis_step_us{25.0};    // fixed integration sub-step between pulses (<= 50)
+
+  // --- WEDM (§6.4) ---
+  std::string wire_thickness_profile{"0:10"};  // "s:H,..." cut length mm : thickness mm steps
+  double wire_hole_from_mm{0.0};               // internal hole (no material) from ...
+  double wire_hole_to_mm{0.0};                 // ... to this cut length; equal = none
+  double wire_ibk_ref_a{3.0};                  // I_BK at H = 10 mm and f = 1 [bk]
+  double wire_flush_floor{0.3};                // f = floor + (1 - floor) F_eff [bk]
+  double wire_break_current_ms{5.0};           // break if Ī > I_BK this long
+  double wire_break_rab{0.5};                  // ... or Rab above this ...
+  double wire_break_rab_ms{100.0};             // ... this long
+  double mean_current_ema_ms{10.0};            // Ī time constant
+
+  // --- Sensors (§6.2 step 8) ---
+  double rab_window_ms{40.0};
+  double mean_voltage_tau_ms{2.0};  // U_av filter [bk]
+  std::int64_t td_quantum_ns{10};   // FPGA resolution of Td
+
+  // --- Cost bound ---
+  std::int64_t max_pulses_per_advance{100000};  // per advance_to(); beyond it pulses pause
+
+  /// Names every field (with unit) in declaration order. Non-RT.
+  void visit(edm::rt::ParamVisitor& v);
+  /// Every problem with the values; empty means valid. Non-RT.
+  [[nodiscard]] std::vector<edm::rt::ParamError> validate() const;
+  /// "drill", "sink" or "wire" (PLANT-MODEL.md §6.5); nullopt for another name.
+  static std::optional<SimParams> preset(std::string_view name);
+};
+
+/// The names preset() knows, in a fixed order.
+std::vector<std::string> preset_names();
+
+/// One step of the WEDM thickness profile: from cut length from_mm on, the part is thickness_mm.
+struct ThicknessStep {
+  double from_mm{0.0};
+  double thickness_mm{0.0};
+};
+
+/// Parses "0:10,20:60,40:10" (ascending lengths starting at 0, thicknesses > 0, at most
+/// kMaxThicknessSteps steps). On error returns nullopt and says why in *error. Non-RT.
+inline constexpr std::size_t kMaxThicknessSteps = 16;
+std::optional<std::vector<ThicknessStep>> parse_thickness_profile(std::string_view text,
+                                                                  std::string* error);
+
+}  // namespace edm::sim

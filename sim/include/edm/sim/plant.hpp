@@ -1,0 +1,167 @@
+#pragma once
+// The EDM plant: discharge gap, generator, debris, electrode wear, axes and wire, advanced
+// event by event (one event per pulse) on an int64-ns time line. PLANT-MODEL.md §6;
+// docs/simulator.md is the model as built.
+//
+// RT-safety: advance_to(), set_commands(), take_sensors(), enter_safe_state() never allocate,
+// lock or throw (the plant runs inside the I/O task's input latch). Construction is non-RT.
+// Thread-safety: one thread.
+
+#include <array>
+#include <cstdint>
+
+#include "edm/runtime/time.hpp"
+#include "edm/sim/axis.hpp"
+#include "edm/sim/gap_model.hpp"
+#include "edm/sim/monitors.hpp"
+#include "edm/sim/params.hpp"
+
+namespace edm::sim {
+
+// PulseClass (open, normal, transient arc, stable arc, short) is in gap_model.hpp.
+
+/// What the runtime commands (the driver copies its input pins here each cycle).
+struct PlantCommands {
+  // Axis velocity commands. +z moves away from the work; for the wire, z is the position along
+  // the cut and −z is forward (x and y play no part in the wire physics yet).
+  double vx_mm_s{0.0}, vy_mm_s{0.0}, vz_mm_s{0.0};
+  bool generator_armed{false};
+  bool generator_on{false};
+  bool polarity_positive{false};  // false: negative (drilling), true: positive (finishing)
+  double on_time_us{0.0};         // 0: preset default
+  double off_time_us{0.0};        // 0: preset default
+  double arc_off_time_us{0.0};    // off time after an abnormal pulse; 0: = off_time
+  bool flushing_on{true};
+  double flushing_strength{1.0};  // 0..1, multiplies the scenario's flushing factor F
+  bool rotation_on{false};
+};
+
+/// Sensor values accumulated since the last take_sensors() (one PLC cycle), FPGA-style.
+struct CycleSensors {
+  std::int64_t td_sum_ns{0};       // sum of ignition delays of pulses that ignited (normal + arcs)
+  std::int64_t td_count{0};        // how many
+  std::int64_t count[5]{};         // pulses by PulseClass
+  std::int64_t time_ns[5]{};       // time spent in each class (for five-state time ratios)
+  double mean_gap_voltage_v{0.0};  // time-averaged gap voltage over the cycle
+};
+
+/// The plant's state as the sensors and the trace see it.
+struct PlantState {
+  edm::rt::TimePoint now{};
+  double x_mm{0.0}, y_mm{0.0}, z_mm{0.0};  // axis positions (encoder, quantised)
+  double vz_mm_s{0.0};
+  double gap_um{0.0};               // front gap
+  double debris{0.0};               // c in [0, 1]
+  double depth_mm{0.0};             // hole depth h (drill), or cut length (wire)
+  double wall_radius_mm{0.0};       // mean hole wall radius (orbit bins)
+  double electrode_length_mm{0.0};  // electrode length left
+  double removed_mm3{0.0};          // workpiece volume removed so far
+  double wear_mm3{0.0};             // electrode volume worn so far
+  std::uint32_t history_open{0}, history_short{0}, history_arc{0};  // last 32 pulses, bit 0 newest
+  double rab{0.0};             // (arc + short) / total over the Rab window
+  double mean_current_a{0.0};  // WEDM: EMA of Ip·t_on duty (Ī)
+  bool wire_broken{false};
+  std::uint64_t pulses{0};  // pulse index (keys the random variates)
+  // Added by the simulator core:
+  PulseClass last_class{PulseClass::kOpen};  // class of the newest pulse
+  std::int64_t last_td_ns{0};                // its delay (quantised; T_wait when open)
+  double gap_voltage_filtered_v{0.0};        // U_av: 1st-order filter of the gap voltage
+  double flush_effective{0.0};               // F_eff = F x strength x drop (0 = off)
+  std::uint64_t budget_overruns{0};          // advances that hit max_pulses_per_advance
+};
+
+class Plant {
+ public:
+  /// Throws std::invalid_argument when params.validate() finds a problem. Non-RT.
+  Plant(const SimParams& params, std::uint64_t seed);
+
+  /// Takes effect at the current plant time (the generator starts or stops there).
+  void set_commands(const PlantCommands& c) noexcept;
+  /// Runs every pulse and axis step up to time t (never backwards). Cost is bounded by
+  /// params().max_pulses_per_advance; beyond it the generator pauses (no pulses, 0 V) until t
+  /// and state().budget_overruns counts it; axes keep integrating (O(interval / axis_step)).
+  void advance_to(edm::rt::TimePoint t) noexcept;
+  /// The sensors accumulated since the previous call, then resets them.
+  CycleSensors take_sensors() noexcept;
+  [[nodiscard]] const PlantState& state() const noexcept { return state_; }
+  /// Generator off at once, axes commanded to 0.
+  void enter_safe_state() noexcept;
+  [[nodiscard]] const SimParams& params() const noexcept { return params_; }
+
+  // Test hooks: hold the front gap fixed (the axis follows the hole bottom so g stays at
+  // gap_um), and set the hole depth / debris directly.
+  void hold_gap(double gap_um) noexcept;
+  void release_gap() noexcept;
+  void set_depth_mm(double h) noexcept;
+  void set_debris(double c) noexcept;
+
+  /// Tube hole wall: radius of bin j (angle 2πj/kWallBins from +x) at the tip, mm.
+  static constexpr std::size_t kWallBins = 64;
+  [[nodiscard]] double wall_bin_radius_mm(std::size_t j) const noexcept { return wall_r_mm_[j]; }
+
+ private:
+  enum class Phase : std::uint8_t { kIdle, kWait, kOn, kOff };
+  enum class Tool : std::uint8_t { kTube, kBlock, kWire };
+
+  [[nodiscard]] bool generator_enabled() const noexcept;
+  [[nodiscard]] double tool_z_mm(std::int64_t t_ns) const noexcept;  // axis z extrapolated
+  [[nodiscard]] double front_gap_um(double z_mm) const noexcept;
+  [[nodiscard]] double depth_mm() const noexcept;
+  [[nodiscard]] double wall_gap_um(std::size_t j) const noexcept;
+  [[nodiscard]] double gap_volume_mm3(double gap_um) const noexcept;
+  [[nodiscard]] double flush_effective() const noexcept;
+  void account(std::int64_t until_ns) noexcept;
+  void step_axes(std::int64_t t_ns) noexcept;
+  void start_pulse(std::int64_t t_ns) noexcept;
+  void enter_phase(Phase ph, std::int64_t t_ns, std::int64_t dur_ns) noexcept;
+  void on_phase_end(std::int64_t t_ns) noexcept;
+  void remove(double volume_mm3, double wear_mm3, double gap_um, int site) noexcept;
+  void update_wire(std::int64_t t_ns) noexcept;
+  void set_idle(std::int64_t t_ns) noexcept;
+  void publish() noexcept;
+
+  SimParams params_;
+  PlantState state_;
+  GapModel model_;
+  std::uint64_t seed_;
+  Tool tool_{Tool::kTube};
+  PlantCommands cmd_{};
+  CycleSensors sensors_{};
+  std::int64_t sensor_elapsed_ns_{0};
+  double sensor_volt_ns_{0.0};  // ∫U dt since take_sensors, V·ns
+
+  // Geometry (mm; +z away from the work, surface at 0, hole bottom z_w = −depth).
+  double area_front_mm2_{0.0}, area_electrode_mm2_{0.0}, side_area_mm2_{0.0};
+  double hole_bottom_mm_{0.0};
+  double wear_length_mm_{0.0};  // electrode consumed: the tip is at z + wear_length
+  std::array<double, kWallBins> wall_r_mm_{};
+  std::array<double, kWallBins> wall_cos_{}, wall_sin_{};
+  ThicknessProfile profile_{};
+
+  // Axes.
+  std::array<Axis, 3> axes_{};
+  std::int64_t axis_time_ns_{0}, axis_step_ns_{25'000};
+  bool hold_{false};
+  double hold_gap_um_{0.0};
+  double jump_low_z_mm_{0.0};
+  bool jump_armed_{true};
+
+  // Generator.
+  Phase phase_{Phase::kIdle};
+  PulseClass cls_{PulseClass::kOpen};
+  std::int64_t phase_end_ns_{0};
+  std::int64_t on_ns_{0}, off_ns_{0};  // durations of the current pulse's ON and OFF phases
+  double on_voltage_v_{0.0}, phase_voltage_v_{0.0};
+  std::int64_t accounted_ns_{0};
+  std::int64_t last_discharge_end_ns_{-1'000'000'000};
+  std::int64_t pulses_this_advance_{0};
+  bool paused_{false};
+
+  // Sensors and WEDM.
+  RabWindow rab_{};
+  WireBreakMonitor wire_monitor_{};
+  std::int64_t wire_time_ns_{0};
+  double current_sum_a_{0.0};  // Ī
+};
+
+}  // namespace edm::sim

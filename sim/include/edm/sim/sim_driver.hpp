@@ -1,0 +1,93 @@
+#pragma once
+// The EDM plant simulator as the machine's I/O driver (`driver: sim`).
+//
+// Parameters: `preset` (drill | sink | wire) supplies every default; any SimParams field can be
+// overridden by name in `machine.io.params` and is validated like all config (file:line:col);
+// `seed` keys every random variate (--seed overrides it).
+//
+// Process image (io.<pin>), inputs to the runtime — latched at the start of each cycle of the
+// I/O task after advancing the plant to the clock's now:
+//   td_sum_ns, td_count                 ignition delay sum (10 ns quantum) and count this cycle
+//   n_open, n_normal, n_transient_arc, n_stable_arc, n_short   pulses by class this cycle
+//   ratio_open … ratio_short            five-state time ratios this cycle (0..1)
+//   hist_open, hist_short, hist_arc     last 32 pulses as bitmasks (bit 0 newest)
+//   rab                                 (arc + short) / total over the Rab window
+//   gap_voltage_v                       mean gap voltage this cycle
+//   x_mm, y_mm, z_mm                    encoder positions
+//   electrode_mm, depth_mm, wall_radius_mm, wire_broken, driver_fault
+//   true_gap_um, true_debris            the plant's hidden state (for traces, not for control)
+// outputs from the runtime — latched at the end of each cycle:
+//   vx_cmd, vy_cmd, vz_cmd (mm/s, +z away from the work), gen_arm, gen_on, polarity_positive,
+//   on_time_us, off_time_us, arc_off_time_us (0 = preset), servo_ref_v, flushing_on,
+//   flushing_strength (0..1), rotation_on
+// Safe state: in FAULT and ESTOP the generator is off whatever the pins say; in ESTOP the axes
+// are also held at zero velocity (in FAULT the programs back Z off through vz_cmd).
+//
+// RT-safety: read_inputs/write_outputs/enter_safe_state/fault are RT-safe. Thread-safety: the
+// I/O task's thread only.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "edm/runtime/io_driver.hpp"
+#include "edm/runtime/type_registry.hpp"
+#include "edm/sim/params.hpp"
+#include "edm/sim/plant.hpp"
+
+namespace edm::sim {
+
+struct SimDriverParams {
+  std::string preset{"drill"};
+  std::int64_t seed{1};
+  SimParams plant{};
+  std::string loaded_preset;  // which preset `plant` was filled from (not a parameter)
+
+  /// `preset` first: once the loader has set it, the plant fields are reset to that preset and
+  /// the loader then applies the overrides written in the config.
+  void visit(edm::rt::ParamVisitor& v);
+  [[nodiscard]] std::vector<edm::rt::ParamError> validate() const;
+};
+
+class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt::IoDriver> {
+ public:
+  std::vector<edm::rt::ParamError> configure(const edm::rt::BlockSetup& setup) override;
+  void activate() noexcept override;
+  void visit_pins(edm::rt::PinVisitor& v) override;
+  void read_inputs(const edm::rt::CycleContext& ctx) noexcept override;
+  void write_outputs(const edm::rt::CycleContext& ctx) noexcept override;
+  void enter_safe_state(const edm::rt::SafeStateRequest& request) noexcept override;
+  [[nodiscard]] edm::rt::IoFault fault() const noexcept override;
+  bool set_seed(std::uint64_t seed) override;
+  /// Simulator parameters are load-time only: a runtime write is refused with a message.
+  std::vector<edm::rt::ParamError> stage_param(std::size_t index,
+                                               const edm::rt::ParamValue& v) override;
+
+  /// The plant (tests and benchmarks). Valid after configure().
+  [[nodiscard]] Plant& plant() noexcept { return *plant_; }
+
+ private:
+  std::unique_ptr<Plant> plant_;
+  bool started_{false};
+
+  // Inputs to the runtime (the driver's outputs).
+  edm::rt::Output<std::int64_t> td_sum_ns_, td_count_;
+  edm::rt::Output<std::int64_t> n_[5];
+  edm::rt::Output<double> ratio_[5];
+  edm::rt::Output<std::int64_t> hist_open_, hist_short_, hist_arc_;
+  edm::rt::Output<double> rab_, gap_voltage_v_, x_mm_, y_mm_, z_mm_;
+  edm::rt::Output<double> electrode_mm_, depth_mm_, wall_radius_mm_, true_gap_um_, true_debris_;
+  edm::rt::Output<bool> wire_broken_, driver_fault_;
+  // Outputs from the runtime.
+  edm::rt::Input<double> vx_cmd_, vy_cmd_, vz_cmd_;
+  edm::rt::Input<bool> gen_arm_, gen_on_, polarity_positive_;
+  edm::rt::Input<double> on_time_us_, off_time_us_, arc_off_time_us_, servo_ref_v_;
+  edm::rt::Input<bool> flushing_on_{true};
+  edm::rt::Input<double> flushing_strength_{1.0};
+  edm::rt::Input<bool> rotation_on_;
+};
+
+/// Registers "sim". Non-RT.
+void register_sim_driver(edm::rt::DriverRegistry& r);
+
+}  // namespace edm::sim

@@ -1,0 +1,179 @@
+#include "edm/sim/sim_driver.hpp"
+
+#include "edm/runtime/clock.hpp"
+
+namespace edm::sim {
+
+namespace rt = edm::rt;
+
+void SimDriverParams::visit(rt::ParamVisitor& v) {
+  v.param("preset", preset, "", "drill | sink | wire: the defaults of every other parameter");
+  if (preset != loaded_preset) {
+    if (auto p = SimParams::preset(preset)) {
+      plant = *p;
+    }
+    loaded_preset = preset;
+  }
+  v.param("seed", seed, "", "random seed (every variate is keyed by seed, stream, pulse)");
+  plant.visit(v);
+}
+
+std::vector<rt::ParamError> SimDriverParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  if (!SimParams::preset(preset)) {
+    std::string names;
+    for (const auto& n : preset_names()) {
+      names += (names.empty() ? "" : ", ") + n;
+    }
+    errs.push_back({"preset", "unknown preset '" + preset + "' (presets: " + names + ")"});
+    return errs;
+  }
+  if (seed < 0) {
+    errs.push_back({"seed", "must be >= 0"});
+  }
+  for (auto& e : plant.validate()) {
+    errs.push_back(std::move(e));
+  }
+  return errs;
+}
+
+std::vector<rt::ParamError> SimDriver::configure(const rt::BlockSetup& setup) {
+  if (setup.period.count() <= 0) {
+    return {{"", "the simulator needs an I/O task with a period > 0"}};
+  }
+  plant_ = std::make_unique<Plant>(params_.plant, static_cast<std::uint64_t>(params_.seed));
+  started_ = false;
+  return {};
+}
+
+void SimDriver::activate() noexcept { started_ = false; }
+
+std::vector<rt::ParamError> SimDriver::stage_param(std::size_t /*index*/,
+                                                   const rt::ParamValue& /*v*/) {
+  return {{"", "simulator parameters are set in the config (load time only)"}};
+}
+
+bool SimDriver::set_seed(std::uint64_t seed) {
+  params_.seed = static_cast<std::int64_t>(seed & 0x7fffffffffffffffULL);
+  return true;
+}
+
+void SimDriver::visit_pins(rt::PinVisitor& v) {
+  v.output("td_sum_ns", td_sum_ns_, "ns");
+  v.output("td_count", td_count_);
+  static constexpr const char* kCount[5] = {"n_open", "n_normal", "n_transient_arc", "n_stable_arc",
+                                            "n_short"};
+  static constexpr const char* kRatio[5] = {"ratio_open", "ratio_normal", "ratio_transient_arc",
+                                            "ratio_stable_arc", "ratio_short"};
+  for (int k = 0; k < 5; ++k) {
+    v.output(kCount[k], n_[k]);
+  }
+  for (int k = 0; k < 5; ++k) {
+    v.output(kRatio[k], ratio_[k], "1");
+  }
+  v.output("hist_open", hist_open_);
+  v.output("hist_short", hist_short_);
+  v.output("hist_arc", hist_arc_);
+  v.output("rab", rab_, "1");
+  v.output("gap_voltage_v", gap_voltage_v_, "V");
+  v.output("x_mm", x_mm_, "mm");
+  v.output("y_mm", y_mm_, "mm");
+  v.output("z_mm", z_mm_, "mm");
+  v.output("electrode_mm", electrode_mm_, "mm");
+  v.output("depth_mm", depth_mm_, "mm");
+  v.output("wall_radius_mm", wall_radius_mm_, "mm");
+  v.output("wire_broken", wire_broken_);
+  v.output("driver_fault", driver_fault_);
+  v.output("true_gap_um", true_gap_um_, "um");
+  v.output("true_debris", true_debris_, "1");
+
+  v.input("vx_cmd", vx_cmd_, "mm/s");
+  v.input("vy_cmd", vy_cmd_, "mm/s");
+  v.input("vz_cmd", vz_cmd_, "mm/s");
+  v.input("gen_arm", gen_arm_);
+  v.input("gen_on", gen_on_);
+  v.input("polarity_positive", polarity_positive_);
+  v.input("on_time_us", on_time_us_, "us");
+  v.input("off_time_us", off_time_us_, "us");
+  v.input("arc_off_time_us", arc_off_time_us_, "us");
+  v.input("servo_ref_v", servo_ref_v_, "V");
+  v.input("flushing_on", flushing_on_);
+  v.input("flushing_strength", flushing_strength_, "1");
+  v.input("rotation_on", rotation_on_);
+}
+
+void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
+  // Virtual clock: now == the release; real clock: the plant catches up to the wall clock.
+  const rt::TimePoint now = ctx.clock != nullptr ? ctx.clock->now() : ctx.release;
+  if (!started_) {
+    // The plant's time line starts at the first latch (real-clock times are large).
+    plant_->advance_to(now);
+    (void)plant_->take_sensors();
+    started_ = true;
+  }
+  plant_->advance_to(now);
+  const CycleSensors s = plant_->take_sensors();
+  const PlantState& st = plant_->state();
+  td_sum_ns_.set(s.td_sum_ns);
+  td_count_.set(s.td_count);
+  std::int64_t total_ns = 0;
+  for (int k = 0; k < 5; ++k) {
+    n_[k].set(s.count[k]);
+    total_ns += s.time_ns[k];
+  }
+  for (int k = 0; k < 5; ++k) {
+    ratio_[k].set(total_ns > 0 ? static_cast<double>(s.time_ns[k]) / static_cast<double>(total_ns)
+                               : 0.0);
+  }
+  hist_open_.set(st.history_open);
+  hist_short_.set(st.history_short);
+  hist_arc_.set(st.history_arc);
+  rab_.set(st.rab);
+  gap_voltage_v_.set(s.mean_gap_voltage_v);
+  x_mm_.set(st.x_mm);
+  y_mm_.set(st.y_mm);
+  z_mm_.set(st.z_mm);
+  electrode_mm_.set(st.electrode_length_mm);
+  depth_mm_.set(st.depth_mm);
+  wall_radius_mm_.set(st.wall_radius_mm);
+  wire_broken_.set(st.wire_broken);
+  driver_fault_.set(st.wire_broken);
+  true_gap_um_.set(st.gap_um);
+  true_debris_.set(st.debris);
+}
+
+void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {
+  const bool safe = rt::is_safe_state(ctx.state);
+  const bool estop = ctx.state == rt::MachineState::kEstop;
+  PlantCommands c;
+  c.vx_mm_s = estop ? 0.0 : vx_cmd_.get();
+  c.vy_mm_s = estop ? 0.0 : vy_cmd_.get();
+  c.vz_mm_s = estop ? 0.0 : vz_cmd_.get();
+  c.generator_armed = !safe && gen_arm_.get();
+  c.generator_on = !safe && gen_on_.get();
+  c.polarity_positive = polarity_positive_.get();
+  c.on_time_us = on_time_us_.get();
+  c.off_time_us = off_time_us_.get();
+  c.arc_off_time_us = arc_off_time_us_.get();
+  c.flushing_on = flushing_on_.get();
+  c.flushing_strength = flushing_strength_.get();
+  c.rotation_on = rotation_on_.get();
+  plant_->set_commands(c);
+}
+
+void SimDriver::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
+  plant_->enter_safe_state();
+}
+
+rt::IoFault SimDriver::fault() const noexcept {
+  if (plant_ && plant_->state().wire_broken) {
+    return {static_cast<int>(rt::AlarmCode::kWireBreak), "sim: wire broken"};
+  }
+  return {};
+}
+
+void register_sim_driver(rt::DriverRegistry& r) {
+  r.add<SimDriver>("sim", "EDM plant simulator (presets drill, sink, wire)");
+}
+
+}  // namespace edm::sim

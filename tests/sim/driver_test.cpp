@@ -1,0 +1,79 @@
+// The simulator as the I/O driver of edmplc: determinism by seed, parameter overrides and their
+// errors, load-time-only parameters.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "support/subprocess.hpp"
+#include "support/temp_dir.hpp"
+
+namespace edm::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+const std::string kDrill = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml";
+
+TEST(SimDriver, SameSeedGivesByteIdenticalTracesAndAnotherSeedDoesNot) {
+  TempDir dir("edm-sim");
+  auto run = [&](const std::string& seed, const std::string& out) {
+    Child c({EDM_EDMPLC_PATH, "--config", kDrill, "--clock", "virtual", "--run-for", "30s",
+             "--seed", seed, "--trace-out", dir.file(out)});
+    EXPECT_EQ(c.wait(), 0) << c.output();
+    return slurp(dir.file(out));
+  };
+  const std::string a = run("7", "a.csv");
+  const std::string b = run("7", "b.csv");
+  const std::string c = run("8", "c.csv");
+  EXPECT_EQ(std::count(a.begin(), a.end(), '\n'), 30001);
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
+
+TEST(SimDriver, TheShippedMachinesPassCheck) {
+  for (const char* m : {"drill-sim", "sink-sim", "wire-sim"}) {
+    Child c({EDM_EDMPLC_PATH, "--check", "--config",
+             std::string(EDM_SOURCE_DIR) + "/config/machines/" + m + ".yaml"});
+    EXPECT_EQ(c.wait(), 0) << m << ": " << c.output();
+  }
+}
+
+struct BadSim {
+  const char* params;
+  const char* message;
+};
+
+TEST(SimDriver, BadParametersAreLocatedErrors) {
+  TempDir dir("edm-sim");
+  const BadSim cases[] = {
+      {"{preset: drll}", "unknown preset 'drll' (presets: drill, sink, wire)"},
+      {"{preset: drill, peak_current_a: fast}", "parameter 'peak_current_a' is LREAL"},
+      {"{preset: drill, peak_curent_a: 10}", "unknown parameter 'peak_curent_a'"},
+      {"{preset: drill, peak_current_a: -5}", "peak_current_a"},
+      {"{preset: drill, seed: -1}", "seed must be >= 0"},
+  };
+  for (const BadSim& b : cases) {
+    const std::string path = dir.file("bad.yaml");
+    std::ofstream(path) << "version: 1\nmachine:\n  name: m\n  io: {driver: sim, params: "
+                        << b.params
+                        << "}\ntasks:\n  - {name: t, interval: 1ms, priority: 0, programs: [p]}\n"
+                           "programs:\n  - {name: p, blocks: []}\n";
+    Child c({EDM_EDMPLC_PATH, "--check", "--config", path});
+    EXPECT_EQ(c.wait(), 2) << b.params << ": " << c.output();
+    EXPECT_NE(c.output().find(path + ":4:"), std::string::npos) << c.output();
+    EXPECT_NE(c.output().find(b.message), std::string::npos) << c.output();
+  }
+}
+
+}  // namespace
+}  // namespace edm::test

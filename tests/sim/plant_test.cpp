@@ -1,0 +1,449 @@
+#include "edm/sim/plant.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+namespace edm::sim {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+PlantCommands generator_on() {
+  PlantCommands c;
+  c.generator_armed = true;
+  c.generator_on = true;
+  return c;
+}
+
+/// Runs in 1 ms cycles (the PLC tick), summing the sensors; `each` runs before every cycle.
+CycleSensors run_ms(Plant& p, int ms, const std::function<void(Plant&)>& each = {}) {
+  CycleSensors sum;
+  for (int i = 0; i < ms; ++i) {
+    if (each) each(p);
+    p.advance_to(p.state().now + std::chrono::milliseconds(1));
+    const auto s = p.take_sensors();
+    sum.td_sum_ns += s.td_sum_ns;
+    sum.td_count += s.td_count;
+    for (int k = 0; k < 5; ++k) {
+      sum.count[k] += s.count[k];
+      sum.time_ns[k] += s.time_ns[k];
+    }
+    sum.mean_gap_voltage_v += s.mean_gap_voltage_v / ms;
+  }
+  return sum;
+}
+
+std::int64_t total(const CycleSensors& s) {
+  std::int64_t n = 0;
+  for (auto c : s.count) n += c;
+  return n;
+}
+std::int64_t of(const CycleSensors& s, PulseClass c) { return s.count[static_cast<int>(c)]; }
+std::int64_t arcs(const CycleSensors& s) {
+  return of(s, PulseClass::kTransientArc) + of(s, PulseClass::kStableArc);
+}
+
+/// The front gap at which the drill fires `rate_hz` pulses (expected cycle: E[min(Td, T_wait)]
+/// + t_on when ignited + t_off), by bisection on the model's own median law.
+double drill_gap_for_rate(const SimParams& p, double rate_hz, double c) {
+  const GapModel m(p);
+  auto rate = [&](double g) {
+    const double mean = m.td_median_us(g, c) / std::numbers::ln2;
+    const double p_ign = 1.0 - std::exp(-p.wait_time_us / mean);
+    return 1e6 / (mean * p_ign + p.default_on_time_us * p_ign + p.default_off_time_us);
+  };
+  double lo = 5.0, hi = 80.0;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (rate(mid) > rate_hz ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+const SimParams kDrill = *SimParams::preset("drill");
+
+TEST(SimPlant, rejects_invalid_params) {
+  auto p = kDrill;
+  p.peak_current_a = 0.0;
+  EXPECT_THROW(Plant(p, 1), std::invalid_argument);
+}
+
+TEST(SimPlant, generator_off_means_no_pulses_and_no_voltage) {
+  Plant p(kDrill, 1);
+  p.hold_gap(20.0);
+  auto s = run_ms(p, 20);
+  EXPECT_EQ(total(s), 0);
+  EXPECT_DOUBLE_EQ(s.mean_gap_voltage_v, 0.0);
+  auto cmd = generator_on();
+  cmd.generator_armed = false;  // on but not armed
+  p.set_commands(cmd);
+  EXPECT_EQ(total(run_ms(p, 20)), 0);
+  p.set_commands(generator_on());
+  s = run_ms(p, 20);
+  EXPECT_GT(total(s), 100);
+  EXPECT_GT(s.mean_gap_voltage_v, 10.0);
+  EXPECT_LT(s.mean_gap_voltage_v, 100.0);
+  p.enter_safe_state();
+  EXPECT_EQ(total(run_ms(p, 5)), 0);
+}
+
+TEST(SimPlant, zero_gap_is_all_shorts) {
+  Plant p(kDrill, 2);
+  p.hold_gap(0.0);
+  p.set_commands(generator_on());
+  const auto s = run_ms(p, 200);
+  EXPECT_GT(total(s), 1000);
+  EXPECT_EQ(of(s, PulseClass::kShort), total(s));
+  EXPECT_EQ(s.td_count, 0);
+  EXPECT_DOUBLE_EQ(p.state().removed_mm3, 0.0);
+  EXPECT_EQ(p.state().history_short, 0xFFFFFFFFU);
+  EXPECT_NEAR(p.state().rab, 1.0, 1e-12);
+  EXPECT_LT(s.mean_gap_voltage_v, 3.0);
+}
+
+TEST(SimPlant, beyond_the_no_ignition_gap_is_all_open) {
+  for (const char* name : {"drill", "wire"}) {
+    const auto params = *SimParams::preset(name);
+    const GapModel m(params);
+    Plant p(params, 3);
+    p.hold_gap(m.no_ignition_gap_um(params.wait_time_us, 0.0) + 1.0);
+    p.set_commands(generator_on());
+    const auto s = run_ms(p, 500);
+    EXPECT_GT(total(s), 1000) << name;
+    EXPECT_EQ(of(s, PulseClass::kOpen), total(s)) << name;
+    EXPECT_EQ(p.state().history_open, 0xFFFFFFFFU) << name;
+    EXPECT_NEAR(s.mean_gap_voltage_v,
+                params.open_voltage_v * params.wait_time_us /
+                    (params.wait_time_us + params.default_off_time_us),
+                0.5)
+        << name;
+  }
+}
+
+TEST(SimPlant, sensors_account_for_all_time_and_quantise_td) {
+  Plant p(kDrill, 4);
+  p.hold_gap(25.0);
+  p.set_commands(generator_on());
+  for (int i = 0; i < 50; ++i) {
+    p.advance_to(p.state().now + std::chrono::milliseconds(1));
+    const auto s = p.take_sensors();
+    std::int64_t t = 0;
+    for (auto x : s.time_ns) t += x;
+    ASSERT_EQ(t, kMs);
+    ASSERT_EQ(s.td_sum_ns % 10, 0);
+    ASSERT_GT(s.td_count, 5);
+  }
+  EXPECT_EQ(p.state().last_td_ns % 10, 0);
+}
+
+TEST(SimPlant, drill_removes_31_mm3_per_min_at_the_21k_spark_gap) {
+  // PLANT-MODEL.md §6.5: ≈21 k sparks/s x 7.5 mJ x 3.2e-3 mm³/J ≈ 31 mm³/min.
+  const double gap = drill_gap_for_rate(kDrill, 21000.0, 0.01);
+  Plant p(kDrill, 5);
+  p.hold_gap(gap);
+  p.set_commands(generator_on());
+  run_ms(p, 500);  // debris settles
+  const double v0 = p.state().removed_mm3;
+  const auto s = run_ms(p, 3000);
+  const double mrr_mm3_min = (p.state().removed_mm3 - v0) / 3.0 * 60.0;
+  const double rate_hz = static_cast<double>(total(s)) / 3.0;
+  RecordProperty("gap_um", std::to_string(gap));
+  RecordProperty("mrr_mm3_min", std::to_string(mrr_mm3_min));
+  EXPECT_GT(gap, 20.0);
+  EXPECT_LT(gap, 32.0);
+  EXPECT_NEAR(rate_hz, 21000.0, 2500.0);
+  EXPECT_NEAR(mrr_mm3_min, 31.0, 5.0);
+  // ≈32 mm/min of depth at Ø1.1 mm; length wear ≈ 80 % of the depth (θ = 0.6 by volume).
+  const double depth_rate = p.state().depth_mm / 3.5 * 60.0;
+  EXPECT_NEAR(depth_rate, mrr_mm3_min / (std::numbers::pi / 4 * 1.1 * 1.1), 1.5);
+  const double wear_len = kDrill.electrode_length_mm - p.state().electrode_length_mm;
+  EXPECT_NEAR(wear_len / p.state().depth_mm, 0.8, 0.05);
+}
+
+double steady_debris(double depth_mm, double flush_factor) {
+  auto params = kDrill;
+  params.flush_factor = flush_factor;
+  Plant p(params, 6);
+  p.hold_gap(drill_gap_for_rate(kDrill, 21000.0, 0.01));
+  p.set_depth_mm(depth_mm);
+  p.set_commands(generator_on());
+  run_ms(p, 1500);
+  double sum = 0.0;
+  run_ms(p, 1000, [&](Plant& q) { sum += q.state().debris; });
+  return sum / 1000.0;
+}
+
+TEST(SimPlant, steady_debris_matches_the_sanity_figures) {
+  // PLANT-MODEL.md §6.5: c ≈ 0.1 at 15 mm and ≈ 0.4 at 30 mm (F = 1); tolerance 20 %.
+  const double c15 = steady_debris(15.0, 1.0);
+  const double c30 = steady_debris(30.0, 1.0);
+  RecordProperty("c15", std::to_string(c15));
+  RecordProperty("c30", std::to_string(c30));
+  EXPECT_NEAR(c15, 0.1, 0.02);
+  EXPECT_NEAR(c30, 0.4, 0.08);
+  // B3: F = 0.3 at 30 mm goes well above, to where debris shorts start.
+  const double c30_f03 = steady_debris(30.0, 0.3);
+  RecordProperty("c30_f03", std::to_string(c30_f03));
+  EXPECT_GT(c30_f03, 0.6);
+}
+
+TEST(SimPlant, arc_fraction_rises_with_debris) {
+  auto params = kDrill;
+  params.debris_c0 = 0.95;  // keep debris shorts out of this test
+  double last = -1.0;
+  for (double c : {0.0, 0.2, 0.4, 0.6, 0.8}) {
+    Plant p(params, 7);
+    p.hold_gap(26.0);
+    p.set_commands(generator_on());
+    const auto s = run_ms(p, 1000, [c](Plant& q) { q.set_debris(c); });
+    const double frac =
+        static_cast<double>(arcs(s)) / static_cast<double>(arcs(s) + of(s, PulseClass::kNormal));
+    EXPECT_GT(frac, last + 0.03) << "c = " << c;
+    last = frac;
+  }
+}
+
+TEST(SimPlant, fast_open_loop_feed_ends_in_sustained_shorts) {
+  Plant p(kDrill, 8);
+  p.hold_gap(26.0);
+  p.release_gap();
+  auto cmd = generator_on();
+  cmd.vz_mm_s = -2.0;  // 120 mm/min: faster than the drill can erode
+  p.set_commands(cmd);
+  run_ms(p, 2000);
+  const auto s = run_ms(p, 500);
+  EXPECT_GT(static_cast<double>(of(s, PulseClass::kShort)) / static_cast<double>(total(s)), 0.95);
+  EXPECT_LT(p.state().gap_um, 2.0);
+}
+
+TEST(SimPlant, slow_open_loop_feed_opens_the_gap) {
+  Plant p(kDrill, 9);
+  p.hold_gap(26.0);
+  p.release_gap();
+  auto cmd = generator_on();
+  cmd.vz_mm_s = -0.05;  // 3 mm/min: far slower than the erosion at 26 µm
+  p.set_commands(cmd);
+  run_ms(p, 2000);
+  const auto s = run_ms(p, 1000);
+  EXPECT_GT(p.state().gap_um, 35.0);
+  EXPECT_GT(static_cast<double>(of(s, PulseClass::kOpen)) / static_cast<double>(total(s)), 0.3);
+  EXPECT_EQ(of(s, PulseClass::kShort), 0);
+  // The plant self-regulates: the tip advances with the feed less the length wear, and the
+  // length wear is 0.8 x the depth, so the hole deepens at feed / 1.8.
+  const double d0 = p.state().depth_mm;
+  run_ms(p, 1000);
+  EXPECT_NEAR(p.state().depth_mm - d0, 0.05 / 1.8, 0.004);
+}
+
+PlantState run_feed(std::uint64_t seed, double vz) {
+  Plant p(kDrill, seed);
+  auto cmd = generator_on();
+  cmd.vz_mm_s = vz;
+  p.set_commands(cmd);
+  run_ms(p, 1500, [&](Plant& q) {  // a crude gap servo, so the run sees every pulse class
+    cmd.vz_mm_s = q.state().gap_um > 22.0 ? vz : 1.0;
+    q.set_commands(cmd);
+  });
+  return p.state();
+}
+
+TEST(SimPlant, same_seed_same_state_different_seed_different) {
+  const auto a = run_feed(123, -0.6);
+  const auto b = run_feed(123, -0.6);
+  const auto c = run_feed(124, -0.6);
+  EXPECT_EQ(a.pulses, b.pulses);
+  EXPECT_EQ(a.z_mm, b.z_mm);
+  EXPECT_EQ(a.gap_um, b.gap_um);
+  EXPECT_EQ(a.debris, b.debris);
+  EXPECT_EQ(a.removed_mm3, b.removed_mm3);
+  EXPECT_EQ(a.wear_mm3, b.wear_mm3);
+  EXPECT_EQ(a.history_open, b.history_open);
+  EXPECT_EQ(a.history_arc, b.history_arc);
+  EXPECT_EQ(a.gap_voltage_filtered_v, b.gap_voltage_filtered_v);
+  EXPECT_GT(a.pulses, 10000U);
+  EXPECT_NE(a.removed_mm3, c.removed_mm3);
+  EXPECT_NE(a.pulses, c.pulses);
+}
+
+// Records pulse k's class and delay as it starts (pulses are ≥ 10 µs apart; steps are 1 µs).
+void record_pulses(Plant& p, std::vector<PulseClass>& cls, std::vector<std::int64_t>& td,
+                   std::size_t n) {
+  while (cls.size() < n) {
+    const auto before = p.state().pulses;
+    p.advance_to(p.state().now + std::chrono::microseconds(1));
+    if (p.state().pulses == before + 1) {
+      cls.push_back(p.state().last_class);
+      td.push_back(p.state().last_td_ns);
+    } else {
+      ASSERT_EQ(p.state().pulses, before);
+    }
+  }
+}
+
+TEST(SimPlant, pulse_k_sees_the_same_variates_under_any_controller) {
+  auto params = kDrill;
+  params.td_debris_k = 0.0;  // Td then depends on the gap only, which both runs hold
+  constexpr std::size_t kN = 600;
+  std::vector<PulseClass> ca, cb, cc;
+  std::vector<std::int64_t> ta, tb, tc;
+  {
+    Plant a(params, 77);
+    a.hold_gap(24.0);
+    a.set_commands(generator_on());
+    record_pulses(a, ca, ta, kN);
+  }
+  {
+    Plant b(params, 77);  // another "controller": longer off-time, different timing
+    b.hold_gap(24.0);
+    auto cmd = generator_on();
+    cmd.off_time_us = 37.0;
+    cmd.on_time_us = 12.0;
+    b.set_commands(cmd);
+    record_pulses(b, cb, tb, kN);
+  }
+  {
+    Plant c(params, 78);
+    c.hold_gap(24.0);
+    c.set_commands(generator_on());
+    record_pulses(c, cc, tc, kN);
+  }
+  int both = 0, same = 0, same_other_seed = 0;
+  for (std::size_t k = 0; k < kN; ++k) {
+    if (ca[k] == PulseClass::kNormal && cb[k] == PulseClass::kNormal) {
+      ++both;
+      same += ta[k] == tb[k] ? 1 : 0;
+    }
+    if (ca[k] == PulseClass::kNormal && cc[k] == PulseClass::kNormal) {
+      same_other_seed += ta[k] == tc[k] ? 1 : 0;
+    }
+  }
+  EXPECT_GT(both, 400);
+  EXPECT_EQ(same, both);
+  EXPECT_LT(same_other_seed, 10);
+}
+
+TEST(SimPlant, wire_breaks_on_excess_mean_current_only) {
+  const auto wire = *SimParams::preset("wire");
+  {
+    Plant p(wire, 10);  // default t_off 80 µs: Ī ≈ 60 A x 3 µs / 100 µs ≈ 1.8 A < 3 A
+    p.hold_gap(10.0);
+    p.set_commands(generator_on());
+    run_ms(p, 500);
+    EXPECT_FALSE(p.state().wire_broken);
+    EXPECT_GT(p.state().mean_current_a, 1.0);
+    EXPECT_LT(p.state().mean_current_a, 3.0);
+  }
+  {
+    Plant p(wire, 10);  // t_off 5 µs: Ī ≈ 4 A > I_BK = 3 A at H = 10 mm
+    p.hold_gap(10.0);
+    auto cmd = generator_on();
+    cmd.off_time_us = 5.0;
+    p.set_commands(cmd);
+    int broke_at_ms = -1;
+    int over_since_ms = -1;
+    for (int ms = 0; ms < 200 && broke_at_ms < 0; ++ms) {
+      run_ms(p, 1);
+      if (over_since_ms < 0 && p.state().mean_current_a > 3.0) over_since_ms = ms;
+      if (p.state().wire_broken) broke_at_ms = ms;
+    }
+    ASSERT_GE(broke_at_ms, 0);
+    ASSERT_GE(over_since_ms, 0);
+    EXPECT_GE(broke_at_ms - over_since_ms, 4);  // ≈ 5 ms after Ī crossed I_BK
+    EXPECT_LE(broke_at_ms - over_since_ms, 6);
+    EXPECT_EQ(total(run_ms(p, 10)), 0);  // a broken wire fires nothing
+  }
+  {
+    Plant p(wire, 10);  // the same at H = 60 mm: I_BK = 3 √6 ≈ 7.3 A holds
+    p.set_depth_mm(25.0);
+    p.hold_gap(10.0);
+    auto cmd = generator_on();
+    cmd.off_time_us = 5.0;
+    p.set_commands(cmd);
+    run_ms(p, 200);
+    EXPECT_FALSE(p.state().wire_broken);
+  }
+}
+
+TEST(SimPlant, wire_crosses_the_internal_hole_as_open_pulses) {
+  const auto wire = *SimParams::preset("wire");  // hole from 45 to 47 mm
+  Plant p(wire, 11);
+  p.set_depth_mm(44.99);
+  p.hold_gap(10.0);
+  p.release_gap();
+  auto cmd = generator_on();
+  cmd.vz_mm_s = -0.3;  // feed along the cut
+  p.set_commands(cmd);
+  for (int i = 0; i < 1000 && p.state().depth_mm < 45.0; ++i) run_ms(p, 1);
+  EXPECT_DOUBLE_EQ(p.state().depth_mm, 47.0);  // the far side of the hole
+  cmd.vz_mm_s = 0.0;
+  p.set_commands(cmd);
+  run_ms(p, 20);
+  const auto s = run_ms(p, 50);
+  EXPECT_GT(p.state().gap_um, 1950.0);
+  EXPECT_GT(total(s), 100);
+  EXPECT_EQ(of(s, PulseClass::kOpen), total(s));
+}
+
+TEST(SimPlant, orbit_offset_erodes_the_near_wall) {
+  auto params = kDrill;
+  params.wall_sparks = true;
+  Plant p(params, 12);
+  p.hold_gap(45.0);  // a slow front, so the wall competes
+  auto cmd = generator_on();
+  cmd.vx_mm_s = 1.0;
+  p.set_commands(cmd);
+  run_ms(p, 30);  // x ≈ +0.03 mm: the wall at +x is 20 µm away, at -x 80 µm
+  cmd.vx_mm_s = 0.0;
+  p.set_commands(cmd);
+  run_ms(p, 500);
+  const double r0 = params.hole_d_mm / 2.0;
+  const double near = p.wall_bin_radius_mm(0) - r0;
+  const double far = p.wall_bin_radius_mm(Plant::kWallBins / 2) - r0;
+  EXPECT_GT(near, 0.005);
+  EXPECT_LT(far, 0.2 * near);  // (centred, in the first ms, all bins took some sparks)
+  EXPECT_GT(p.state().wall_radius_mm, r0);
+}
+
+TEST(SimPlant, a_jump_flushes_debris) {
+  const auto sink = *SimParams::preset("sink");  // Δz_j = 1 mm, ε_j = 0.7
+  for (double v_mm_s : {10.0, 50.0}) {
+    Plant p(sink, 13);
+    p.set_depth_mm(20.0);  // τ_f ≈ 0.9 s: flushing alone changes little in 0.1 s
+    p.set_debris(0.5);
+    PlantCommands cmd;
+    cmd.vz_mm_s = v_mm_s;
+    p.set_commands(cmd);
+    run_ms(p, 60);  // ≈ 0.6 mm and ≈ 2.4 mm
+    cmd.vz_mm_s = 0.0;
+    p.set_commands(cmd);
+    run_ms(p, 60);
+    if (v_mm_s < 20.0) {
+      EXPECT_LT(p.state().z_mm, 1.0);
+      EXPECT_GT(p.state().debris, 0.42);
+    } else {
+      EXPECT_GT(p.state().z_mm, 2.0);
+      EXPECT_LT(p.state().debris, 0.16);  // x (1 - 0.7) once
+      EXPECT_GT(p.state().debris, 0.12);
+    }
+  }
+}
+
+TEST(SimPlant, pulse_budget_pauses_deterministically) {
+  auto params = kDrill;
+  params.max_pulses_per_advance = 10;
+  Plant p(params, 14);
+  p.hold_gap(25.0);
+  p.set_commands(generator_on());
+  p.advance_to(p.state().now + std::chrono::milliseconds(5));
+  EXPECT_EQ(p.state().pulses, 11U);  // 1 started by set_commands + 10 in the advance
+  EXPECT_EQ(p.state().budget_overruns, 1U);
+  p.advance_to(p.state().now + std::chrono::microseconds(100));
+  EXPECT_GT(p.state().pulses, 11U);  // resumed
+}
+
+}  // namespace
+}  // namespace edm::sim
