@@ -58,6 +58,13 @@ RunSummary Runtime::run(const RunOptions& options) {
   if (machine_.state() == MachineState::kOff) {
     machine_.command(MachineCommand::kPowerOn);
   }
+  if (options.trace_out.empty()) {
+    // Nobody drains the rings without a trace file: don't sample, don't count drops.
+    for (auto& t : tasks_) {
+      t->detach_trace();
+    }
+    has_trace_ = false;
+  }
   RunSummary summary;
   const auto stop_requested = [&] {
     return options.stop != nullptr && options.stop->load(std::memory_order_relaxed);

@@ -103,15 +103,14 @@ void SimDriver::visit_pins(rt::PinVisitor& v) {
 }
 
 void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
-  // Virtual clock: now == the release; real clock: the plant catches up to the wall clock.
+  // The plant's time line starts at 0 at the first latch: CLOCK_MONOTONIC is days, not 0.
+  // Virtual clock: now == the release; real clock: each latch catches the plant up to now.
   const rt::TimePoint now = ctx.clock != nullptr ? ctx.clock->now() : ctx.release;
   if (!started_) {
-    // The plant's time line starts at the first latch (real-clock times are large).
-    plant_->advance_to(now);
-    (void)plant_->take_sensors();
+    origin_ = now;
     started_ = true;
   }
-  plant_->advance_to(now);
+  plant_->advance_to(now - origin_);
   const CycleSensors s = plant_->take_sensors();
   const PlantState& st = plant_->state();
   td_sum_ns_.set(s.td_sum_ns);

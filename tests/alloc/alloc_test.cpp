@@ -8,6 +8,7 @@
 #include <new>
 #include <sstream>
 
+#include "edm/sim/sim_driver.hpp"
 #include "support/runtime_fixture.hpp"
 
 namespace {
@@ -141,6 +142,36 @@ TEST(Allocations, NoneInsideCyclesOfARealisticProgram) {
   EXPECT_EQ(tasks[0]->cycles(), 2000u);
   EXPECT_EQ(r->trace().dropped(), 0u);
   EXPECT_GT(sink.str().size(), 2000u * 10);
+}
+
+TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
+  // The simulator runs inside the I/O task's input latch: pulses, axes, debris and sensors must
+  // not allocate either.
+  rt::DriverRegistry drivers;
+  rt::register_runtime_drivers(drivers);
+  sim::register_sim_driver(drivers);
+  rt::Config cfg =
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
+  auto r = rt::Runtime::build(cfg, registries().blocks, drivers);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  std::ostringstream sink;
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 3000; ++k) {  // 3 s of drilling, ~60 000 pulses
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 1000 == 999) {
+      g_counting = false;
+      r->trace().drain(sink);
+      g_counting = true;
+    }
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0u);
+  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.5) << "it really drilled";
 }
 
 TEST(Allocations, TheCounterSeesAllocations) {

@@ -40,6 +40,23 @@ TEST(SimDriver, SameSeedGivesByteIdenticalTracesAndAnotherSeedDoesNot) {
   EXPECT_NE(a, c);
 }
 
+TEST(SimDriver, RealClockLatchAdvancesThePlantFromTheFirstLatchOnly) {
+  // The plant starts at the first latch: a first cycle that tried to simulate CLOCK_MONOTONIC's
+  // whole history would take seconds. (No watchdog here: a loaded CI machine must not fault it.)
+  TempDir dir("edm-sim");
+  std::string cfg = slurp(kDrill);
+  cfg.erase(cfg.find("    watchdog:"),
+            cfg.find("\n", cfg.find("    watchdog:")) + 1 - cfg.find("    watchdog:"));
+  std::ofstream(dir.file("m.yaml")) << cfg;
+  Child c({EDM_EDMPLC_PATH, "--config", dir.file("m.yaml"), "--clock", "real", "--run-for", "300ms",
+           "--stats-out", dir.file("s.json")});
+  ASSERT_EQ(c.wait(), 0) << c.output();
+  const std::string stats = slurp(dir.file("s.json"));
+  const auto exec = stats.find("\"exec_us\"");
+  const auto max_at = stats.find("\"max\": ", exec);
+  EXPECT_LT(std::stod(stats.substr(max_at + 7)), 100000.0) << stats;
+}
+
 TEST(SimDriver, TheShippedMachinesPassCheck) {
   for (const char* m : {"drill-sim", "sink-sim", "wire-sim"}) {
     Child c({EDM_EDMPLC_PATH, "--check", "--config",

@@ -50,6 +50,8 @@ class Task {
     trace_ = &t;
     trace_channel_ = channel;
   }
+  /// Stops sampling the trace (no --trace-out: nothing would drain the ring). Non-RT, before run.
+  void detach_trace() noexcept { trace_ = nullptr; }
 
   /// One scan for the cycle scheduled at `release`. Returns the time the cycle ended. RT-safe.
   TimePoint run_cycle(TimePoint release, const Clock& clock) noexcept;

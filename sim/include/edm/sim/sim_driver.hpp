@@ -69,6 +69,7 @@ class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt
  private:
   std::unique_ptr<Plant> plant_;
   bool started_{false};
+  edm::rt::TimePoint origin_{};  // clock time of the first latch = plant time 0
 
   // Inputs to the runtime (the driver's outputs).
   edm::rt::Output<std::int64_t> td_sum_ns_, td_count_;
