@@ -164,6 +164,28 @@ TEST(SimPlant, drill_removes_31_mm3_per_min_at_the_21k_spark_gap) {
   EXPECT_NEAR(wear_len / p.state().depth_mm, 0.8, 0.05);
 }
 
+TEST(SimPlant, positive_polarity_removes_less_and_wears_much_less) {
+  // Negative polarity (drilling): fast removal, high electrode wear; positive (finishing): low
+  // removal and low wear, by the preset's removal_scale_positive and wear_ratio_positive.
+  const double gap = drill_gap_for_rate(kDrill, 21000.0, 0.01);
+  auto run = [&](bool positive) {
+    Plant p(kDrill, 5);  // same seed: the same pulses, classes and scatter
+    p.hold_gap(gap);
+    PlantCommands c = generator_on();
+    c.polarity_positive = positive;
+    p.set_commands(c);
+    run_ms(p, 2000);
+    return std::pair{p.state().removed_mm3, p.state().wear_mm3};
+  };
+  const auto [removed_neg, wear_neg] = run(false);
+  const auto [removed_pos, wear_pos] = run(true);
+  ASSERT_GT(removed_neg, 0.0);
+  EXPECT_NEAR(removed_pos / removed_neg, kDrill.removal_scale_positive, 0.05);
+  EXPECT_NEAR(wear_neg / removed_neg, kDrill.wear_ratio, 0.05);
+  EXPECT_NEAR(wear_pos / removed_pos, kDrill.wear_ratio_positive, 0.02);
+  EXPECT_LT(wear_pos, 0.1 * wear_neg);
+}
+
 double steady_debris(double depth_mm, double flush_factor) {
   auto params = kDrill;
   params.flush_factor = flush_factor;
