@@ -1,11 +1,14 @@
 #include "edm/blocks/register.hpp"
 
 #include "edm/blocks/gain.hpp"
+#include "edm/blocks/gap_controller_p.hpp"
 #include "edm/blocks/integrator.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/low_pass.hpp"
 #include "edm/blocks/moving_average.hpp"
+#include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/sine_source.hpp"
+#include "edm/blocks/td_detector.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -17,6 +20,10 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<MovingAverage>("MovingAverage", "mean of the last `window` samples, O(1) per cycle");
   r.add<SineSource>("SineSource", "sine test signal, phase exact from the cycle count");
   r.add<Integrator>("Integrator", "integrator with clamping anti-windup and reset");
+  // Seed 004: deep-hole drilling.
+  r.add<TdDetector>("TdDetector", "mean ignition delay and open/short ratios over a window");
+  r.add<GapControllerP>("GapControllerP", "seed 004 eq. 1: Vz = Kg·(Tdr − Td), limits, retract");
+  r.add<PolaritySwitch>("PolaritySwitch", "reverses polarity only with the generator off");
 }
 
 }  // namespace edm::blocks

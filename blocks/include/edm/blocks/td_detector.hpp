@@ -1,0 +1,81 @@
+#pragma once
+// TdDetector: the mean ignition delay Td and the open/short ratios from the per-cycle pulse
+// counters of the generator's FPGA (or the simulator's io.td_sum_ns, io.td_count, io.n_*).
+//
+//   total(k)    = n_total(k) if n_total(k) > 0, else td_count(k) + n_open(k) + n_short(k)
+//   td_raw_us   = td_sum_ns(k) / td_count(k) / 1000                 this cycle
+//   td_us       = Σ td_sum_ns / Σ td_count / 1000                   over the last `window` cycles
+//   open_ratio  = Σ n_open / Σ total,  short_ratio = Σ n_short / Σ total   (same window)
+//   valid       = Σ td_count > 0       (at least one ignited pulse in the window)
+//
+// Pooling the sums (not averaging the per-cycle means) weighs every pulse equally, so a cycle
+// with 3 pulses does not count as much as one with 300. The sums are exact 64-bit integers kept
+// with a ring of `window` cycles: no drift, no O(window) work per cycle.
+// Empty window (no ignited pulse, or no pulse at all for the ratios): nothing is divided; with
+// hold_when_empty the outputs keep their last values, otherwise td_us/td_raw_us = empty_td_us
+// and the ratios = 0. valid is false either way.
+//
+// `window` sizes the ring, allocated once in configure(); it cannot change at run time.
+// A negative or absurdly large counter, or an n_total smaller than td_count or n_open + n_short,
+// is a broken signal: the cycle is not stored, the outputs are held and update() returns kFault.
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins (see
+// pin.hpp).
+
+#include <cstdint>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct TdDetectorParams {
+  static constexpr std::int64_t kMaxWindow = 65536;
+
+  std::int64_t window{8};      // cycles pooled, 1..kMaxWindow (load time only)
+  bool hold_when_empty{true};  // empty window: hold the last td_us (else output empty_td_us)
+  double empty_td_us{0.0};  // [µs] ≥ 0: td_us after activate(), and when empty and not holding
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("window", window, "cycles", "number of cycles pooled (1..65536), load time only");
+    v.param("hold_when_empty", hold_when_empty, "",
+            "with no ignited pulse in the window keep the last td_us (else output empty_td_us)");
+    v.param("empty_td_us", empty_td_us, "us",
+            "td_us after activation, and with an empty window when not holding (>= 0)");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
+ public:
+  /// Per-cycle counters above this are treated as a broken signal (keeps the window sums far
+  /// from int64 overflow: kMaxWindow · kMaxCount < 2^63).
+  static constexpr std::int64_t kMaxCount = std::int64_t{1} << 46;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Allocates the ring (window cycles).
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. Empties the window: td_us = td_raw_us = empty_td_us, ratios 0, valid false.
+  void activate() noexcept override;
+  /// RT-safe. kOk, or kFault (nothing stored, outputs held) on inconsistent counters.
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+  /// Non-RT. Refuses `window` (it sized the ring at configure()).
+  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
+
+ private:
+  struct Counts {
+    std::int64_t td_sum_ns{0};
+    std::int64_t td_count{0};
+    std::int64_t n_open{0};
+    std::int64_t n_short{0};
+    std::int64_t n_total{0};
+  };
+
+  rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_, n_total_;
+  rt::Output<double> td_us_, td_raw_us_, open_ratio_, short_ratio_;
+  rt::Output<bool> valid_;
+  std::vector<Counts> ring_;  // sized in configure(); its size is the window in use
+  std::size_t next_{0};       // slot the next cycle overwrites
+  Counts sum_;                // sums over the ring
+};
+
+}  // namespace edm::blocks
