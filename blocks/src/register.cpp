@@ -7,8 +7,11 @@
 #include "edm/blocks/low_pass.hpp"
 #include "edm/blocks/moving_average.hpp"
 #include "edm/blocks/polarity_switch.hpp"
+#include "edm/blocks/position_loop.hpp"
+#include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/sine_source.hpp"
 #include "edm/blocks/td_detector.hpp"
+#include "edm/blocks/wear_compensator.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -24,6 +27,9 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<TdDetector>("TdDetector", "mean ignition delay and open/short ratios over a window");
   r.add<GapControllerP>("GapControllerP", "seed 004 eq. 1: Vz = Kg·(Tdr − Td), limits, retract");
   r.add<PolaritySwitch>("PolaritySwitch", "reverses polarity only with the generator off");
+  r.add<WearCompensator>("WearCompensator", "seed 004 eq. 8: Vd = MRRe/A added to the Z feed");
+  r.add<PositionLoop>("PositionLoop", "P/PI axis loop with feed-forward and following error");
+  r.add<ShortRetract>("ShortRetract", "sustained short: retract along the path, resume, alarm");
 }
 
 }  // namespace edm::blocks

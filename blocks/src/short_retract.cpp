@@ -1,0 +1,300 @@
+#include "edm/blocks/short_retract.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edm/blocks/validation.hpp"
+
+namespace edm::blocks {
+namespace {
+
+// Index of `history_capacity` in ShortRetractParams::visit().
+constexpr std::size_t kHistoryCapacityIndex = 0;
+
+double distance(double ax, double ay, double az, double bx, double by, double bz) noexcept {
+  const double dx = bx - ax;
+  const double dy = by - ay;
+  const double dz = bz - az;
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+}  // namespace
+
+std::vector<rt::ParamError> ShortRetractParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "history_capacity", static_cast<double>(history_capacity), 2.0,
+                    static_cast<double>(kMaxHistory));
+  rt::require_range(errs, "min_spacing_mm", min_spacing_mm, 0.0, 1.0e3);
+  rt::require_range(errs, "short_cycles", static_cast<double>(short_cycles), 1.0, 1.0e9);
+  rt::require_range(errs, "retract_distance_mm", retract_distance_mm, 1.0e-9, 1.0e4);
+  rt::require_range(errs, "retract_speed_mm_s", retract_speed_mm_s, 1.0e-9, 1.0e4);
+  rt::require_range(errs, "resume_speed_mm_s", resume_speed_mm_s, 1.0e-9, 1.0e4);
+  rt::require_range(errs, "resume_ramp_ms", resume_ramp_ms, 0.0, 60000.0);
+  rt::require_range(errs, "max_tries", static_cast<double>(max_tries), 0.0, 1.0e6);
+  rt::require_range(errs, "progress_mm", progress_mm, 0.0, 1.0e4);
+  return errs;
+}
+
+void ShortRetract::visit_pins(rt::PinVisitor& v) {
+  v.input("x_mm", x_mm_, "mm");
+  v.input("y_mm", y_mm_, "mm");
+  v.input("z_mm", z_mm_, "mm");
+  v.input("short_detected", short_detected_);
+  v.input("enable", enable_);
+  v.input("reset", reset_);
+  v.output("active", active_);
+  v.output("x_sp_mm", x_sp_mm_, "mm");
+  v.output("y_sp_mm", y_sp_mm_, "mm");
+  v.output("z_sp_mm", z_sp_mm_, "mm");
+  v.output("v_scale", v_scale_);
+  v.output("tries", tries_out_);
+  v.output("alarm", alarm_out_);
+  v.output("hold", hold_out_);
+}
+
+std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup) {
+  auto errs = params_.validate();
+  require_task_period(errs, setup.period);
+  if (!errs.empty()) {
+    return errs;
+  }
+  dt_s_ = rt::to_seconds(setup.period);
+  ring_.assign(static_cast<std::size_t>(params_.history_capacity), PathPoint{});
+  compute_ramp();
+  activate();
+  return errs;
+}
+
+void ShortRetract::activate() noexcept {
+  start_ = 0;
+  count_ = 0;
+  state_ = State::kIdle;
+  pos_s_ = 0.0;
+  target_s_ = 0.0;
+  seg_ = 0;
+  short_count_ = 0;
+  tries_ = 0;
+  s_at_short_ = 0.0;
+  alarm_ = false;
+  final_ = false;
+  ramp_k_ = 0;
+  active_.set(false);
+  v_scale_.set(1.0);
+  tries_out_.set(0);
+  alarm_out_.set(false);
+  hold_out_.set(false);
+}
+
+std::vector<rt::ParamError> ShortRetract::stage_param(std::size_t index, const rt::ParamValue& v) {
+  if (index == kHistoryCapacityIndex) {
+    return {{"history_capacity",
+             "cannot change at run time (it sizes the path ring); reload the config"}};
+  }
+  return BlockWithParams::stage_param(index, v);
+}
+
+void ShortRetract::params_changed() noexcept { compute_ramp(); }
+
+void ShortRetract::compute_ramp() noexcept {
+  // floor: full feed is reached within resume_ramp_ms, never one cycle after it.
+  const double cycles =
+      dt_s_ > 0.0 ? std::floor(params_.resume_ramp_ms * 1e-3 / dt_s_ + 1e-9) : 0.0;
+  ramp_cycles_ = static_cast<std::int64_t>(std::clamp(cycles, 0.0, 1.0e12));
+}
+
+void ShortRetract::record(double x, double y, double z, bool force) noexcept {
+  const std::size_t cap = ring_.size();
+  if (count_ == 0) {
+    ring_[start_] = {x, y, z, 0.0};
+    count_ = 1;
+    return;
+  }
+  // A back-off over the last segment unwinds the path instead of doubling it.
+  while (count_ >= 2) {
+    const PathPoint& h = head();
+    const PathPoint& p = at(count_ - 2);
+    const double dot = (x - h.x) * (h.x - p.x) + (y - h.y) * (h.y - p.y) + (z - h.z) * (h.z - p.z);
+    if (dot < 0.0 && distance(p.x, p.y, p.z, x, y, z) < h.s - p.s) {
+      --count_;
+    } else {
+      break;
+    }
+  }
+  const PathPoint& h = head();
+  const double d = distance(h.x, h.y, h.z, x, y, z);
+  if (d <= 0.0 || (!force && d < params_.min_spacing_mm)) {
+    return;
+  }
+  const double s = h.s + d;
+  if (count_ == cap) {  // drop the oldest point
+    start_ = (start_ + 1) % cap;
+    --count_;
+  }
+  ring_[(start_ + count_) % cap] = {x, y, z, s};
+  ++count_;
+}
+
+void ShortRetract::set_point_at(double s) noexcept {
+  const PathPoint& a = at(seg_);
+  if (count_ < 2 || s <= a.s) {
+    sp_[0] = a.x;
+    sp_[1] = a.y;
+    sp_[2] = a.z;
+    return;
+  }
+  const PathPoint& b = at(seg_ + 1);
+  if (s >= b.s) {
+    sp_[0] = b.x;
+    sp_[1] = b.y;
+    sp_[2] = b.z;
+    return;
+  }
+  const double t = (s - a.s) / (b.s - a.s);
+  sp_[0] = a.x + t * (b.x - a.x);
+  sp_[1] = a.y + t * (b.y - a.y);
+  sp_[2] = a.z + t * (b.z - a.z);
+}
+
+void ShortRetract::start_retract(bool from_head) noexcept {
+  if (from_head) {
+    pos_s_ = head().s;
+    seg_ = count_ >= 2 ? count_ - 2 : 0;
+    s_at_short_ = pos_s_;
+  }
+  target_s_ = std::max(pos_s_ - params_.retract_distance_mm, at(0).s);
+  state_ = State::kRetract;
+  short_count_ = 0;
+}
+
+rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const ShortRetractParams& p = params_;
+  if (ring_.empty()) {  // not configured
+    return rt::BlockStatus::kFault;
+  }
+  if (reset_.get()) {
+    alarm_ = false;
+    final_ = false;
+    tries_ = 0;
+    if (state_ == State::kHold) {
+      state_ = State::kResume;
+    }
+  }
+  bool input_fault = false;
+  double v_scale = 1.0;
+  if (!enable_.get()) {
+    state_ = State::kIdle;
+    count_ = 0;
+    start_ = 0;
+    short_count_ = 0;
+    final_ = false;
+    const double x = x_mm_.get();
+    const double y = y_mm_.get();
+    const double z = z_mm_.get();
+    if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
+      sp_[0] = x;
+      sp_[1] = y;
+      sp_[2] = z;
+    } else {
+      input_fault = true;
+    }
+  } else {
+    // Short detection (not while backing off or holding: the short is being dealt with).
+    bool sustained = false;
+    if (state_ == State::kRetract || state_ == State::kHold) {
+      short_count_ = 0;
+    } else {
+      short_count_ = short_detected_.get() ? std::min(short_count_ + 1, p.short_cycles) : 0;
+      sustained = short_count_ >= p.short_cycles;
+    }
+    const bool recording = state_ == State::kIdle || state_ == State::kRamp;
+    if (recording) {
+      const double x = x_mm_.get();
+      const double y = y_mm_.get();
+      const double z = z_mm_.get();
+      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
+        input_fault = true;
+        sustained = false;  // no valid head to retract from this cycle
+      } else {
+        record(x, y, z, sustained);
+        sp_[0] = x;
+        sp_[1] = y;
+        sp_[2] = z;
+        if (head().s - s_at_short_ >= p.progress_mm) {
+          tries_ = 0;
+        }
+      }
+    }
+    if (sustained) {
+      if (tries_ >= p.max_tries) {
+        alarm_ = true;
+        final_ = true;
+      } else {
+        ++tries_;
+      }
+      start_retract(/*from_head=*/recording);
+    }
+
+    switch (state_) {
+      case State::kIdle:
+        break;
+      case State::kRetract: {
+        pos_s_ = std::max(pos_s_ - p.retract_speed_mm_s * dt_s_, target_s_);
+        while (seg_ > 0 && at(seg_).s > pos_s_) {
+          --seg_;
+        }
+        set_point_at(pos_s_);
+        v_scale = 0.0;
+        if (pos_s_ <= target_s_) {
+          state_ = final_ ? State::kHold : State::kResume;
+        }
+        break;
+      }
+      case State::kResume: {
+        const double s_head = head().s;
+        pos_s_ = std::min(pos_s_ + p.resume_speed_mm_s * dt_s_, s_head);
+        while (seg_ + 2 < count_ && at(seg_ + 1).s < pos_s_) {
+          ++seg_;
+        }
+        v_scale = 0.0;
+        if (pos_s_ >= s_head) {
+          const PathPoint& h = head();
+          sp_[0] = h.x;
+          sp_[1] = h.y;
+          sp_[2] = h.z;
+          ramp_k_ = 0;
+          state_ = ramp_cycles_ > 0 ? State::kRamp : State::kIdle;
+          v_scale = ramp_cycles_ > 0 ? 0.0 : 1.0;
+        } else {
+          set_point_at(pos_s_);
+        }
+        break;
+      }
+      case State::kRamp:
+        ++ramp_k_;
+        if (ramp_k_ >= ramp_cycles_) {
+          state_ = State::kIdle;
+        } else {
+          v_scale = static_cast<double>(ramp_k_) / static_cast<double>(ramp_cycles_);
+        }
+        break;
+      case State::kHold:
+        v_scale = 0.0;
+        break;
+    }
+  }
+  const bool active =
+      state_ == State::kRetract || state_ == State::kResume || state_ == State::kHold;
+  if (!input_fault || active) {
+    active_.set(active);
+    x_sp_mm_.set(sp_[0]);
+    y_sp_mm_.set(sp_[1]);
+    z_sp_mm_.set(sp_[2]);
+    v_scale_.set(v_scale);
+  }
+  tries_out_.set(tries_);
+  alarm_out_.set(alarm_);
+  hold_out_.set(alarm_);
+  return alarm_ || input_fault ? rt::BlockStatus::kFault : rt::BlockStatus::kOk;
+}
+
+}  // namespace edm::blocks

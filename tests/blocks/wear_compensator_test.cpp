@@ -1,0 +1,164 @@
+#include "edm/blocks/wear_compensator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "block_harness.hpp"
+
+namespace edm::blocks {
+namespace {
+
+using namespace std::chrono_literals;
+using rt::BlockStatus;
+using test::BlockHarness;
+using test::describe;
+
+// Sets the gap controller's command vz_in_mm_s, then runs one cycle.
+BlockStatus step(BlockHarness<WearCompensator>& h, double vz_in_mm_s) {
+  h.source<double>("vz_in_mm_s").set(vz_in_mm_s);
+  return h.step();
+}
+
+TEST(WearCompensatorTest, vd_equals_eq8_for_constant_feeds) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start(WearCompensatorParams{}).empty());
+  const double a_hole = std::numbers::pi / 4.0 * 1.1 * 1.1;
+  const double a_e = std::numbers::pi / 4.0 * (1.0 - 0.09);
+  EXPECT_NEAR(h.block().params().hole_area_mm2, 0.950332, 1e-6);
+  EXPECT_NEAR(h.block().params().electrode_area_mm2, 0.714712, 1e-6);
+  auto& ratio = h.source<double>("wear_ratio");
+  for (const double wr : {0.1, 0.5, 1.2}) {
+    for (const double vz : {-0.001, -0.02, -0.5}) {
+      ratio.set(wr);
+      EXPECT_EQ(step(h, vz), BlockStatus::kOk);
+      // eq. 8 from its parts: MRRw = A_hole·|vz|, MRRe = wr·MRRw, Vd = MRRe / A_e.
+      const double mrr_w = a_hole * -vz;
+      const double vd = wr * mrr_w / a_e;
+      EXPECT_NEAR(h.out("vd_mm_s"), vd, 1e-15) << wr << " " << vz;
+      EXPECT_NEAR(h.out("vz_out_mm_s"), vz - vd, 1e-15);
+      EXPECT_LT(h.out("vz_out_mm_s"), vz) << "more downward";
+    }
+  }
+}
+
+TEST(WearCompensatorTest, no_compensation_while_retracting_holding_or_disabled) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start(WearCompensatorParams{}).empty());
+  h.source<double>("wear_ratio").set(0.5);
+  auto& enable = h.source<bool>("enable");
+  enable.set(true);
+  for (const double vz : {0.0, 0.3, 5.0}) {
+    EXPECT_EQ(step(h, vz), BlockStatus::kOk);
+    EXPECT_EQ(h.out("vz_out_mm_s"), vz);
+    EXPECT_EQ(h.out("vd_mm_s"), 0.0);
+  }
+  enable.set(false);
+  EXPECT_EQ(step(h, -0.1), BlockStatus::kOk);
+  EXPECT_EQ(h.out("vz_out_mm_s"), -0.1);
+  EXPECT_EQ(h.out("vd_mm_s"), 0.0);
+  EXPECT_EQ(h.out("wear_mm"), 0.0);
+}
+
+TEST(WearCompensatorTest, accumulated_wear_integrates_exactly) {
+  // A_hole/A_e = 2, wear ratio 0.25, dt = 0.125 s: every Vd·dt and partial sum is exact in binary.
+  BlockHarness<WearCompensator> h(125ms);
+  ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
+  h.source<double>("wear_ratio").set(0.25);
+  double expected = 0.0;
+  for (int n = 1; n <= 4000; ++n) {
+    const double vz = n % 3 == 0 ? 0.5 : (n % 3 == 1 ? -0.5 : -0.25);  // incl. retracting cycles
+    step(h, vz);
+    const double vd = vz < 0.0 ? 0.25 * 2.0 * -vz : 0.0;
+    ASSERT_EQ(h.out("vd_mm_s"), vd);
+    expected += vd * 0.125;
+    ASSERT_EQ(h.out("wear_mm"), expected) << "n = " << n;
+  }
+  // reset_wear zeroes it (electrode change); a value written into the pin is continued.
+  auto& reset = h.source<bool>("reset_wear");
+  reset.set(true);
+  step(h, -0.5);
+  EXPECT_EQ(h.out("wear_mm"), 0.25 * 0.125);
+  reset.set(false);
+  h.pin("wear_mm").as_output<double>()->set(10.0);  // retained value restored
+  step(h, -0.5);
+  EXPECT_EQ(h.out("wear_mm"), 10.0 + 0.25 * 0.125);
+}
+
+TEST(WearCompensatorTest, electrode_front_keeps_up_with_the_hole_bottom) {
+  // Physical model: the holder moves at vz_out, the electrode shortens by the true wear
+  // (wear_ratio·A_hole·bottom feed / A_e), the bottom advances at the front feed. The gap must
+  // stay constant.
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start(WearCompensatorParams{}).empty());
+  const auto& p = h.block().params();
+  const double wr = 0.6;
+  h.source<double>("wear_ratio").set(wr);
+  double holder = 10.0;
+  double length = 5.0;
+  double bottom = holder - length - 0.01;  // 10 µm gap
+  const double vz = -0.05;                 // the gap controller's command
+  for (int k = 0; k < 100000; ++k) {
+    step(h, vz);
+    const double dt = 1e-3;
+    const double front_before = holder - length;
+    const double bottom_feed = vz;  // the bottom advances with the front (steady gap)
+    holder += h.out("vz_out_mm_s") * dt;
+    length -= wr * p.hole_area_mm2 * -bottom_feed / p.electrode_area_mm2 * dt;
+    bottom += bottom_feed * dt;
+    ASSERT_NEAR((holder - length) - front_before, vz * dt, 1e-12);
+  }
+  EXPECT_NEAR((holder - length) - bottom, 0.01, 1e-9) << "gap unchanged after 100 s";
+  EXPECT_NEAR(h.out("wear_mm"), 5.0 - length, 1e-9) << "wear_mm = length consumed";
+}
+
+TEST(WearCompensatorTest, wear_ratio_is_clamped_and_non_finite_is_a_fault) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(
+      h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0, .wear_ratio_max = 1.0}).empty());
+  auto& ratio = h.source<double>("wear_ratio");
+  ratio.set(-0.5);
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kSaturated);
+  EXPECT_EQ(h.out("vd_mm_s"), 0.0);
+  ratio.set(3.0);
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kSaturated);
+  EXPECT_EQ(h.out("vd_mm_s"), 2.0);
+  ratio.set(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kFault);
+  EXPECT_EQ(h.out("vz_out_mm_s"), -1.0) << "uncompensated, still driven";
+  EXPECT_EQ(h.out("vd_mm_s"), 0.0);
+  ratio.set(0.5);
+  const double wear = h.out("wear_mm");
+  EXPECT_EQ(step(h, std::numeric_limits<double>::infinity()), BlockStatus::kFault);
+  EXPECT_EQ(h.out("vz_out_mm_s"), 0.0) << "a broken feed command stops the axis";
+  EXPECT_EQ(h.out("wear_mm"), wear);
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kOk);
+  EXPECT_EQ(h.out("vd_mm_s"), 1.0);
+}
+
+TEST(WearCompensatorTest, runtime_write_of_the_areas) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
+  h.source<double>("wear_ratio").set(0.5);
+  auto errs = h.write_param("electrode_area_mm2", rt::ParamValue::of_real(0.5));
+  ASSERT_TRUE(errs.empty()) << describe(errs);
+  step(h, -1.0);
+  EXPECT_EQ(h.out("vd_mm_s"), 2.0);
+  EXPECT_FALSE(h.write_param("hole_area_mm2", rt::ParamValue::of_real(0.0)).empty());
+}
+
+TEST(WearCompensatorTest, validate_refuses_bad_parameters) {
+  EXPECT_TRUE(WearCompensatorParams{}.validate().empty());
+  EXPECT_FALSE(WearCompensatorParams{.hole_area_mm2 = -1.0}.validate().empty());
+  EXPECT_FALSE(WearCompensatorParams{.electrode_area_mm2 = std::numeric_limits<double>::infinity()}
+                   .validate()
+                   .empty());
+  BlockHarness<WearCompensator> no_task(rt::Duration{0});
+  EXPECT_FALSE(no_task.start().empty());
+}
+
+}  // namespace
+}  // namespace edm::blocks
