@@ -1,0 +1,207 @@
+// edm-kgdesign — the ISE-optimal gain of the P gap controller Vz = Kg·(Tdr − Td) (SEEDS 004
+// eq. 1–3) for a linearised gap + Z-axis model; see edm/blocks/kg_design.hpp and docs/blocks.md.
+// Exit codes: 0 ok, 2 bad arguments or invalid model.
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <cstdlib>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "edm/blocks/kg_design.hpp"
+
+namespace {
+
+using edm::blocks::AxisOrder;
+using edm::blocks::GapLoopModel;
+using edm::blocks::KgDesignStatus;
+using edm::blocks::TdMedianLaw;
+
+constexpr int kExitOk = 0;
+constexpr int kExitBadInput = 2;
+
+constexpr const char* kUsage =
+    "usage: edm-kgdesign [--law drill|sink] [--gap-um G] [--debris C] [--kd-us-per-um K]\n"
+    "                    [--tau-v-ms T | --wn W --zeta Z] [--tau-m-ms T] [--tdr-us D]\n"
+    "                    [--kg KG]\n"
+    "  --law          Td median law of PLANT-MODEL 6.5 (default drill)\n"
+    "  --gap-um       working gap [um] (default: the law's g_r, 20 for drill)\n"
+    "  --debris       debris concentration c in [0, 1] at the working point (default 0)\n"
+    "  --kd-us-per-um Td slope, overrides the law\n"
+    "  --tau-v-ms     first-order velocity loop, time constant [ms]\n"
+    "  --wn, --zeta   second-order axis, command -> velocity (default 200 rad/s, 0.55)\n"
+    "  --tau-m-ms     first-order lag on the measured Td [ms] (default 0: none)\n"
+    "  --tdr-us       size of the Tdr step used for J [us] (default 1; J scales with D^2)\n"
+    "  --kg           also evaluate this Kg [(mm/s)/us]\n";
+
+int bad(const std::string& msg) {
+  std::fprintf(stderr, "edm-kgdesign: %s\n%s", msg.c_str(), kUsage);
+  return kExitBadInput;
+}
+
+std::optional<double> parse_number(std::string_view text) {
+  const std::string s(text);
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::string format_poly(std::span<const double> p) {
+  std::string out = "[";
+  char buf[64];
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%s%.6g", i == 0 ? "" : ", ", p[i]);
+    out += buf;
+  }
+  return out + "]";
+}
+
+void print_poles(const std::vector<std::complex<double>>& poles) {
+  for (const auto& p : poles) {
+    if (p.imag() < 0.0) continue;  // print each conjugate pair once
+    const double wn = std::abs(p);
+    if (p.imag() == 0.0) {
+      std::printf("  pole            %.6g rad/s (real, time constant %.4g ms)\n", p.real(),
+                  -1e3 / p.real());
+    } else {
+      std::printf("  pole            %.6g +/- %.6gj rad/s (wn %.4g rad/s, zeta %.4f)\n", p.real(),
+                  p.imag(), wn, -p.real() / wn);
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  TdMedianLaw law = TdMedianLaw::drill();
+  std::string law_name = "drill";
+  std::optional<double> gap_um, debris, kd, tau_v_ms, wn, zeta, tau_m_ms, tdr_us, kg_eval;
+
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::fputs(kUsage, stdout);
+      return kExitOk;
+    }
+    if (i + 1 >= argc) return bad("missing value after " + std::string(arg));
+    const std::string_view val = argv[++i];
+    if (arg == "--law") {
+      if (val == "drill") {
+        law = TdMedianLaw::drill();
+      } else if (val == "sink") {
+        law = TdMedianLaw::sink();
+      } else {
+        return bad("--law must be drill or sink, got '" + std::string(val) + "'");
+      }
+      law_name = std::string(val);
+      continue;
+    }
+    std::optional<double>* slot = nullptr;
+    if (arg == "--gap-um") slot = &gap_um;
+    if (arg == "--debris") slot = &debris;
+    if (arg == "--kd-us-per-um") slot = &kd;
+    if (arg == "--tau-v-ms") slot = &tau_v_ms;
+    if (arg == "--wn") slot = &wn;
+    if (arg == "--zeta") slot = &zeta;
+    if (arg == "--tau-m-ms") slot = &tau_m_ms;
+    if (arg == "--tdr-us") slot = &tdr_us;
+    if (arg == "--kg") slot = &kg_eval;
+    if (slot == nullptr) return bad("unknown option '" + std::string(arg) + "'");
+    if (slot->has_value()) return bad(std::string(arg) + " given twice");
+    *slot = parse_number(val);
+    if (!slot->has_value()) {
+      return bad(std::string(arg) + ": '" + std::string(val) + "' is not a finite number");
+    }
+  }
+  if (tau_v_ms && (wn || zeta)) return bad("--tau-v-ms excludes --wn/--zeta (pick one axis model)");
+
+  if (debris) law.debris = *debris;
+  if (const auto errs = law.validate(); !errs.empty()) return bad("Td law: " + errs.front());
+  const double gap = gap_um.value_or(law.g_r_um);
+  if (gap_um && !(gap > 0.0)) return bad("--gap-um must be > 0");
+
+  GapLoopModel m;
+  m.kd_us_per_um = kd.value_or(edm::blocks::td_gap_slope_us_per_um(law, gap));
+  if (tau_v_ms) {
+    m.axis.order = AxisOrder::kFirstOrder;
+    m.axis.tau_v_s = *tau_v_ms * 1e-3;
+  } else {
+    m.axis.order = AxisOrder::kSecondOrder;
+    m.axis.wn_rad_s = wn.value_or(m.axis.wn_rad_s);
+    m.axis.zeta = zeta.value_or(m.axis.zeta);
+  }
+  m.tau_meas_s = tau_m_ms.value_or(0.0) * 1e-3;
+  m.tdr_step_us = tdr_us.value_or(1.0);
+  if (const auto errs = m.validate(); !errs.empty()) return bad("model: " + errs.front());
+  if (kg_eval && !(*kg_eval > 0.0)) return bad("--kg must be > 0");
+
+  const auto r = edm::blocks::optimal_kg(m);
+  if (r.status == KgDesignStatus::kInvalidModel) return bad("model: " + r.errors.front());
+
+  std::printf("edm-kgdesign: ISE-optimal Kg of the P gap controller Vz = Kg*(Tdr - Td)\n");
+  std::printf("model\n");
+  if (kd) {
+    std::printf("  kd              %.6g us/um (given)\n", m.kd_us_per_um);
+  } else {
+    std::printf("  Td law (%s)   tau_med = %g + %g*exp((g - %g)/%g)*exp(-%g*%g) us\n",
+                law_name.c_str(), law.tau_min_us, law.tau_r_us, law.g_r_um, law.l_g_um, law.k_cd,
+                law.debris);
+    std::printf("  working gap     %g um, Td median %.4g us (the Tdr that holds it)\n", gap,
+                edm::blocks::td_median_us(law, gap));
+    std::printf("  kd              %.6g us/um (slope of the law at the gap)\n", m.kd_us_per_um);
+  }
+  if (m.axis.order == AxisOrder::kFirstOrder) {
+    std::printf("  axis            1st order, tau_v %g ms (command -> velocity)\n",
+                m.axis.tau_v_s * 1e3);
+  } else {
+    std::printf("  axis            2nd order, wn %g rad/s, zeta %g (command -> velocity)\n",
+                m.axis.wn_rad_s, m.axis.zeta);
+  }
+  if (m.tau_meas_s > 0.0) {
+    std::printf("  Td measurement  1st-order lag %g ms\n", m.tau_meas_s * 1e3);
+  } else {
+    std::printf("  Td measurement  no lag\n");
+  }
+  std::printf("  loop            L(s) = K*G_axis(s)*H_m(s)/s, K = 1000*Kg*kd [1/s]\n");
+  std::printf("  Tdr step        %g us\n", m.tdr_step_us);
+  std::printf("  E(s) = B/A      order n = %d, ascending powers of s, at the optimum:\n", r.order);
+  std::printf("    B = %s\n", format_poly(r.transfer.b).c_str());
+  std::printf("    A = %s\n", format_poly(r.transfer.a).c_str());
+  std::printf("design\n");
+  if (std::isfinite(r.critical_kg)) {
+    std::printf("  Kg critical     %.6g (mm/s)/us (stability limit, K = %.6g 1/s)\n", r.critical_kg,
+                edm::blocks::loop_gain_per_s(m, r.critical_kg));
+  } else {
+    std::printf("  Kg critical     none (stable for every Kg > 0)\n");
+  }
+  if (r.status == KgDesignStatus::kNoFiniteMinimum) {
+    std::printf("  Kg optimal      none: J falls monotonically as Kg grows\n");
+    std::printf("  J infimum       %.6g us^2*s (approached as Kg -> inf)\n", r.ise_us2_s);
+    std::printf(
+        "  note            ISE does not penalise the oscillation that a large Kg brings;\n"
+        "                  model the Td measurement lag (--tau-m-ms) or the 2nd-order axis\n");
+  } else {
+    std::printf("  Kg optimal      %.6g (mm/s)/us (K = %.6g 1/s, gain margin %.3g)\n",
+                r.kg_mm_s_per_us, r.loop_gain_per_s, r.critical_kg / r.kg_mm_s_per_us);
+    std::printf("  J               %.6g us^2*s\n", r.ise_us2_s);
+    print_poles(r.poles);
+  }
+  if (kg_eval) {
+    const double j = edm::blocks::ise_for_kg(m, *kg_eval);
+    std::printf("at --kg %g (mm/s)/us\n", *kg_eval);
+    if (std::isfinite(j)) {
+      std::printf("  J               %.6g us^2*s (%.3g x the optimum)\n", j,
+                  r.status == KgDesignStatus::kOk ? j / r.ise_us2_s : std::nan(""));
+    } else {
+      std::printf("  J               inf (closed loop unstable)\n");
+    }
+    const auto t = edm::blocks::error_transfer(m, *kg_eval);
+    print_poles(edm::blocks::polynomial_roots(t.a));
+  }
+  return kExitOk;
+}
