@@ -1,11 +1,14 @@
 #include "edm/blocks/register.hpp"
 
+#include "edm/blocks/circular_interpolator.hpp"
 #include "edm/blocks/gain.hpp"
 #include "edm/blocks/gap_controller_p.hpp"
 #include "edm/blocks/integrator.hpp"
+#include "edm/blocks/linear_interpolator.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/low_pass.hpp"
 #include "edm/blocks/moving_average.hpp"
+#include "edm/blocks/orbit_expander.hpp"
 #include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/position_loop.hpp"
 #include "edm/blocks/short_retract.hpp"
@@ -30,6 +33,9 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<WearCompensator>("WearCompensator", "seed 004 eq. 8: Vd = MRRe/A added to the Z feed");
   r.add<PositionLoop>("PositionLoop", "P/PI axis loop with feed-forward and following error");
   r.add<ShortRetract>("ShortRetract", "sustained short: retract along the path, resume, alarm");
+  r.add<LinearInterpolator>("LinearInterpolator", "seed 004 eq. 12-13, exact end point");
+  r.add<CircularInterpolator>("CircularInterpolator", "seed 004 eq. 14-19, G02/G03, full circles");
+  r.add<OrbitExpander>("OrbitExpander", "seed 004 eq. 20-21: radius += kr·mean Td per revolution");
 }
 
 }  // namespace edm::blocks

@@ -1,0 +1,113 @@
+#pragma once
+// CircularInterpolator: arcs and full circles in XY, one per rising edge of `start` (SEEDS 004,
+// eq. 14–19; G03 counter-clockwise, G02 clockwise).
+//
+//   on a rising edge of start (and not busy): latch (i, j) [mm] (current point → centre), cw,
+//       feed, and the end: full_circle → `turns` revolutions back to the start point; otherwise
+//       the end point P0 + (ex, ey) (ex = ey = 0 is one full circle, as in G-code).
+//       R = √(i² + j²), C = P0 + (i, j), θ0 = atan2(−j, −i), σ = +1 (G03) or −1 (G02)
+//   each cycle while busy and not hold:
+//       fr = feed/60 · clamp(override, 0, 2) · dt;   Δθ = fr/R;   φ += Δθ
+//       (i, j) = −R·(cos θ, sin θ),  θ = θ0 + σ·φ;   R_xy = C − (i, j)
+//       once φ ≥ sweep: R_xy = end point exactly, busy = false, done = true
+//
+// Eq. 14–19 (Pa = 1 − cos Δθ, Pb = σ·sin Δθ, V = (Pa·i + Pb·j, −Pb·i + Pa·j), R += V, (i, j) −= V)
+// rotate (i, j) by σ·Δθ each sample. Iterated as written, the rounding of each rotation grows the
+// radius error without bound; here (i, j) is recomputed from the swept angle φ every sample, which
+// is the same sequence in exact arithmetic but keeps the radius error at ~1 ulp of R at any
+// sample, and the end point is snapped exactly. An end point off the circle by more than
+// end_tol_mm is refused; within it the last step lands on the programmed point.
+//
+// Outputs: position, v = step/dt, angle_rad = θ wrapped to [−π, π] (polar angle of the point seen
+// from the centre: the radial direction), swept_rad = φ. `done` is a level (see
+// LinearInterpolator); `load` sets the position and cancels a move.
+//
+// Status: kSaturated when override was clamped; kFault (no advance, v = 0) on a non-finite
+// override or load position, or a rejected move (non-finite inputs, R = 0, feed ≤ 0, turns
+// outside [1, kMaxTurns] with full_circle, end point off the circle).
+// RT-safe: update(), enter_safe_state() (cancels the move). Not thread-safe: the owning task
+// calls every member except the pins (see pin.hpp).
+
+#include <cstdint>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct CircularInterpolatorParams {
+  double x0_mm{0.0};        // [mm] position after configure()/activate()
+  double y0_mm{0.0};        // [mm]
+  double end_tol_mm{1e-3};  // [mm] allowed | |end − C| − R |, ≥ 0
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("x0_mm", x0_mm, "mm", "X position at activation");
+    v.param("y0_mm", y0_mm, "mm", "Y position at activation");
+    v.param("end_tol_mm", end_tol_mm, "mm",
+            "largest accepted difference between the end point's radius and the start radius");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolatorParams> {
+ public:
+  static constexpr double kMaxOverride = 2.0;
+  static constexpr std::int64_t kMaxTurns = 1'000'000;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Needs a task period > 0.
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. Position = (x0, y0), idle.
+  void activate() noexcept override;
+  /// RT-safe. kOk, kSaturated (override clamped) or kFault (see the file comment).
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+  /// RT-safe. Cancels a move in progress (busy = false, v = 0); the position is kept.
+  void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
+
+ private:
+  [[nodiscard]] bool latch_move() noexcept;
+  void publish(double vx_mm_s, double vy_mm_s) noexcept;
+
+  rt::Input<bool> start_;
+  rt::Input<bool> cw_;
+  rt::Input<double> i_;
+  rt::Input<double> j_;
+  rt::Input<bool> full_circle_;
+  rt::Input<std::int64_t> turns_{1};
+  rt::Input<double> ex_;
+  rt::Input<double> ey_;
+  rt::Input<double> feed_;
+  rt::Input<double> override_{1.0};
+  rt::Input<bool> hold_;
+  rt::Input<bool> load_;
+  rt::Input<double> load_x_;
+  rt::Input<double> load_y_;
+  rt::Output<double> rx_;
+  rt::Output<double> ry_;
+  rt::Output<double> vx_;
+  rt::Output<double> vy_;
+  rt::Output<double> angle_;
+  rt::Output<double> swept_;
+  rt::Output<bool> busy_;
+  rt::Output<bool> done_;
+
+  double dt_s_{0.0};
+  double x_{0.0};  // [mm] current position
+  double y_{0.0};
+  double cx_{0.0};  // [mm] centre
+  double cy_{0.0};
+  double ex_abs_{0.0};  // [mm] end point
+  double ey_abs_{0.0};
+  double radius_{0.0};  // [mm]
+  double theta0_{0.0};  // [rad] polar angle of the start point about the centre
+  double theta_{0.0};   // [rad] current polar angle (unwrapped)
+  double sigma_{1.0};   // +1 G03 (ccw), −1 G02 (cw)
+  double sweep_{0.0};   // [rad] total angle of the move, > 0
+  double phi_{0.0};     // [rad] swept so far
+  double feed_mm_s_{0.0};
+  bool busy_state_{false};
+  bool done_state_{false};
+  bool prev_start_{false};
+};
+
+}  // namespace edm::blocks

@@ -1,0 +1,98 @@
+#pragma once
+// LinearInterpolator: straight-line moves in XYZ, one per rising edge of `start` (SEEDS 004,
+// eq. 12–13, generalised to three axes).
+//
+//   on a rising edge of start (and not busy): latch L = (lx, ly, lz) [mm] and feed [mm/min],
+//       P0 = current position, l = √(lx² + ly² + lz²), s = 0
+//   each cycle while busy and not hold:
+//       fr = feed/60 · clamp(override, 0, 2) · dt        [mm this sample]
+//       s += fr;  R = P0 + (s/l)·L                        (= Σ fr·l_axis/l of eq. 12–13)
+//       once s ≥ l: R = P0 + L exactly, busy = false, done = true
+//   v = (R − R_prev)/dt each cycle (0 when not moving)
+//
+// The position is computed from the travelled length s rather than summed per axis, so there is
+// no rounding growth along the move and the end point is bit-exact P0 + L. `load` (level) sets
+// the position to (load_x, load_y, load_z) and cancels a move in progress. A rising start edge
+// while busy is ignored. `done` is a level: true from the cycle the end point is reached until
+// the next move is latched or a load. A zero-length move completes on its start edge.
+//
+// Status: kSaturated when override was outside [0, 2] (clamped); kFault (no advance, v = 0) on
+// a non-finite override or load position, or a rejected move (non-finite increments or feed,
+// feed ≤ 0 with l > 0).
+// RT-safe: update(), enter_safe_state() (cancels the move). Not thread-safe: the owning task
+// calls every member except the pins (see pin.hpp).
+
+#include <array>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct LinearInterpolatorParams {
+  double x0_mm{0.0};  // [mm] position after configure()/activate()
+  double y0_mm{0.0};  // [mm]
+  double z0_mm{0.0};  // [mm]
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("x0_mm", x0_mm, "mm", "X position at activation");
+    v.param("y0_mm", y0_mm, "mm", "Y position at activation");
+    v.param("z0_mm", z0_mm, "mm", "Z position at activation");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class LinearInterpolator final : public rt::BlockWithParams<LinearInterpolatorParams> {
+ public:
+  static constexpr double kMaxOverride = 2.0;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Needs a task period > 0.
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. Position = (x0, y0, z0), idle.
+  void activate() noexcept override;
+  /// RT-safe. kOk, kSaturated (override clamped) or kFault (see the file comment).
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+  /// RT-safe. Cancels a move in progress (busy = false, v = 0); the position is kept.
+  void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
+
+ private:
+  using Vec3 = std::array<double, 3>;
+
+  [[nodiscard]] bool latch_move() noexcept;
+  void publish(const Vec3& v_mm_s) noexcept;
+
+  rt::Input<bool> start_;
+  rt::Input<double> lx_;
+  rt::Input<double> ly_;
+  rt::Input<double> lz_;
+  rt::Input<double> feed_;
+  rt::Input<double> override_{1.0};
+  rt::Input<bool> hold_;
+  rt::Input<bool> load_;
+  rt::Input<double> load_x_;
+  rt::Input<double> load_y_;
+  rt::Input<double> load_z_;
+  rt::Output<double> rx_;
+  rt::Output<double> ry_;
+  rt::Output<double> rz_;
+  rt::Output<double> vx_;
+  rt::Output<double> vy_;
+  rt::Output<double> vz_;
+  rt::Output<bool> busy_;
+  rt::Output<bool> done_;
+
+  double dt_s_{0.0};
+  Vec3 pos_{};       // [mm] current position
+  Vec3 p0_{};        // [mm] position when the move was latched
+  Vec3 l_{};         // [mm] latched increments
+  Vec3 end_{};       // [mm] p0_ + l_
+  double len_{0.0};  // [mm] |l_|
+  double s_{0.0};    // [mm] path length travelled
+  double feed_mm_s_{0.0};
+  bool busy_state_{false};
+  bool done_state_{false};
+  bool prev_start_{false};
+};
+
+}  // namespace edm::blocks

@@ -1,0 +1,88 @@
+#pragma once
+// OrbitExpander: grows the orbit radius once per revolution from the mean ignition delay of that
+// revolution (SEEDS 004, eq. 20–21), for finishing a hole wall by orbiting.
+//
+//   on a rising edge of start (and not busy): radius = r0_mm, final = final_radius_mm (latched),
+//       revolutions = 0; busy unless r0 = final (then done at once)
+//   each cycle while busy and enable: if valid, Σ += td_us and n += 1 (invalid samples are not
+//       read); then, if the revolution ended this cycle:
+//       Tdm = Σ/n                              (eq. 20; Tdm = 0 when n = 0)
+//       Δr  = clamp(kr·Tdm, 0, dr_max_mm)      (eq. 21; Δr = 0 when n = 0: no data, no growth)
+//       Δr  = min(Δr, final − radius);  radius += Δr;  revolutions += 1;  Σ = n = 0
+//       radius = final → busy = false, done = true (radius is set to final exactly)
+//
+// A revolution ends on a rising edge of rev_pulse (samples_per_rev = 0) or after samples_per_rev
+// enabled samples (samples_per_rev > 0; rev_pulse is then ignored). The sample of the cycle in
+// which the revolution ends belongs to that revolution. enable = false pauses: no sample is
+// collected, no revolution ends, the partial sums are kept. The new radius is the radius for the
+// next revolution. `done` is a level, true until the next start. A start edge while busy is
+// ignored; the start cycle itself is not a sample (collection begins in the next cycle).
+//
+// Status: kSaturated in the cycle in which Δr was cut to dr_max_mm; kFault on a non-finite td_us
+// with valid = true (the sample is excluded), on a rejected start (r0 or final non-finite,
+// r0 < 0 or final < r0; nothing latched), or on a revolution whose sum overflowed (Δr = 0).
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+
+#include <cstdint>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct OrbitExpanderParams {
+  double kr{1e-4};                  // [mm/µs] Δr per µs of mean ignition delay, ≥ 0
+  double dr_max_mm{0.01};           // [mm] largest Δr per revolution, ≥ 0
+  std::int64_t samples_per_rev{0};  // samples per revolution; 0 = revolutions from rev_pulse
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("kr", kr, "mm/us", "radius growth per revolution per us of mean ignition delay");
+    v.param("dr_max_mm", dr_max_mm, "mm", "largest radius growth per revolution");
+    v.param("samples_per_rev", samples_per_rev, "",
+            "samples per revolution (0: a rising edge of rev_pulse ends a revolution)");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
+ public:
+  static constexpr std::int64_t kMaxSamplesPerRev = 1'000'000'000;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Idle, radius 0.
+  void activate() noexcept override;
+  /// RT-safe. kOk, kSaturated (Δr clamped to dr_max_mm) or kFault (see the file comment).
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+
+ private:
+  void publish() noexcept;
+
+  rt::Input<bool> start_;
+  rt::Input<double> r0_;
+  rt::Input<double> final_radius_;
+  rt::Input<bool> enable_{true};
+  rt::Input<double> td_;
+  rt::Input<bool> valid_;
+  rt::Input<bool> rev_pulse_;
+  rt::Output<double> radius_;
+  rt::Output<double> dr_;
+  rt::Output<double> tdm_;
+  rt::Output<std::int64_t> revolutions_;
+  rt::Output<bool> busy_;
+  rt::Output<bool> done_;
+
+  double radius_mm_{0.0};
+  double final_mm_{0.0};
+  double dr_mm_{0.0};
+  double tdm_us_{0.0};
+  double sum_us_{0.0};  // Σ td over the valid samples of the current revolution [µs]
+  std::int64_t n_valid_{0};
+  std::int64_t n_samples_{0};  // enabled samples of the current revolution
+  std::int64_t revs_{0};
+  bool busy_state_{false};
+  bool done_state_{false};
+  bool prev_start_{false};
+  bool prev_rev_{false};
+};
+
+}  // namespace edm::blocks

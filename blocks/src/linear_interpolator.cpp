@@ -1,0 +1,178 @@
+#include "edm/blocks/linear_interpolator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edm/blocks/validation.hpp"
+
+namespace edm::blocks {
+
+std::vector<rt::ParamError> LinearInterpolatorParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_finite(errs, "x0_mm", x0_mm);
+  rt::require_finite(errs, "y0_mm", y0_mm);
+  rt::require_finite(errs, "z0_mm", z0_mm);
+  return errs;
+}
+
+void LinearInterpolator::visit_pins(rt::PinVisitor& v) {
+  v.input("start", start_);
+  v.input("lx_mm", lx_, "mm");
+  v.input("ly_mm", ly_, "mm");
+  v.input("lz_mm", lz_, "mm");
+  v.input("feed_mm_min", feed_, "mm/min");
+  v.input("override", override_);
+  v.input("hold", hold_);
+  v.input("load", load_);
+  v.input("load_x_mm", load_x_, "mm");
+  v.input("load_y_mm", load_y_, "mm");
+  v.input("load_z_mm", load_z_, "mm");
+  v.output("rx_mm", rx_, "mm");
+  v.output("ry_mm", ry_, "mm");
+  v.output("rz_mm", rz_, "mm");
+  v.output("vx_mm_s", vx_, "mm/s");
+  v.output("vy_mm_s", vy_, "mm/s");
+  v.output("vz_mm_s", vz_, "mm/s");
+  v.output("busy", busy_);
+  v.output("done", done_);
+}
+
+std::vector<rt::ParamError> LinearInterpolator::configure(const rt::BlockSetup& setup) {
+  std::vector<rt::ParamError> errs;
+  require_task_period(errs, setup.period);
+  dt_s_ = rt::to_seconds(setup.period);
+  activate();
+  return errs;
+}
+
+void LinearInterpolator::activate() noexcept {
+  pos_ = {params_.x0_mm, params_.y0_mm, params_.z0_mm};
+  p0_ = pos_;
+  end_ = pos_;
+  l_ = {};
+  len_ = 0.0;
+  s_ = 0.0;
+  feed_mm_s_ = 0.0;
+  busy_state_ = false;
+  done_state_ = false;
+  prev_start_ = false;
+  publish({});
+}
+
+void LinearInterpolator::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
+  busy_state_ = false;
+  done_state_ = false;
+  publish({});
+}
+
+bool LinearInterpolator::latch_move() noexcept {
+  const Vec3 l{lx_.get(), ly_.get(), lz_.get()};
+  const double feed_mm_min = feed_.get();
+  if (!std::isfinite(l[0]) || !std::isfinite(l[1]) || !std::isfinite(l[2]) ||
+      !std::isfinite(feed_mm_min)) {
+    return false;
+  }
+  const double len = std::hypot(l[0], l[1], l[2]);
+  if (!std::isfinite(len)) {
+    return false;
+  }
+  p0_ = pos_;
+  l_ = l;
+  for (std::size_t a = 0; a < 3; ++a) {
+    end_[a] = p0_[a] + l_[a];
+    if (!std::isfinite(end_[a])) {
+      return false;
+    }
+  }
+  len_ = len;
+  s_ = 0.0;
+  if (len == 0.0) {  // zero-length move: complete at once, the feed is not needed
+    busy_state_ = false;
+    done_state_ = true;
+    return true;
+  }
+  if (!(feed_mm_min > 0.0)) {
+    return false;
+  }
+  feed_mm_s_ = feed_mm_min / 60.0;
+  busy_state_ = true;
+  done_state_ = false;
+  return true;
+}
+
+rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const bool start = start_.get();
+  const bool edge = start && !prev_start_;
+  prev_start_ = start;
+
+  if (load_.get()) {
+    const Vec3 p{load_x_.get(), load_y_.get(), load_z_.get()};
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      publish({});
+      return rt::BlockStatus::kFault;
+    }
+    pos_ = p;
+    busy_state_ = false;
+    done_state_ = false;
+    publish({});
+    return rt::BlockStatus::kOk;
+  }
+
+  if (edge && !busy_state_ && !latch_move()) {
+    busy_state_ = false;
+    done_state_ = false;
+    publish({});
+    return rt::BlockStatus::kFault;
+  }
+  if (!busy_state_) {
+    publish({});
+    return rt::BlockStatus::kOk;
+  }
+
+  const double ov_in = override_.get();
+  if (!std::isfinite(ov_in)) {
+    publish({});
+    return rt::BlockStatus::kFault;
+  }
+  const double ov = std::clamp(ov_in, 0.0, kMaxOverride);
+  const rt::BlockStatus status = ov != ov_in ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
+  if (hold_.get()) {
+    publish({});
+    return status;
+  }
+
+  const double s_next = s_ + feed_mm_s_ * ov * dt_s_;
+  Vec3 next{};
+  if (s_next >= len_) {
+    next = end_;
+    s_ = len_;
+    busy_state_ = false;
+    done_state_ = true;
+  } else {
+    const double u = s_next / len_;
+    for (std::size_t a = 0; a < 3; ++a) {
+      next[a] = p0_[a] + u * l_[a];
+    }
+    s_ = s_next;
+  }
+  Vec3 v{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    v[a] = (next[a] - pos_[a]) / dt_s_;
+  }
+  pos_ = next;
+  publish(v);
+  return status;
+}
+
+void LinearInterpolator::publish(const Vec3& v_mm_s) noexcept {
+  rx_.set(pos_[0]);
+  ry_.set(pos_[1]);
+  rz_.set(pos_[2]);
+  vx_.set(v_mm_s[0]);
+  vy_.set(v_mm_s[1]);
+  vz_.set(v_mm_s[2]);
+  busy_.set(busy_state_);
+  done_.set(done_state_);
+}
+
+}  // namespace edm::blocks
