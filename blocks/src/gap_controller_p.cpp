@@ -8,7 +8,7 @@ namespace edm::blocks {
 std::vector<rt::ParamError> GapControllerPParams::validate() const {
   std::vector<rt::ParamError> errs;
   rt::require_finite(errs, "kg", kg);
-  rt::require_finite(errs, "tdr_us", tdr_us);
+  rt::require_finite(errs, "tdr_default_us", tdr_default_us);
   rt::require_finite(errs, "v_feed_max_mm_s", v_feed_max_mm_s);
   rt::require_finite(errs, "v_retract_max_mm_s", v_retract_max_mm_s);
   rt::require_finite(errs, "retract_speed_mm_s", retract_speed_mm_s);
@@ -17,7 +17,7 @@ std::vector<rt::ParamError> GapControllerPParams::validate() const {
     return errs;
   }
   rt::require_positive(errs, "kg", kg);
-  rt::require_positive(errs, "tdr_us", tdr_us);
+  rt::require_positive(errs, "tdr_default_us", tdr_default_us);
   rt::require_positive(errs, "v_feed_max_mm_s", v_feed_max_mm_s);
   rt::require_positive(errs, "v_retract_max_mm_s", v_retract_max_mm_s);
   rt::require_positive(errs, "retract_speed_mm_s", retract_speed_mm_s);
@@ -65,7 +65,7 @@ rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept
     if (!std::isfinite(td) || !std::isfinite(tdr_in) || tdr_in < 0.0) {
       return rt::BlockStatus::kFault;
     }
-    const double tdr = tdr_in > 0.0 ? tdr_in : p.tdr_us;
+    const double tdr = tdr_in > 0.0 ? tdr_in : p.tdr_default_us;
     vz = p.kg * (tdr - td);
     if (!std::isfinite(vz)) {  // finite inputs, but kg·error overflowed
       return rt::BlockStatus::kFault;

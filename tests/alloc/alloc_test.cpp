@@ -174,6 +174,94 @@ TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.5) << "it really drilled";
 }
 
+// Every seed-004 block in one program on the simulated drill: Td detector → P gap controller →
+// wear compensation → Z, interpolators and position loops for X/Y, orbit expander, polarity
+// switch and short retract.
+constexpr const char* kSeed004 = R"(version: 1
+machine:
+  name: alloc-004
+  io: {driver: sim, params: {preset: drill, seed: 3}}
+tasks:
+  - {name: servo, interval: 1ms, priority: 0, programs: [drill]}
+programs:
+  - name: drill
+    blocks:
+      - {name: td, type: TdDetector, params: {window: 8}}
+      - {name: gap, type: GapControllerP, params: {kg: 0.05, tdr_default_us: 8}}
+      - {name: wear, type: WearCompensator}
+      - {name: retract, type: ShortRetract, params: {history_capacity: 1024}}
+      - {name: lin, type: LinearInterpolator}
+      - {name: arc, type: CircularInterpolator}
+      - {name: orbit, type: OrbitExpander, params: {samples_per_rev: 100}}
+      - {name: px, type: PositionLoop}
+      - {name: py, type: PositionLoop}
+      - {name: pol, type: PolaritySwitch}
+    wires:
+      td.td_sum_ns: io.td_sum_ns
+      td.td_count: io.td_count
+      td.n_open: io.n_open
+      td.n_short: io.n_short
+      gap.td_us: td.td_us
+      gap.valid: td.valid
+      wear.vz_in_mm_s: gap.vz_mm_s
+      wear.wear_ratio: 0.6
+      io.vz_cmd: wear.vz_out_mm_s
+      retract.z_mm: io.z_mm
+      lin.start: true
+      lin.lx_mm: 0.5
+      lin.feed_mm_min: 30
+      arc.start: true
+      arc.i_mm: 0.2
+      arc.full_circle: true
+      arc.turns: 100
+      arc.feed_mm_min: 60
+      orbit.start: true
+      orbit.final_radius_mm: 0.05
+      orbit.td_us: td.td_us
+      orbit.valid: td.valid
+      px.x_ref_mm: arc.rx_mm
+      px.v_ff_mm_s: arc.vx_mm_s
+      px.x_mm: io.x_mm
+      py.x_ref_mm: arc.ry_mm
+      py.v_ff_mm_s: arc.vy_mm_s
+      py.x_mm: io.y_mm
+      io.vx_cmd: px.v_cmd_mm_s
+      io.vy_cmd: py.v_cmd_mm_s
+      pol.generator_on_request: true
+      io.gen_on: pol.generator_on
+      io.gen_arm: true
+      io.polarity_positive: pol.polarity_positive
+trace:
+  variables: [io.depth_mm, drill.gap.vz_mm_s, drill.orbit.radius_mm]
+)";
+
+TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
+  rt::DriverRegistry drivers;
+  sim::register_sim_driver(drivers);
+  auto r = rt::Runtime::build(rt::parse_config_text(kSeed004, "alloc-004.yaml"),
+                              registries().blocks, drivers);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  std::ostringstream sink;
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 2000; ++k) {
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 500 == 499) {
+      g_counting = false;
+      r->trace().drain(sink);
+      g_counting = true;
+    }
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0u);
+  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "the Td controller drilled";
+  EXPECT_GT(r->variables().read("drill.arc.swept_rad").value(), 1.0) << "the arc moved";
+}
+
 TEST(Allocations, TheCounterSeesAllocations) {
   // Guards the guard: the replaced operator new really counts.
   g_allocations = 0;

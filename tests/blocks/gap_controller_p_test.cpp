@@ -19,7 +19,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // kg 0.1 mm/s per µs, Tdr 10 µs, feed ≤ 0.5 mm/s down, ≤ 2 mm/s up, retract
 // at 1.5 mm/s.
 constexpr GapControllerPParams kParams{.kg = 0.1,
-                                       .tdr_us = 10.0,
+                                       .tdr_default_us = 10.0,
                                        .v_feed_max_mm_s = 0.5,
                                        .v_retract_max_mm_s = 2.0,
                                        .retract_speed_mm_s = 1.5,
@@ -209,7 +209,7 @@ TEST(GapControllerPParamsTest, validate_refuses_bad_values) {
   };
   EXPECT_FALSE(with([](auto& p) { p.kg = 0.0; }).empty());
   EXPECT_FALSE(with([](auto& p) { p.kg = -0.1; }).empty());
-  EXPECT_FALSE(with([](auto& p) { p.tdr_us = 0.0; }).empty());
+  EXPECT_FALSE(with([](auto& p) { p.tdr_default_us = 0.0; }).empty());
   EXPECT_FALSE(with([](auto& p) { p.v_feed_max_mm_s = 0.0; }).empty());
   EXPECT_FALSE(with([](auto& p) { p.v_retract_max_mm_s = -1.0; }).empty());
   EXPECT_FALSE(with([](auto& p) { p.retract_speed_mm_s = 0.0; }).empty());

@@ -6,7 +6,7 @@
 // Z is positive upward and the electrode drills downward: a gap that is too large (Td > Tdr)
 // gives Vz < 0 (feed down into the work), a gap that is too small (Td < Tdr) gives Vz > 0 (back
 // off). Tdr is the input tdr_us when it is > 0 (the active condition sets it), else the
-// parameter tdr_us (an unwired input reads 0).
+// parameter tdr_default_us (an unwired input reads 0).
 //
 // Commands, highest precedence first:
 //   retract         Vz = +retract_speed_mm_s                    (whatever enable/hold say)
@@ -30,7 +30,7 @@ namespace edm::blocks {
 
 struct GapControllerPParams {
   double kg{0.05};                 // [mm/s per µs] > 0
-  double tdr_us{8.0};              // [µs] > 0, used while the tdr_us input is 0 (unwired)
+  double tdr_default_us{8.0};      // [µs] > 0, used while the tdr_us input is 0 (unwired)
   double v_feed_max_mm_s{1.0};     // [mm/s] > 0, largest downward speed (Vz ≥ −this)
   double v_retract_max_mm_s{5.0};  // [mm/s] > 0, largest upward speed (Vz ≤ +this)
   double retract_speed_mm_s{2.0};  // [mm/s] in (0, v_retract_max_mm_s], Vz while retract
@@ -38,7 +38,8 @@ struct GapControllerPParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("kg", kg, "mm/s/us", "gain: Vz per microsecond of Td error (> 0)");
-    v.param("tdr_us", tdr_us, "us", "reference ignition delay while the tdr_us input is 0 (> 0)");
+    v.param("tdr_default_us", tdr_default_us, "us",
+            "reference ignition delay while the tdr_us input is 0 (> 0)");
     v.param("v_feed_max_mm_s", v_feed_max_mm_s, "mm/s", "largest downward speed (> 0)");
     v.param("v_retract_max_mm_s", v_retract_max_mm_s, "mm/s", "largest upward speed (> 0)");
     v.param("retract_speed_mm_s", retract_speed_mm_s, "mm/s",
