@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "edm/blocks/register.hpp"
+#include "edm/programs/register.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/log.hpp"
 #include "edm/runtime/loopback_driver.hpp"
@@ -159,6 +160,7 @@ int main(int argc, char** argv) {
 
   edm::rt::BlockRegistry blocks;
   edm::blocks::register_builtin_blocks(blocks);
+  edm::programs::register_builtin_programs(blocks);
   edm::rt::DriverRegistry drivers;
   edm::rt::register_runtime_drivers(drivers);
   edm::sim::register_sim_driver(drivers);

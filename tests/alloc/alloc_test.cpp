@@ -8,6 +8,7 @@
 #include <new>
 #include <sstream>
 
+#include "edm/programs/register.hpp"
 #include "edm/sim/sim_driver.hpp"
 #include "support/runtime_fixture.hpp"
 
@@ -260,6 +261,38 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
   EXPECT_EQ(g_allocations.load(), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "the Td controller drilled";
   EXPECT_GT(r->variables().read("drill.arc.swept_rad").value(), 1.0) << "the arc moved";
+}
+
+TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
+  // The whole drill program of config/machines/drill-sim-program.yaml: approach, touch, drilling
+  // with wear compensation, on the simulated machine.
+  rt::BlockRegistry blocks;
+  blocks::register_builtin_blocks(blocks);
+  programs::register_builtin_programs(blocks);
+  rt::DriverRegistry drivers;
+  sim::register_sim_driver(drivers);
+  auto r = rt::Runtime::build(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
+                                                    "/config/machines/drill-sim-program.yaml"),
+                              blocks, drivers);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  std::ostringstream sink;
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 5000; ++k) {
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 1000 == 999) {
+      g_counting = false;
+      r->trace().drain(sink);
+      g_counting = true;
+    }
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0u);
+  EXPECT_EQ(r->variables().read("cycle.drill.state"), 2.0) << "drilling after 5 s";
 }
 
 TEST(Allocations, TheCounterSeesAllocations) {

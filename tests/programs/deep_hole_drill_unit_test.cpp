@@ -1,0 +1,233 @@
+// DeepHoleDrill sequence on synthetic inputs: touch detection, retract at depth, safe state.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <string>
+
+#include "edm/programs/deep_hole_drill.hpp"
+#include "edm/programs/register.hpp"
+
+namespace edm::test {
+namespace {
+
+using namespace std::chrono_literals;
+using programs::DeepHoleDrill;
+
+// Drives the composite's own inputs from cells and reads its outputs.
+struct Rig {
+  DeepHoleDrill drill;
+  rt::Output<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  rt::Output<double> z_mm;
+  rt::Output<bool> start, comp{true};
+  std::map<std::string, rt::PinRef> pins;
+  rt::CycleContext ctx;
+
+  explicit Rig(const programs::DeepHoleDrillParams& p) {
+    drill.set_params(p);
+    EXPECT_TRUE(drill.validate().empty());
+    EXPECT_TRUE(drill.configure({"cycle.drill", 1ms}).empty());
+    struct Collect final : rt::PinVisitor {
+      std::map<std::string, rt::PinRef>* out;
+      void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
+        (*out)[std::string(n)] = r;
+      }
+    } c;
+    c.out = &pins;
+    drill.visit_pins(c);
+    in<std::int64_t>("td_sum_ns").connect(td_sum_ns);
+    in<std::int64_t>("td_count").connect(td_count);
+    in<std::int64_t>("n_open").connect(n_open);
+    in<std::int64_t>("n_short").connect(n_short);
+    in<double>("z_mm").connect(z_mm);
+    in<bool>("start").connect(start);
+    in<bool>("enable_wear_comp").connect(comp);
+    drill.activate();
+    ctx.period = 1ms;
+    ctx.dt_s = 0.001;
+  }
+  template <class T>
+  rt::Input<T>& in(const std::string& n) {
+    return *pins.at(n).as_input<T>();
+  }
+  template <class T>
+  T out(const std::string& n) {
+    return pins.at(n).as_output<T>()->get();
+  }
+  std::int64_t state() { return out<std::int64_t>("state"); }
+  double vz() { return out<double>("vz_cmd_mm_s"); }
+  bool gen() { return out<bool>("gen_on"); }
+  void sparks(std::int64_t n, double td_us) {
+    td_count.set(n);
+    td_sum_ns.set(static_cast<std::int64_t>(static_cast<double>(n) * td_us * 1000.0));
+  }
+  void step() {
+    drill.update(ctx);
+    ++ctx.cycle;
+  }
+};
+
+programs::DeepHoleDrillParams params() {
+  programs::DeepHoleDrillParams p;
+  p.depth_default_mm = 2.0;
+  p.touch_cycles = 3;
+  p.clearance_mm = 1.0;
+  return p;
+}
+
+TEST(DeepHoleDrill, RegisteredAsAProgramType) {
+  rt::BlockRegistry r;
+  programs::register_builtin_programs(r);
+  EXPECT_NE(r.create("DeepHoleDrill"), nullptr);
+}
+
+TEST(DeepHoleDrill, IdleUntilARisingStartThenApproachesWithTheGeneratorOn) {
+  Rig r(params());
+  r.step();
+  EXPECT_EQ(r.state(), 0);
+  EXPECT_FALSE(r.gen());
+  EXPECT_EQ(r.vz(), 0.0);
+  r.start.set(true);
+  r.step();
+  EXPECT_EQ(r.state(), 1);
+  EXPECT_TRUE(r.gen());
+  EXPECT_DOUBLE_EQ(r.vz(), -0.5);
+}
+
+TEST(DeepHoleDrill, TouchNeedsTouchCyclesConsecutiveCyclesWithSparks) {
+  Rig r(params());
+  r.start.set(true);
+  r.z_mm.set(0.1);
+  r.step();  // APPROACH
+  r.sparks(5, 8.0);
+  r.step();
+  r.step();
+  r.sparks(0, 0.0);  // a lone pair of sparks is not a touch
+  r.step();
+  EXPECT_EQ(r.state(), 1);
+  r.sparks(5, 8.0);
+  r.step();
+  r.step();
+  EXPECT_EQ(r.state(), 1);
+  r.z_mm.set(0.03);
+  r.step();  // third consecutive cycle
+  EXPECT_EQ(r.state(), 2);
+  EXPECT_DOUBLE_EQ(r.out<double>("touch_z_mm"), 0.03);
+  EXPECT_TRUE(r.gen());
+}
+
+TEST(DeepHoleDrill, DrillsOnTdThenRetractsAtDepthAndEndsDone) {
+  auto p = params();
+  Rig r(p);
+  r.comp.set(false);  // depth = touch_z − z exactly
+  r.start.set(true);
+  r.z_mm.set(0.0);
+  r.sparks(20, 12.0);  // Td > Tdr (8 µs): the gap is too large → feed down
+  for (int k = 0; k < 4; ++k) r.step();
+  ASSERT_EQ(r.state(), 2);
+  r.step();
+  EXPECT_LT(r.vz(), 0.0);
+  EXPECT_NEAR(r.vz(), -0.05 * (12.0 - 8.0), 1e-9);  // Kg·(Tdr − Td)
+  r.sparks(20, 4.0);                                // too small → back off
+  for (int k = 0; k < 10; ++k) r.step();
+  EXPECT_NEAR(r.vz(), +0.05 * 4.0, 1e-9);
+  r.z_mm.set(-1.999);
+  r.step();
+  EXPECT_EQ(r.state(), 2);
+  EXPECT_NEAR(r.out<double>("depth_reached_mm"), 1.999, 1e-12);
+  r.z_mm.set(-2.0);
+  r.step();
+  EXPECT_EQ(r.state(), 3);
+  EXPECT_FALSE(r.gen());
+  EXPECT_DOUBLE_EQ(r.vz(), 5.0);
+  r.z_mm.set(0.5);
+  r.step();
+  EXPECT_EQ(r.state(), 3);  // back to touch_z + clearance = 1.0
+  r.z_mm.set(1.0);
+  r.step();
+  EXPECT_EQ(r.state(), 4);
+  EXPECT_TRUE(r.out<bool>("done"));
+  EXPECT_EQ(r.vz(), 0.0);
+  EXPECT_FALSE(r.gen());
+  r.step();  // start still true: no new edge, stays DONE
+  EXPECT_EQ(r.state(), 4);
+}
+
+TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
+  Rig r(params());
+  r.start.set(true);
+  r.sparks(20, 12.0);
+  for (int k = 0; k < 20; ++k) r.step();
+  ASSERT_EQ(r.state(), 2);
+  const double vz_in = -0.05 * 4.0;
+  const double area = (1.1 * 1.1) / (1.0 - 0.09);
+  EXPECT_NEAR(r.vz(), vz_in - 0.6 * area * 0.2, 1e-9);  // vz_in − Vd
+  r.z_mm.set(-2.0);
+  r.step();
+  EXPECT_EQ(r.state(), 2) << "wear makes the front shallower than the axis";
+  EXPECT_LT(r.out<double>("depth_reached_mm"), 2.0);
+  EXPECT_GT(r.out<double>("depth_reached_mm"), 1.95);
+}
+
+TEST(DeepHoleDrill, SafeStateTurnsTheGeneratorOffAndBacksZOffWithoutFinishing) {
+  Rig r(params());
+  r.start.set(true);
+  r.sparks(20, 12.0);
+  for (int k = 0; k < 10; ++k) r.step();
+  ASSERT_EQ(r.state(), 2);
+  r.z_mm.set(-0.5);
+  r.drill.enter_safe_state({rt::MachineState::kFault, rt::AlarmCode::kNone});
+  EXPECT_FALSE(r.gen());
+  EXPECT_EQ(r.state(), 3);
+  EXPECT_DOUBLE_EQ(r.vz(), 5.0);
+  r.ctx.state = rt::MachineState::kFault;
+  r.step();
+  EXPECT_EQ(r.state(), 3);
+  EXPECT_FALSE(r.gen());
+  EXPECT_DOUBLE_EQ(r.vz(), 5.0);
+  r.z_mm.set(1.0);  // touch_z (0) + clearance
+  r.step();
+  EXPECT_EQ(r.state(), 0) << "an aborted hole is not DONE";
+  EXPECT_FALSE(r.out<bool>("done"));
+  EXPECT_EQ(r.vz(), 0.0);
+  r.start.set(false);
+  r.step();
+  r.start.set(true);
+  r.step();
+  EXPECT_EQ(r.state(), 0) << "start is ignored in a safe state";
+  r.ctx.state = rt::MachineState::kReady;
+  r.start.set(false);
+  r.step();
+  r.start.set(true);
+  r.step();
+  EXPECT_EQ(r.state(), 1);
+}
+
+TEST(DeepHoleDrill, SafeStateDuringApproachBacksOffByTheClearance) {
+  Rig r(params());
+  r.start.set(true);
+  r.z_mm.set(0.2);
+  r.step();
+  ASSERT_EQ(r.state(), 1);
+  r.drill.enter_safe_state({rt::MachineState::kEstop, rt::AlarmCode::kNone});
+  EXPECT_EQ(r.state(), 3);
+  EXPECT_FALSE(r.gen());
+  r.ctx.state = rt::MachineState::kEstop;
+  r.z_mm.set(1.2);
+  r.step();
+  EXPECT_EQ(r.state(), 0);
+}
+
+TEST(DeepHoleDrill, BadParametersAreRefused) {
+  auto p = params();
+  p.depth_default_mm = 0.0;
+  p.touch_cycles = 0;
+  p.approach_speed_mm_s = 2.0;
+  DeepHoleDrill d;
+  d.set_params(p);
+  EXPECT_EQ(d.validate().size(), 3u);
+}
+
+}  // namespace
+}  // namespace edm::test
