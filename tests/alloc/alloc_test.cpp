@@ -295,6 +295,35 @@ TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
   EXPECT_EQ(r->variables().read("cycle.drill.state"), 2.0) << "drilling after 5 s";
 }
 
+TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
+  rt::BlockRegistry blocks;
+  blocks::register_builtin_blocks(blocks);
+  programs::register_builtin_programs(blocks);
+  rt::DriverRegistry drivers;
+  sim::register_sim_driver(drivers);
+  auto r = rt::Runtime::build(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
+                                                    "/config/machines/finish-sim-program.yaml"),
+                              blocks, drivers);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  std::ostringstream sink;
+  g_allocations = 0;
+  g_counting = true;
+  for (int k = 0; k < 5000; ++k) {  // polarity switch, then orbiting
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 1000 == 999) {
+      g_counting = false;
+      r->trace().drain(sink);
+      g_counting = true;
+    }
+  }
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0u);
+}
+
 TEST(Allocations, TheCounterSeesAllocations) {
   // Guards the guard: the replaced operator new really counts.
   g_allocations = 0;

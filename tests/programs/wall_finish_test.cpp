@@ -1,0 +1,239 @@
+// WallFinish sequence on a synthetic plant (x, y integrate the velocity
+// commands): polarity switch before the generator, orbit radius growth per
+// revolution (eq. 20–21) up to exactly the final offset, return to the centre,
+// safe state.
+
+#include "edm/programs/wall_finish.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "edm/programs/register.hpp"
+
+namespace edm::test {
+namespace {
+
+using namespace std::chrono_literals;
+using programs::WallFinish;
+
+struct Rig {
+  WallFinish wf;
+  rt::Output<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  rt::Output<double> x_mm, y_mm, start_offset, final_offset;
+  rt::Output<bool> start;
+  std::map<std::string, rt::PinRef> pins;
+  rt::CycleContext ctx;
+
+  explicit Rig(const programs::WallFinishParams& p) {
+    wf.set_params(p);
+    EXPECT_TRUE(wf.validate().empty());
+    EXPECT_TRUE(wf.configure({"cycle.finish", 1ms}).empty());
+    struct Collect final : rt::PinVisitor {
+      std::map<std::string, rt::PinRef>* out;
+      void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
+        (*out)[std::string(n)] = r;
+      }
+    } c;
+    c.out = &pins;
+    wf.visit_pins(c);
+    in<std::int64_t>("td_sum_ns").connect(td_sum_ns);
+    in<std::int64_t>("td_count").connect(td_count);
+    in<std::int64_t>("n_open").connect(n_open);
+    in<std::int64_t>("n_short").connect(n_short);
+    in<double>("x_mm").connect(x_mm);
+    in<double>("y_mm").connect(y_mm);
+    in<double>("start_offset_mm").connect(start_offset);
+    in<double>("final_offset_mm").connect(final_offset);
+    in<bool>("start").connect(start);
+    wf.activate();
+    ctx.period = 1ms;
+    ctx.dt_s = 0.001;
+    x_mm.set(3.0);
+    y_mm.set(-2.0);
+  }
+  template <class T>
+  rt::Input<T>& in(const std::string& n) {
+    return *pins.at(n).as_input<T>();
+  }
+  template <class T>
+  T out(const std::string& n) {
+    return pins.at(n).as_output<T>()->get();
+  }
+  std::int64_t state() { return out<std::int64_t>("state"); }
+  bool gen() { return out<bool>("gen_on"); }
+  bool positive() { return out<bool>("polarity_positive"); }
+  double offset() { return out<double>("offset_mm"); }
+  double r() { return std::hypot(x_mm.get() - 3.0, y_mm.get() + 2.0); }
+  // Sparks at a constant Td while the generator is on.
+  void step(double td_us = 10.0) {
+    if (gen()) {
+      td_count.set(10);
+      td_sum_ns.set(static_cast<std::int64_t>(10.0 * td_us * 1000.0));
+    } else {
+      td_count.set(0);
+      td_sum_ns.set(0);
+    }
+    wf.update(ctx);
+    x_mm.set(x_mm.get() + out<double>("vx_cmd_mm_s") * ctx.dt_s);
+    y_mm.set(y_mm.get() + out<double>("vy_cmd_mm_s") * ctx.dt_s);
+    ++ctx.cycle;
+    ctx.release += 1ms;
+  }
+};
+
+programs::WallFinishParams params() {
+  programs::WallFinishParams p;
+  p.orbit_period_s = 0.2;
+  p.radial_speed_mm_s = 0.05;
+  p.kr = 1e-4;  // Td = 10 µs → Δr = 1 µm per revolution
+  p.dr_max_mm = 0.005;
+  p.spark_out_revs = 2;
+  return p;
+}
+
+TEST(WallFinish, RegisteredAsAProgramType) {
+  rt::BlockRegistry r;
+  programs::register_builtin_programs(r);
+  EXPECT_NE(r.create("WallFinish"), nullptr);
+}
+
+TEST(WallFinish, RejectsBadParameters) {
+  programs::WallFinishParams p = params();
+  p.orbit_period_s = 0.0;
+  p.spark_out_revs = -1;
+  p.settle = rt::Duration::zero();
+  EXPECT_EQ(p.validate().size(), 3u);
+}
+
+TEST(WallFinish, FullCyclePolarityThenGrowingOrbitThenBackToCentre) {
+  Rig rig(params());
+  rig.final_offset.set(0.0105);  // not a multiple of Δr: the last step is cut to land on it
+  for (int k = 0; k < 50; ++k) rig.step();
+  EXPECT_EQ(rig.state(), 0);
+  EXPECT_FALSE(rig.gen());
+  EXPECT_FALSE(rig.positive());
+  rig.start.set(true);
+
+  bool saw_polarity_state = false;
+  std::int64_t switch_cycle = -1;
+  std::int64_t first_gen_cycle = -1;
+  std::vector<double> offsets;  // orbit offset after each revolution
+  std::int64_t revs = 0;
+  double max_r_err = 0.0;  // |r − offset| while orbiting on radius
+  std::int64_t k = 0;
+  for (; k < 40000 && rig.state() != 4; ++k) {
+    const bool was_positive = rig.positive();
+    rig.step();
+    if (rig.state() == 1) saw_polarity_state = true;
+    if (!was_positive && rig.positive()) switch_cycle = k;
+    if (rig.gen() && first_gen_cycle < 0) first_gen_cycle = k;
+    if (rig.gen()) {
+      ASSERT_TRUE(rig.positive()) << "generator on with negative polarity at cycle " << k;
+    }
+    const auto revs_now = rig.out<std::int64_t>("revolutions");
+    if (revs_now != revs) {
+      revs = revs_now;
+      offsets.push_back(rig.offset());
+    }
+    if (rig.state() == 2 && rig.out<double>("rho_mm") == rig.offset() && revs >= 1) {
+      max_r_err = std::max(max_r_err, std::abs(rig.r() - rig.offset()));
+    }
+  }
+  ASSERT_EQ(rig.state(), 4) << "not DONE";
+  EXPECT_TRUE(rig.out<bool>("done"));
+  EXPECT_TRUE(saw_polarity_state);
+  ASSERT_GE(switch_cycle, 0);
+  ASSERT_GE(first_gen_cycle, 0);
+  // The polarity switched first, and the generator stayed off for the settle
+  // time (20 ms).
+  EXPECT_GE(first_gen_cycle - switch_cycle, 20);
+
+  // Eq. 20–21: +1 µm per revolution (kr·Tdm = 1e-4 · 10), the last step cut to
+  // 0.5 µm, then spark_out_revs revolutions at the final offset.
+  ASSERT_GE(offsets.size(), 13u);
+  for (std::size_t i = 0; i < 10; ++i) {
+    EXPECT_NEAR(offsets[i], 0.001 * static_cast<double>(i + 1), 1e-12) << i;
+  }
+  EXPECT_EQ(offsets[10], 0.0105);  // exactly the final offset
+  EXPECT_EQ(offsets.size(), 13u);  // 11 growth revolutions + 2 spark-out
+  EXPECT_EQ(offsets[11], 0.0105);
+  EXPECT_EQ(offsets[12], 0.0105);
+  EXPECT_EQ(rig.offset(), 0.0105);
+  std::printf("[wall_finish] max |r - offset| while orbiting: %.3f um\n", max_r_err * 1e3);
+  EXPECT_LT(max_r_err, 0.001);
+
+  // Back at the centre, generator off, axes stopped, polarity stays positive.
+  EXPECT_LE(rig.r(), 0.002);
+  EXPECT_FALSE(rig.gen());
+  EXPECT_TRUE(rig.positive());
+  EXPECT_EQ(rig.out<double>("vx_cmd_mm_s"), 0.0);
+  EXPECT_EQ(rig.out<double>("vy_cmd_mm_s"), 0.0);
+  for (int i = 0; i < 100; ++i) rig.step();
+  EXPECT_EQ(rig.state(), 4);
+}
+
+TEST(WallFinish, GrowthPerRevolutionIsClampedToDrMax) {
+  Rig rig(params());
+  rig.final_offset.set(0.012);
+  rig.start.set(true);
+  std::vector<double> offsets;
+  std::int64_t revs = 0;
+  for (int k = 0; k < 20000 && rig.state() != 4; ++k) {
+    rig.step(100.0);  // kr·Tdm = 10 µm > dr_max = 5 µm
+    const auto revs_now = rig.out<std::int64_t>("revolutions");
+    if (revs_now != revs) {
+      revs = revs_now;
+      offsets.push_back(rig.offset());
+    }
+  }
+  ASSERT_EQ(rig.state(), 4);
+  ASSERT_GE(offsets.size(), 3u);
+  EXPECT_NEAR(offsets[0], 0.005, 1e-12);
+  EXPECT_NEAR(offsets[1], 0.010, 1e-12);
+  EXPECT_EQ(offsets[2], 0.012);
+}
+
+TEST(WallFinish, StartOffsetIsTheFirstOrbitRadius) {
+  Rig rig(params());
+  rig.start_offset.set(0.02);
+  rig.final_offset.set(0.022);
+  rig.start.set(true);
+  double first_offset = -1.0;
+  for (int k = 0; k < 20000 && rig.state() != 4; ++k) {
+    rig.step();
+    if (rig.state() == 2 && first_offset < 0.0) first_offset = rig.offset();
+  }
+  ASSERT_EQ(rig.state(), 4);
+  EXPECT_EQ(first_offset, 0.02);
+  EXPECT_EQ(rig.offset(), 0.022);
+}
+
+TEST(WallFinish, SafeStateStopsAtOnceAndIgnoresStart) {
+  Rig rig(params());
+  rig.final_offset.set(0.05);
+  rig.start.set(true);
+  for (int k = 0; k < 1000; ++k) rig.step();
+  ASSERT_EQ(rig.state(), 2);
+  ASSERT_TRUE(rig.gen());
+  rig.wf.enter_safe_state(rt::SafeStateRequest{});
+  EXPECT_FALSE(rig.gen());
+  EXPECT_EQ(rig.out<double>("vx_cmd_mm_s"), 0.0);
+  EXPECT_EQ(rig.out<double>("vy_cmd_mm_s"), 0.0);
+  EXPECT_EQ(rig.state(), 0);
+  rig.ctx.state = rt::MachineState::kFault;
+  rig.start.set(false);
+  rig.step();
+  rig.start.set(true);
+  for (int k = 0; k < 100; ++k) rig.step();
+  EXPECT_EQ(rig.state(), 0);
+  EXPECT_FALSE(rig.gen());
+  EXPECT_FALSE(rig.out<bool>("done"));
+}
+
+}  // namespace
+}  // namespace edm::test
