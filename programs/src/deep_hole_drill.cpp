@@ -18,70 +18,6 @@ constexpr std::size_t kTdWindowIndex = 10;
 // is also the gap child's idle feed, which must not exceed it.
 constexpr double kMaxApproachSpeed = blocks::GapControllerPParams{}.v_feed_max_mm_s;
 
-rt::BlockStatus worst(rt::BlockStatus a, rt::BlockStatus b) noexcept {
-  if (a == rt::BlockStatus::kFault || b == rt::BlockStatus::kFault) {
-    return rt::BlockStatus::kFault;
-  }
-  if (a == rt::BlockStatus::kSaturated || b == rt::BlockStatus::kSaturated) {
-    return rt::BlockStatus::kSaturated;
-  }
-  return rt::BlockStatus::kOk;
-}
-
-// Finds one pin of a child by name and type (load time only).
-template <class T, bool kInput>
-auto* find_pin(rt::Block& b, std::string_view name) {
-  struct Find final : rt::PinVisitor {
-    std::string_view want;
-    rt::PinRef ref{};
-    bool found{false};
-    void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
-      if (n == want) {
-        ref = r;
-        found = true;
-      }
-    }
-  } f;
-  f.want = name;
-  b.visit_pins(f);
-  if constexpr (kInput) {
-    return f.found ? f.ref.template as_input<T>() : nullptr;
-  } else {
-    return f.found ? f.ref.template as_output<T>() : nullptr;
-  }
-}
-
-template <class T>
-void wire(std::vector<rt::ParamError>& errs, rt::Block& child, std::string_view child_name,
-          std::string_view pin, const rt::Output<T>& source) {
-  rt::Input<T>* in = find_pin<T, true>(child, pin);
-  if (in == nullptr) {
-    errs.push_back(
-        {std::string(child_name) + "." + std::string(pin), "internal wire: no such input"});
-    return;
-  }
-  in->connect(source);
-}
-
-template <class T>
-const rt::Output<T>* output_of(std::vector<rt::ParamError>& errs, rt::Block& child,
-                               std::string_view child_name, std::string_view pin) {
-  const rt::Output<T>* out = find_pin<T, false>(child, pin);
-  if (out == nullptr) {
-    errs.push_back(
-        {std::string(child_name) + "." + std::string(pin), "internal wire: no such output"});
-  }
-  return out;
-}
-
-void append(std::vector<rt::ParamError>& errs, std::string_view child,
-            std::vector<rt::ParamError> more) {
-  for (rt::ParamError& e : more) {
-    errs.push_back({e.field.empty() ? std::string(child) : std::string(child) + "." + e.field,
-                    std::move(e.message)});
-  }
-}
-
 }  // namespace
 
 void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
@@ -161,42 +97,42 @@ std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& 
   blocks::TdDetectorParams tp = td_.params();
   tp.window = params_.td_window;
   td_.set_params(tp);
-  append(errs, "td", td_.validate());
-  append(errs, "td", td_.configure(setup));
+  append_child_errors(errs, "td", td_.validate());
+  append_child_errors(errs, "td", td_.configure(setup));
 
   params_changed();  // gap: kg, tdr_us, idle feed
-  append(errs, "gap", gap_.validate());
-  append(errs, "gap", gap_.configure(setup));
+  append_child_errors(errs, "gap", gap_.validate());
+  append_child_errors(errs, "gap", gap_.configure(setup));
 
   blocks::WearCompensatorParams wp = wear_.params();
   wp.hole_area_mm2 = params_.hole_area_mm2;
   wp.electrode_area_mm2 = params_.electrode_area_mm2;
   wear_.set_params(wp);
-  append(errs, "wear", wear_.validate());
-  append(errs, "wear", wear_.configure(setup));
+  append_child_errors(errs, "wear", wear_.validate());
+  append_child_errors(errs, "wear", wear_.configure(setup));
 
   // Internal wires, resolved once.
-  wire(errs, td_, "td", "td_sum_ns", c_td_sum_ns_);
-  wire(errs, td_, "td", "td_count", c_td_count_);
-  wire(errs, td_, "td", "n_open", c_n_open_);
-  wire(errs, td_, "td", "n_short", c_n_short_);
-  const rt::Output<double>* td_us = output_of<double>(errs, td_, "td", "td_us");
-  const rt::Output<bool>* td_valid = output_of<bool>(errs, td_, "td", "valid");
+  wire_child(errs, td_, "td", "td_sum_ns", c_td_sum_ns_);
+  wire_child(errs, td_, "td", "td_count", c_td_count_);
+  wire_child(errs, td_, "td", "n_open", c_n_open_);
+  wire_child(errs, td_, "td", "n_short", c_n_short_);
+  const rt::Output<double>* td_us = child_output<double>(errs, td_, "td", "td_us");
+  const rt::Output<bool>* td_valid = child_output<bool>(errs, td_, "td", "valid");
   if (td_us != nullptr) {
-    wire(errs, gap_, "gap", "td_us", *td_us);
+    wire_child(errs, gap_, "gap", "td_us", *td_us);
   }
   if (td_valid != nullptr) {
-    wire(errs, gap_, "gap", "valid", *td_valid);
+    wire_child(errs, gap_, "gap", "valid", *td_valid);
   }
-  gap_vz_ = output_of<double>(errs, gap_, "gap", "vz_mm_s");
+  gap_vz_ = child_output<double>(errs, gap_, "gap", "vz_mm_s");
   if (gap_vz_ != nullptr) {
-    wire(errs, wear_, "wear", "vz_in_mm_s", *gap_vz_);
+    wire_child(errs, wear_, "wear", "vz_in_mm_s", *gap_vz_);
   }
-  wire(errs, wear_, "wear", "wear_ratio", c_wear_ratio_);
-  wire(errs, wear_, "wear", "enable", c_wear_enable_);
-  wire(errs, wear_, "wear", "reset_wear", c_reset_wear_);
-  wear_vz_ = output_of<double>(errs, wear_, "wear", "vz_out_mm_s");
-  wear_mm_ = output_of<double>(errs, wear_, "wear", "wear_mm");
+  wire_child(errs, wear_, "wear", "wear_ratio", c_wear_ratio_);
+  wire_child(errs, wear_, "wear", "enable", c_wear_enable_);
+  wire_child(errs, wear_, "wear", "reset_wear", c_reset_wear_);
+  wear_vz_ = child_output<double>(errs, wear_, "wear", "vz_out_mm_s");
+  wear_mm_ = child_output<double>(errs, wear_, "wear", "wear_mm");
   return errs;
 }
 
@@ -298,7 +234,7 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
 
   bool td_stepped = false;
   if (state_value_ == State::kApproach) {
-    status = worst(status, td_.update(ctx));  // fills the Td window before the gap loop starts
+    status = rt::worst(status, td_.update(ctx));  // fills the Td window before the gap loop starts
     td_stepped = true;
     spark_cycles_ = td_count_.get() > 0 ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
@@ -313,10 +249,10 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
 
   if (state_value_ == State::kDrill) {
     if (!td_stepped) {
-      status = worst(status, td_.update(ctx));
+      status = rt::worst(status, td_.update(ctx));
     }
-    status = worst(status, gap_.update(ctx));
-    status = worst(status, wear_.update(ctx));
+    status = rt::worst(status, gap_.update(ctx));
+    status = rt::worst(status, wear_.update(ctx));
     c_reset_wear_.set(false);
     // The electrode front is z − accumulated wear: the compensated axis travels further than the
     // front by the length the compensator has added for the wear, so the front (≈ the hole

@@ -18,70 +18,6 @@ constexpr std::size_t kTdWindowIndex = 10;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
-rt::BlockStatus worst(rt::BlockStatus a, rt::BlockStatus b) noexcept {
-  if (a == rt::BlockStatus::kFault || b == rt::BlockStatus::kFault) {
-    return rt::BlockStatus::kFault;
-  }
-  if (a == rt::BlockStatus::kSaturated || b == rt::BlockStatus::kSaturated) {
-    return rt::BlockStatus::kSaturated;
-  }
-  return rt::BlockStatus::kOk;
-}
-
-// Finds one pin of a child by name and type (load time only).
-template <class T, bool kInput>
-auto* find_pin(rt::Block& b, std::string_view name) {
-  struct Find final : rt::PinVisitor {
-    std::string_view want;
-    rt::PinRef ref{};
-    bool found{false};
-    void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
-      if (n == want) {
-        ref = r;
-        found = true;
-      }
-    }
-  } f;
-  f.want = name;
-  b.visit_pins(f);
-  if constexpr (kInput) {
-    return f.found ? f.ref.template as_input<T>() : nullptr;
-  } else {
-    return f.found ? f.ref.template as_output<T>() : nullptr;
-  }
-}
-
-template <class T>
-void wire(std::vector<rt::ParamError>& errs, rt::Block& child, std::string_view child_name,
-          std::string_view pin, const rt::Output<T>& source) {
-  rt::Input<T>* in = find_pin<T, true>(child, pin);
-  if (in == nullptr) {
-    errs.push_back(
-        {std::string(child_name) + "." + std::string(pin), "internal wire: no such input"});
-    return;
-  }
-  in->connect(source);
-}
-
-template <class T>
-const rt::Output<T>* output_of(std::vector<rt::ParamError>& errs, rt::Block& child,
-                               std::string_view child_name, std::string_view pin) {
-  const rt::Output<T>* out = find_pin<T, false>(child, pin);
-  if (out == nullptr) {
-    errs.push_back(
-        {std::string(child_name) + "." + std::string(pin), "internal wire: no such output"});
-  }
-  return out;
-}
-
-void append(std::vector<rt::ParamError>& errs, std::string_view child,
-            std::vector<rt::ParamError> more) {
-  for (rt::ParamError& e : more) {
-    errs.push_back({e.field.empty() ? std::string(child) : std::string(child) + "." + e.field,
-                    std::move(e.message)});
-  }
-}
-
 template <class T>
 T get_or(const rt::Output<T>* p, T fallback) noexcept {
   return p != nullptr ? p->get() : fallback;
@@ -167,62 +103,62 @@ std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& set
   pp.settle = params_.settle;
   pp.initial_positive = false;
   pol_.set_params(pp);
-  append(errs, "pol", pol_.validate());
-  append(errs, "pol", pol_.configure(setup));
+  append_child_errors(errs, "pol", pol_.validate());
+  append_child_errors(errs, "pol", pol_.configure(setup));
 
   blocks::TdDetectorParams tp = td_.params();
   tp.window = params_.td_window;
   td_.set_params(tp);
-  append(errs, "td", td_.validate());
-  append(errs, "td", td_.configure(setup));
+  append_child_errors(errs, "td", td_.validate());
+  append_child_errors(errs, "td", td_.configure(setup));
 
   params_changed();  // orbit: kr, dr_max; px/py: kv, v_max, f_err
-  append(errs, "orbit", orbit_.validate());
-  append(errs, "orbit", orbit_.configure(setup));
-  append(errs, "px", px_.validate());
-  append(errs, "px", px_.configure(setup));
-  append(errs, "py", py_.validate());
-  append(errs, "py", py_.configure(setup));
+  append_child_errors(errs, "orbit", orbit_.validate());
+  append_child_errors(errs, "orbit", orbit_.configure(setup));
+  append_child_errors(errs, "px", px_.validate());
+  append_child_errors(errs, "px", px_.configure(setup));
+  append_child_errors(errs, "py", py_.validate());
+  append_child_errors(errs, "py", py_.configure(setup));
 
   // Internal wires, resolved once.
-  wire(errs, pol_, "pol", "request_positive", c_pol_req_);
-  wire(errs, pol_, "pol", "generator_on_request", c_gen_req_);
-  pol_positive_ = output_of<bool>(errs, pol_, "pol", "polarity_positive");
-  pol_gen_ = output_of<bool>(errs, pol_, "pol", "generator_on");
-  pol_switching_ = output_of<bool>(errs, pol_, "pol", "switching");
+  wire_child(errs, pol_, "pol", "request_positive", c_pol_req_);
+  wire_child(errs, pol_, "pol", "generator_on_request", c_gen_req_);
+  pol_positive_ = child_output<bool>(errs, pol_, "pol", "polarity_positive");
+  pol_gen_ = child_output<bool>(errs, pol_, "pol", "generator_on");
+  pol_switching_ = child_output<bool>(errs, pol_, "pol", "switching");
 
-  wire(errs, td_, "td", "td_sum_ns", c_td_sum_ns_);
-  wire(errs, td_, "td", "td_count", c_td_count_);
-  wire(errs, td_, "td", "n_open", c_n_open_);
-  wire(errs, td_, "td", "n_short", c_n_short_);
-  const rt::Output<double>* td_us = output_of<double>(errs, td_, "td", "td_us");
-  const rt::Output<bool>* td_valid = output_of<bool>(errs, td_, "td", "valid");
+  wire_child(errs, td_, "td", "td_sum_ns", c_td_sum_ns_);
+  wire_child(errs, td_, "td", "td_count", c_td_count_);
+  wire_child(errs, td_, "td", "n_open", c_n_open_);
+  wire_child(errs, td_, "td", "n_short", c_n_short_);
+  const rt::Output<double>* td_us = child_output<double>(errs, td_, "td", "td_us");
+  const rt::Output<bool>* td_valid = child_output<bool>(errs, td_, "td", "valid");
 
-  wire(errs, orbit_, "orbit", "start", c_orbit_start_);
-  wire(errs, orbit_, "orbit", "r0_mm", c_r0_);
-  wire(errs, orbit_, "orbit", "final_radius_mm", c_final_);
-  wire(errs, orbit_, "orbit", "enable", c_orbit_enable_);
-  wire(errs, orbit_, "orbit", "rev_pulse", c_rev_pulse_);
+  wire_child(errs, orbit_, "orbit", "start", c_orbit_start_);
+  wire_child(errs, orbit_, "orbit", "r0_mm", c_r0_);
+  wire_child(errs, orbit_, "orbit", "final_radius_mm", c_final_);
+  wire_child(errs, orbit_, "orbit", "enable", c_orbit_enable_);
+  wire_child(errs, orbit_, "orbit", "rev_pulse", c_rev_pulse_);
   if (td_us != nullptr) {
-    wire(errs, orbit_, "orbit", "td_us", *td_us);
+    wire_child(errs, orbit_, "orbit", "td_us", *td_us);
   }
   if (td_valid != nullptr) {
-    wire(errs, orbit_, "orbit", "valid", *td_valid);
+    wire_child(errs, orbit_, "orbit", "valid", *td_valid);
   }
-  orbit_radius_ = output_of<double>(errs, orbit_, "orbit", "radius_mm");
-  orbit_done_ = output_of<bool>(errs, orbit_, "orbit", "done");
-  orbit_revs_ = output_of<std::int64_t>(errs, orbit_, "orbit", "revolutions");
+  orbit_radius_ = child_output<double>(errs, orbit_, "orbit", "radius_mm");
+  orbit_done_ = child_output<bool>(errs, orbit_, "orbit", "done");
+  orbit_revs_ = child_output<std::int64_t>(errs, orbit_, "orbit", "revolutions");
 
-  wire(errs, px_, "px", "x_ref_mm", c_xref_);
-  wire(errs, px_, "px", "v_ff_mm_s", c_vffx_);
-  wire(errs, px_, "px", "x_mm", c_x_);
-  wire(errs, px_, "px", "enable", c_loop_enable_);
-  wire(errs, py_, "py", "x_ref_mm", c_yref_);
-  wire(errs, py_, "py", "v_ff_mm_s", c_vffy_);
-  wire(errs, py_, "py", "x_mm", c_y_);
-  wire(errs, py_, "py", "enable", c_loop_enable_);
-  px_v_ = output_of<double>(errs, px_, "px", "v_cmd_mm_s");
-  py_v_ = output_of<double>(errs, py_, "py", "v_cmd_mm_s");
+  wire_child(errs, px_, "px", "x_ref_mm", c_xref_);
+  wire_child(errs, px_, "px", "v_ff_mm_s", c_vffx_);
+  wire_child(errs, px_, "px", "x_mm", c_x_);
+  wire_child(errs, px_, "px", "enable", c_loop_enable_);
+  wire_child(errs, py_, "py", "x_ref_mm", c_yref_);
+  wire_child(errs, py_, "py", "v_ff_mm_s", c_vffy_);
+  wire_child(errs, py_, "py", "x_mm", c_y_);
+  wire_child(errs, py_, "py", "enable", c_loop_enable_);
+  px_v_ = child_output<double>(errs, px_, "px", "v_cmd_mm_s");
+  py_v_ = child_output<double>(errs, py_, "py", "v_cmd_mm_s");
   return errs;
 }
 
@@ -336,7 +272,7 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
 
   // The polarity switch runs every cycle (it times the generator-off periods).
   c_gen_req_.set(state_value_ == State::kOrbit && !safe);
-  status = worst(status, pol_.update(ctx));
+  status = rt::worst(status, pol_.update(ctx));
   const bool positive = get_or(pol_positive_, false);
   polarity_positive_.set(positive);
 
@@ -350,7 +286,7 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
 
   double rho_target = 0.0;
   if (state_value_ == State::kOrbit) {
-    status = worst(status, td_.update(ctx));
+    status = rt::worst(status, td_.update(ctx));
     const double radius = get_or(orbit_radius_, 0.0);
     // Revolutions count (and Td is collected) only once the reference radius has reached the
     // orbit radius: the entry from the centre is not a machining revolution.
@@ -370,7 +306,7 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
         --spark_out_left_;
       }
     }
-    status = worst(status, orbit_.update(ctx));
+    status = rt::worst(status, orbit_.update(ctx));
     c_orbit_start_.set(false);
     if (!spark_out_ && get_or(orbit_done_, false) && get_or(orbit_radius_, 0.0) == rho_) {
       spark_out_ = true;  // the final radius is reached: spark out for spark_out_revs more
@@ -398,8 +334,8 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
     c_vffx_.set(vffx);
     c_vffy_.set(vffy);
     c_loop_enable_.set(true);
-    status = worst(status, px_.update(ctx));
-    status = worst(status, py_.update(ctx));
+    status = rt::worst(status, px_.update(ctx));
+    status = rt::worst(status, py_.update(ctx));
     vx_cmd_mm_s_.set(get_or(px_v_, 0.0));
     vy_cmd_mm_s_.set(get_or(py_v_, 0.0));
     rho_mm_.set(rho_);

@@ -21,6 +21,30 @@ class PrefixedPins final : public PinVisitor {
 
 }  // namespace
 
+PinRef CompositeBlock::find_pin(Block& block, std::string_view name) {
+  struct Find final : PinVisitor {
+    std::string_view want;
+    PinRef found{};
+    void on_pin(std::string_view n, PinRef r, std::string_view) override {
+      if (n == want) {
+        found = r;
+      }
+    }
+  } f;
+  f.want = name;
+  block.visit_pins(f);
+  return f.found;
+}
+
+void CompositeBlock::append_child_errors(std::vector<ParamError>& errs, std::string_view child_name,
+                                         std::vector<ParamError> more) {
+  for (ParamError& e : more) {
+    errs.push_back(
+        {e.field.empty() ? std::string(child_name) : std::string(child_name) + "." + e.field,
+         std::move(e.message)});
+  }
+}
+
 void CompositeBlock::visit_pins(PinVisitor& v) {
   visit_own_pins(v);
   for (Child& c : children_) {
@@ -32,12 +56,8 @@ void CompositeBlock::visit_pins(PinVisitor& v) {
 std::vector<ParamError> CompositeBlock::configure(const BlockSetup& setup) {
   std::vector<ParamError> errs;
   for (Child& c : children_) {
-    for (ParamError& e : c.block->validate()) {
-      errs.push_back({e.field.empty() ? c.name : c.name + "." + e.field, e.message});
-    }
-    for (ParamError& e : c.block->configure(setup)) {
-      errs.push_back({e.field.empty() ? c.name : c.name + "." + e.field, e.message});
-    }
+    append_child_errors(errs, c.name, c.block->validate());
+    append_child_errors(errs, c.name, c.block->configure(setup));
     c.block->commit_params();
   }
   for (ParamError& e : configure_self(setup)) {

@@ -145,33 +145,52 @@ TEST(Allocations, NoneInsideCyclesOfARealisticProgram) {
   EXPECT_GT(sink.str().size(), 2000u * 10);
 }
 
-TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
-  // The simulator runs inside the I/O task's input latch: pulses, axes, debris and sensors must
-  // not allocate either.
-  rt::DriverRegistry drivers;
-  rt::register_runtime_drivers(drivers);
-  sim::register_sim_driver(drivers);
-  rt::Config cfg =
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
-  auto r = rt::Runtime::build(cfg, registries().blocks, drivers);
+// Builds a config with the built-in blocks, the C++ PROGRAM types and the simulator driver.
+std::unique_ptr<rt::Runtime> build_sim_machine(const rt::Config& cfg) {
+  static const auto registries = [] {
+    std::pair<rt::BlockRegistry, rt::DriverRegistry> r;
+    blocks::register_builtin_blocks(r.first);
+    programs::register_builtin_programs(r.first);
+    sim::register_sim_driver(r.second);
+    return r;
+  }();
+  auto r = rt::Runtime::build(cfg, registries.first, registries.second);
   r->machine().command(rt::MachineCommand::kPowerOn);
+  return r;
+}
+
+std::unique_ptr<rt::Runtime> build_shipped(const std::string& machine) {
+  return build_sim_machine(
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/" + machine + ".yaml"));
+}
+
+// Runs `cycles` 1 ms cycles of the first task on a virtual clock and returns the allocations
+// made inside them; the trace is drained (non-RT work, not counted) every 500 cycles.
+std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
   rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
+  auto& task = *r.tasks()[0];
   std::ostringstream sink;
-  g_allocations = 0;
-  g_counting = true;
-  for (int k = 0; k < 3000; ++k) {  // 3 s of drilling, ~60 000 pulses
+  std::size_t total = 0;
+  for (int k = 0; k < cycles; ++k) {
     const rt::TimePoint release{1ms * k};
     clock.advance_to(release);
+    g_allocations = 0;
+    g_counting = true;
     task.run_cycle(release, clock);
-    if (k % 1000 == 999) {
-      g_counting = false;
-      r->trace().drain(sink);
-      g_counting = true;
+    g_counting = false;
+    total += g_allocations.load();
+    if (k % 500 == 499) {
+      r.trace().drain(sink);
     }
   }
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0u);
+  return total;
+}
+
+TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
+  // The simulator runs inside the I/O task's input latch: pulses, axes, debris and sensors must
+  // not allocate either. 3 s of drilling, ~60 000 pulses.
+  auto r = build_shipped("drill-sim");
+  EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.5) << "it really drilled";
 }
 
@@ -237,91 +256,22 @@ trace:
 )";
 
 TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
-  rt::DriverRegistry drivers;
-  sim::register_sim_driver(drivers);
-  auto r = rt::Runtime::build(rt::parse_config_text(kSeed004, "alloc-004.yaml"),
-                              registries().blocks, drivers);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  std::ostringstream sink;
-  g_allocations = 0;
-  g_counting = true;
-  for (int k = 0; k < 2000; ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 500 == 499) {
-      g_counting = false;
-      r->trace().drain(sink);
-      g_counting = true;
-    }
-  }
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0u);
+  auto r = build_sim_machine(rt::parse_config_text(kSeed004, "alloc-004.yaml"));
+  EXPECT_EQ(allocations_in_cycles(*r, 2000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "the Td controller drilled";
   EXPECT_GT(r->variables().read("drill.arc.swept_rad").value(), 1.0) << "the arc moved";
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
-  // The whole drill program of config/machines/drill-sim-program.yaml: approach, touch, drilling
-  // with wear compensation, on the simulated machine.
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  sim::register_sim_driver(drivers);
-  auto r = rt::Runtime::build(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
-                                                    "/config/machines/drill-sim-program.yaml"),
-                              blocks, drivers);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  std::ostringstream sink;
-  g_allocations = 0;
-  g_counting = true;
-  for (int k = 0; k < 5000; ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 1000 == 999) {
-      g_counting = false;
-      r->trace().drain(sink);
-      g_counting = true;
-    }
-  }
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0u);
+  // Approach, touch, drilling with wear compensation, on the simulated machine.
+  auto r = build_shipped("drill-sim-program");
+  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
   EXPECT_EQ(r->variables().read("cycle.drill.state"), 2.0) << "drilling after 5 s";
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  sim::register_sim_driver(drivers);
-  auto r = rt::Runtime::build(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
-                                                    "/config/machines/finish-sim-program.yaml"),
-                              blocks, drivers);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  std::ostringstream sink;
-  g_allocations = 0;
-  g_counting = true;
-  for (int k = 0; k < 5000; ++k) {  // polarity switch, then orbiting
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 1000 == 999) {
-      g_counting = false;
-      r->trace().drain(sink);
-      g_counting = true;
-    }
-  }
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0u);
+  auto r = build_shipped("finish-sim-program");  // polarity switch, then orbiting
+  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
 }
 
 TEST(Allocations, TheCounterSeesAllocations) {

@@ -180,18 +180,12 @@ class TwoStep final : public rt::BlockWithParams<TwoStepParams, rt::CompositeBlo
   void visit_own_pins(rt::PinVisitor& v) override { v.output("step", step_); }
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup&) override {
     // Wire the child's output back to its input, once, in C++.
-    struct Find final : rt::PinVisitor {
-      rt::Input<double>* in{nullptr};
-      rt::Output<double>* out{nullptr};
-      void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
-        if (n == "in") in = r.as_input<double>();
-        if (n == "out") out = r.as_output<double>();
-      }
-    } f;
-    fill_.visit_pins(f);
-    f.in->connect(*f.out);
-    fill_out_ = f.out;
-    return {};
+    std::vector<rt::ParamError> errs;
+    fill_out_ = child_output<double>(errs, fill_, "fill", "out");
+    if (fill_out_ != nullptr) {
+      wire_child(errs, fill_, "fill", "in", *fill_out_);
+    }
+    return errs;
   }
   void activate_self() noexcept override { step_.set(0); }
   void safe_state_self(const rt::SafeStateRequest&) noexcept override {

@@ -25,6 +25,17 @@ class Clock;
 
 enum class BlockStatus : std::int8_t { kOk = 0, kSaturated = 1, kFault = -1 };
 
+/// The more severe of two statuses (fault > saturated > ok). RT-safe.
+constexpr BlockStatus worst(BlockStatus a, BlockStatus b) noexcept {
+  if (a == BlockStatus::kFault || b == BlockStatus::kFault) {
+    return BlockStatus::kFault;
+  }
+  if (a == BlockStatus::kSaturated || b == BlockStatus::kSaturated) {
+    return BlockStatus::kSaturated;
+  }
+  return BlockStatus::kOk;
+}
+
 /// What a block sees each cycle. RT-safe to read.
 struct CycleContext {
   TimePoint release{};     // scheduled release time of this cycle (on the task's grid)

@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "edm/runtime/block.hpp"
@@ -43,12 +44,43 @@ class CompositeBlock : public Block {
     return ref;
   }
 
+  /// Connects the child's input `pin` to `source` (configure time). A missing or mistyped pin
+  /// is reported as "<child>.<pin>: internal wire: no such input".
+  template <PinValue T>
+  static void wire_child(std::vector<ParamError>& errs, Block& child, std::string_view child_name,
+                         std::string_view pin, const Output<T>& source) {
+    Input<T>* in = find_pin(child, pin).template as_input<T>();
+    if (in == nullptr) {
+      errs.push_back(
+          {std::string(child_name) + "." + std::string(pin), "internal wire: no such input"});
+      return;
+    }
+    in->connect(source);
+  }
+  /// The child's output `pin`, or nullptr with an error (configure time).
+  template <PinValue T>
+  static const Output<T>* child_output(std::vector<ParamError>& errs, Block& child,
+                                       std::string_view child_name, std::string_view pin) {
+    const Output<T>* out = find_pin(child, pin).template as_output<T>();
+    if (out == nullptr) {
+      errs.push_back(
+          {std::string(child_name) + "." + std::string(pin), "internal wire: no such output"});
+    }
+    return out;
+  }
+  /// Appends a child's problems with "<child>." in front of each field.
+  static void append_child_errors(std::vector<ParamError>& errs, std::string_view child_name,
+                                  std::vector<ParamError> more);
+
   virtual void visit_own_pins(PinVisitor& /*v*/) {}
   virtual std::vector<ParamError> configure_self(const BlockSetup& /*setup*/) { return {}; }
   virtual void activate_self() noexcept {}
   virtual void safe_state_self(const SafeStateRequest& /*request*/) noexcept {}
 
  private:
+  /// The pin named `name` of a block, or a null PinRef (load time only).
+  static PinRef find_pin(Block& block, std::string_view name);
+
   struct Child {
     std::string name;
     std::unique_ptr<Block> block;
