@@ -196,7 +196,7 @@ class TwoStep final : public rt::BlockWithParams<TwoStepParams, rt::CompositeBlo
  private:
   AddOne& fill_;
   Recorder& drain_;
-  rt::Output<double>* fill_out_{nullptr};
+  const rt::Output<double>* fill_out_{nullptr};
   rt::Output<std::int64_t> step_;
 };
 
