@@ -1,0 +1,48 @@
+#pragma once
+// What a part program is checked against: the machine's machining-condition table (E numbers)
+// and its soft limits. Plain data shared by the runtime (which enforces them) and the HMI (which
+// checks a program offline), so both sides use one definition. Non-RT; thread-compatible.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace edm::machining {
+
+enum class Polarity : std::uint8_t { kNegative, kPositive };
+
+/// A machining condition, selected by its E number.
+struct Condition {
+  int e{0};  // >= 1, unique in a table
+  std::string name;
+  Polarity polarity{Polarity::kNegative};
+  double open_voltage_v{120.0};
+  double peak_current_a{10.0};
+  double on_time_us{20.0};
+  double off_time_us{40.0};
+  double tdr_us{8.0};        // reference ignition delay for the gap controller
+  double servo_ref_v{40.0};  // reference mean gap voltage for voltage-based servos
+  double wear_ratio{0.0};    // electrode volume / workpiece volume removed, 0..10
+};
+
+/// Soft limits and dynamics of one axis (machine coordinates, mm).
+struct AxisLimits {
+  char name{'X'};  // 'X', 'Y' or 'Z'
+  double min_mm{0.0};
+  double max_mm{0.0};
+  double v_max_mm_s{10.0};
+  double a_max_mm_s2{1000.0};
+};
+
+struct MachineTables {
+  std::vector<Condition> conditions;
+  std::vector<AxisLimits> axes;  // axes not listed are unlimited
+
+  /// The condition with E number e, or nullptr.
+  [[nodiscard]] const Condition* condition(int e) const noexcept;
+  /// The limits of axis 'X' / 'Y' / 'Z', or nullptr.
+  [[nodiscard]] const AxisLimits* axis(char name) const noexcept;
+};
+
+}  // namespace edm::machining

@@ -1,0 +1,17 @@
+#include "edm/machining/machine_tables.hpp"
+
+namespace edm::machining {
+
+const Condition* MachineTables::condition(int e) const noexcept {
+  for (const Condition& c : conditions)
+    if (c.e == e) return &c;
+  return nullptr;
+}
+
+const AxisLimits* MachineTables::axis(char name) const noexcept {
+  for (const AxisLimits& a : axes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+}  // namespace edm::machining
