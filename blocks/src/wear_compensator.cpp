@@ -34,6 +34,8 @@ std::vector<rt::ParamError> WearCompensator::configure(const rt::BlockSetup& set
   dt_s_ = rt::to_seconds(setup.period);
   compute_ratio();
   wear_mm_.set(0.0);
+  front_mm_ = 0.0;
+  deepest_mm_ = 0.0;
   vd_mm_s_.set(0.0);
   vz_out_mm_s_.set(0.0);
   return errs;
@@ -50,6 +52,8 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& /*ctx*/) noexcep
   double wear = wear_mm_.get();
   if (reset_wear_.get()) {
     wear = 0.0;
+    front_mm_ = 0.0;
+    deepest_mm_ = 0.0;
   } else if (!std::isfinite(wear)) {  // a corrupt restored value
     wear = 0.0;
     status = rt::BlockStatus::kFault;
@@ -61,8 +65,20 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& /*ctx*/) noexcep
     wear_mm_.set(wear);
     return rt::BlockStatus::kFault;
   }
+  // High-water mark of the front: only depth never reached before is erosion progress.
+  front_mm_ += vz_in * dt_s_;
+  if (!std::isfinite(front_mm_)) {  // absurd feeds: restart the tracking, compensate nothing
+    front_mm_ = 0.0;
+    deepest_mm_ = 0.0;
+    status = rt::BlockStatus::kFault;
+  }
+  double new_depth_mm = 0.0;
+  if (-front_mm_ > deepest_mm_) {
+    new_depth_mm = -front_mm_ - deepest_mm_;
+    deepest_mm_ = -front_mm_;
+  }
   double vd = 0.0;
-  if (enable_.get() && vz_in < 0.0) {
+  if (enable_.get() && new_depth_mm > 0.0) {
     const double ratio_in = wear_ratio_.get();
     if (!std::isfinite(ratio_in)) {
       status = rt::BlockStatus::kFault;
@@ -71,7 +87,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& /*ctx*/) noexcep
       if (ratio != ratio_in && status == rt::BlockStatus::kOk) {
         status = rt::BlockStatus::kSaturated;
       }
-      vd = ratio * area_ratio_ * -vz_in;
+      vd = ratio * area_ratio_ * new_depth_mm / dt_s_;  // v_bottom = new depth per cycle
     }
   }
   const double vz_out = vz_in - vd;

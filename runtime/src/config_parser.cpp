@@ -273,4 +273,30 @@ Config parse_config_file(const std::string& path) {
   return parse_config_text(text, path);
 }
 
+machining::MachineTables to_machine_tables(const Config& cfg) {
+  machining::MachineTables t;
+  for (const ConditionSpec& c : cfg.conditions) {
+    t.conditions.push_back({.e = c.e,
+                            .name = c.name,
+                            .polarity = c.polarity == Polarity::kPositive
+                                            ? machining::Polarity::kPositive
+                                            : machining::Polarity::kNegative,
+                            .open_voltage_v = c.open_voltage_v,
+                            .peak_current_a = c.peak_current_a,
+                            .on_time_us = c.on_time_us,
+                            .off_time_us = c.off_time_us,
+                            .tdr_us = c.tdr_us,
+                            .servo_ref_v = c.servo_ref_v,
+                            .wear_ratio = c.wear_ratio});
+  }
+  for (const AxisSpec& a : cfg.machine.axes) {
+    t.axes.push_back({.name = a.name.empty() ? '?' : a.name[0],
+                      .min_mm = a.min_mm,
+                      .max_mm = a.max_mm,
+                      .v_max_mm_s = a.v_max_mm_s,
+                      .a_max_mm_s2 = a.a_max_mm_s2});
+  }
+  return t;
+}
+
 }  // namespace edm::rt

@@ -84,6 +84,7 @@ class RuntimeBuilder {
   std::unique_ptr<Runtime> build() {
     rt_.reset(new Runtime());
     rt_->config_ = cfg_;
+    rt_->tables_ = to_machine_tables(cfg_);
     make_tasks();
     make_driver();
     make_programs();
@@ -143,7 +144,8 @@ class RuntimeBuilder {
       return;
     }
     const Duration period = io_task_ != nullptr ? io_task_->spec().interval : Duration{};
-    report_param_errors(rt_->driver_->configure({"io", period}), io.params, what, io.loc, diag_);
+    report_param_errors(rt_->driver_->configure(setup("io", period)), io.params, what, io.loc,
+                        diag_);
     std::vector<std::string> names;
     PinCollector pc("io", io_task_, pins_, names);
     rt_->driver_->visit_pins(pc);
@@ -151,6 +153,10 @@ class RuntimeBuilder {
       io_task_->attach_driver(*rt_->driver_);
     }
     block_pin_names_["io"] = names;
+  }
+
+  BlockSetup setup(std::string_view instance, Duration period) {
+    return BlockSetup{instance, period, &rt_->machine_, &rt_->job_, &rt_->tables_};
   }
 
   void make_programs() {
@@ -176,7 +182,8 @@ class RuntimeBuilder {
         }
         if (diag_.diagnostics().size() == before) {
           const std::string full = ps.name + "." + bs.name;
-          report_param_errors(block->configure({full, period}), bs.params, what, bs.loc, diag_);
+          report_param_errors(block->configure(setup(full, period)), bs.params, what, bs.loc,
+                              diag_);
         }
         std::vector<std::string> names;
         PinCollector pc(ps.name + "." + bs.name, task, pins_, names);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -64,19 +65,29 @@ TEST(WearCompensatorTest, no_compensation_while_retracting_holding_or_disabled) 
 }
 
 TEST(WearCompensatorTest, accumulated_wear_integrates_exactly) {
-  // A_hole/A_e = 2, wear ratio 0.25, dt = 0.125 s: every Vd·dt and partial sum is exact in binary.
+  // A_hole/A_e = 2, wear ratio 0.25, dt = 0.125 s: every step and partial sum is exact in binary.
+  // The feed pattern goes down, further down, then back up (a retract): only depth the front has
+  // never reached before is erosion (the high-water mark), so the up-stroke and the down-stroke
+  // that re-covers it add no wear.
   BlockHarness<WearCompensator> h(125ms);
   ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
   h.source<double>("wear_ratio").set(0.25);
   double expected = 0.0;
+  double front = 0.0;
+  double deepest = 0.0;
   for (int n = 1; n <= 4000; ++n) {
     const double vz = n % 3 == 0 ? 0.5 : (n % 3 == 1 ? -0.5 : -0.25);  // incl. retracting cycles
     step(h, vz);
-    const double vd = vz < 0.0 ? 0.25 * 2.0 * -vz : 0.0;
-    ASSERT_EQ(h.out("vd_mm_s"), vd);
+    front += vz * 0.125;
+    const double new_depth = std::max(0.0, -front - deepest);
+    deepest = std::max(deepest, -front);
+    const double vd = 0.25 * 2.0 * new_depth / 0.125;
+    ASSERT_EQ(h.out("vd_mm_s"), vd) << "n = " << n;
     expected += vd * 0.125;
     ASSERT_EQ(h.out("wear_mm"), expected) << "n = " << n;
   }
+  // Net travel 4000/3 patterns × 0.03125 mm (+ the first partial pattern): wear = θ·A_h/A_e·depth.
+  EXPECT_EQ(h.out("wear_mm"), 0.25 * 2.0 * deepest);
   // reset_wear zeroes it (electrode change); a value written into the pin is continued.
   auto& reset = h.source<bool>("reset_wear");
   reset.set(true);
@@ -86,6 +97,25 @@ TEST(WearCompensatorTest, accumulated_wear_integrates_exactly) {
   h.pin("wear_mm").as_output<double>()->set(10.0);  // retained value restored
   step(h, -0.5);
   EXPECT_EQ(h.out("wear_mm"), 10.0 + 0.25 * 0.125);
+}
+
+TEST(WearCompensatorTest, oscillation_over_eroded_depth_adds_no_wear) {
+  // A servo that swings ±A about a slowly advancing mean: the wear estimate must follow the net
+  // advance, not the sum of the down-strokes (which is many times larger here).
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start({.hole_area_mm2 = 1.0, .electrode_area_mm2 = 1.0}).empty());
+  h.source<double>("wear_ratio").set(0.5);
+  double down_strokes = 0.0;
+  double front = 0.0;
+  for (int n = 0; n < 20000; ++n) {
+    const double vz = -0.01 + 2.0 * std::sin(2.0 * 3.141592653589793 * n / 50.0);  // mm/s
+    step(h, vz);
+    front += vz * 1e-3;
+    if (vz < 0.0) down_strokes += -vz * 1e-3;
+  }
+  const double net = -front;  // 0.2 mm
+  EXPECT_NEAR(h.out("wear_mm"), 0.5 * net, 0.5 * 0.02 * net + 0.5 * 2.0 * 50e-3 / 3.14159);
+  EXPECT_LT(h.out("wear_mm"), 0.05 * 0.5 * down_strokes);
 }
 
 TEST(WearCompensatorTest, electrode_front_keeps_up_with_the_hole_bottom) {

@@ -19,9 +19,14 @@
 #include "edm/runtime/pin.hpp"
 #include "edm/runtime/time.hpp"
 
+namespace edm::machining {
+struct MachineTables;
+}
+
 namespace edm::rt {
 
 class Clock;
+class JobStore;
 
 enum class BlockStatus : std::int8_t { kOk = 0, kSaturated = 1, kFault = -1 };
 
@@ -47,9 +52,15 @@ struct CycleContext {
 };
 
 /// What configure() is told. Non-RT.
+/// What configure() is given. The pointers are the runtime's (they outlive every block); they
+/// are null when a block is built outside a Runtime (unit tests), so blocks that need them must
+/// report a configure error rather than dereference null.
 struct BlockSetup {
   std::string_view instance;  // "program.block"
   Duration period{};          // interval of the task the block runs on
+  Machine* machine{nullptr};  // the state machine (commands from a sequencer; alarms)
+  JobStore* job{nullptr};     // the loaded part program (job sequencers)
+  const machining::MachineTables* tables{nullptr};  // conditions and soft limits of the config
 };
 
 class Block : public SafeStateHandler {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "edm/machining/machine_tables.hpp"
 #include "edm/runtime/diagnostics.hpp"
 #include "edm/runtime/time.hpp"
 
@@ -156,6 +157,9 @@ struct Config {
   BridgeSpec bridge;
   RetainSpec retain;
 };
+
+/// The conditions and soft limits in the form part programs are checked against (machining/).
+machining::MachineTables to_machine_tables(const Config& cfg);
 
 /// Reads and checks a config file. Throws ConfigError listing every problem (file:line:col).
 Config parse_config_file(const std::string& path);

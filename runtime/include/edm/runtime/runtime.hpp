@@ -12,9 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "edm/machining/machine_tables.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/io_driver.hpp"
+#include "edm/runtime/job.hpp"
 #include "edm/runtime/machine.hpp"
 #include "edm/runtime/program.hpp"
 #include "edm/runtime/retain.hpp"
@@ -70,6 +72,10 @@ class Runtime {
   [[nodiscard]] const std::string& retain_warning() const noexcept { return retain_warning_; }
   [[nodiscard]] std::vector<TaskStatsReport> stats_reports() const;
   [[nodiscard]] const Config& config() const noexcept { return config_; }
+  /// The loaded part program and its progress (DESIGN §2: the runtime owns it).
+  [[nodiscard]] JobStore& job() noexcept { return job_; }
+  /// The config's conditions and soft limits, in the form part programs are checked against.
+  [[nodiscard]] const machining::MachineTables& tables() const noexcept { return tables_; }
 
  private:
   friend class RuntimeBuilder;
@@ -77,7 +83,9 @@ class Runtime {
   void drain_alarms();
 
   Config config_;
+  machining::MachineTables tables_;
   Machine machine_;
+  JobStore job_;
   std::unique_ptr<IoDriver> driver_;
   std::vector<std::unique_ptr<Program>> programs_;
   std::vector<std::unique_ptr<Task>> tasks_;

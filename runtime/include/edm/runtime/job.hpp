@@ -1,0 +1,88 @@
+#pragma once
+// JobStore: the part program the runtime owns (DESIGN §2) and the real-time cursor through it.
+//
+// Non-RT side (the bridge's program.commit, tests): load() swaps in a whole, already checked
+// program of motion blocks — only when no job is active. RT side (the job sequencer program):
+// rt_begin() at cycle start, rt_current()/rt_advance() while running, rt_finish() at the end.
+// Once begun, a job runs to its end from the store alone: nothing the HMI does (disconnect, kill)
+// touches it; load() is refused with kBusy until the job has finished.
+//
+// Synchronisation: one atomic phase word. load() moves it Idle → Loading → Idle with a CAS;
+// rt_begin() moves it Idle → Active with a CAS, rt_finish() Active → Idle. The RT side reads the
+// program only while it holds Active, so the loader can free the old program right after its
+// swap. Both sides are lock-free; the RT side never allocates or frees.
+// Progress (index, count, outcome, counters) is published in atomics any thread may read.
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "edm/machining/motion_block.hpp"
+
+namespace edm::rt {
+
+enum class JobOutcome : std::uint8_t {
+  kNone = 0,      // no job has run since the last load
+  kRunning = 1,   // a job is active
+  kFinished = 2,  // the last job reached its end
+  kAborted = 3,   // the last job was stopped (operator stop, fault, E-stop)
+};
+
+enum class LoadResult : std::uint8_t { kOk, kBusy };
+
+struct JobProgress {
+  JobOutcome outcome{JobOutcome::kNone};
+  std::uint64_t generation{0};  // increments on every successful load()
+  std::uint64_t jobs_started{0};
+  std::size_t block_index{0};  // index of the block being executed (= count when finished)
+  std::size_t block_count{0};  // blocks in the loaded program
+  std::int32_t line{0};        // G-code line of the block being executed
+};
+
+class JobStore {
+ public:
+  JobStore() = default;
+  JobStore(const JobStore&) = delete;
+  JobStore& operator=(const JobStore&) = delete;
+
+  /// Non-RT. Replaces the loaded program (validated by the caller). kBusy while a job is active
+  /// or another load is in progress; the previous program is then kept untouched.
+  LoadResult load(std::vector<machining::MotionBlock> program);
+  /// Non-RT. Number of blocks in the loaded program (0 = none).
+  [[nodiscard]] std::size_t loaded_blocks() const noexcept {
+    return count_.load(std::memory_order_acquire);
+  }
+
+  /// RT-safe. Starts a job at block 0 of the loaded program. False (nothing changed) when there is
+  /// no program, a job is already active, or a load is in progress.
+  bool rt_begin() noexcept;
+  /// RT-safe. The block being executed, or nullptr when no job is active or it is past the end.
+  [[nodiscard]] const machining::MotionBlock* rt_current() const noexcept;
+  /// RT-safe. Moves to the next block (index = count past the last one).
+  void rt_advance() noexcept;
+  /// RT-safe. Ends the active job (no-op if none) with kFinished or kAborted.
+  void rt_finish(JobOutcome outcome) noexcept;
+  /// Any thread.
+  [[nodiscard]] bool active() const noexcept {
+    return phase_.load(std::memory_order_acquire) == Phase::kActive;
+  }
+  /// Any thread; the fields are read one by one (each is consistent, the set nearly so).
+  [[nodiscard]] JobProgress progress() const noexcept;
+
+ private:
+  enum class Phase : std::uint8_t { kIdle, kLoading, kActive };
+  using Program = std::vector<machining::MotionBlock>;
+
+  std::atomic<Phase> phase_{Phase::kIdle};
+  std::unique_ptr<const Program> program_;  // written only in Loading, read only in Active
+  std::atomic<std::size_t> count_{0};
+  std::atomic<std::size_t> index_{0};
+  std::atomic<std::int32_t> line_{0};
+  std::atomic<JobOutcome> outcome_{JobOutcome::kNone};
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<std::uint64_t> jobs_started_{0};
+};
+
+}  // namespace edm::rt
