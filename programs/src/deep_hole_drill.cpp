@@ -1,5 +1,6 @@
 #include "edm/programs/deep_hole_drill.hpp"
 
+#include <cmath>
 #include <string>
 #include <string_view>
 
@@ -32,11 +33,17 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
   v.param("wear_ratio_default", wear_ratio_default, "",
           "electrode/workpiece volume ratio while the wear_ratio input is <= 0 (>= 0)");
   v.param("kg", kg, "mm/s/us", "gap controller gain (> 0)");
-  v.param("tdr_us", tdr_us, "us", "reference ignition delay (> 0)");
+  v.param("tdr_default_us", tdr_default_us, "us",
+          "reference ignition delay while the tdr_us input is <= 0 (> 0)");
   v.param("hole_area_mm2", hole_area_mm2, "mm^2", "hole cross-section (> 0), load time only");
   v.param("electrode_area_mm2", electrode_area_mm2, "mm^2",
           "electrode material cross-section (> 0), load time only");
   v.param("td_window", td_window, "cycles", "cycles pooled for Td (1..65536), load time only");
+  v.param("breakthrough_cycles", breakthrough_cycles, "cycles",
+          "cycles without ignition that mean breakthrough of a through hole (>= 1)");
+  v.param("breakthrough_min_mm", breakthrough_min_mm, "mm",
+          "no breakthrough is detected above this depth (>= 0)");
+  v.param("overtravel_mm", overtravel_mm, "mm", "feed on after breakthrough (>= 0)");
 }
 
 std::vector<rt::ParamError> DeepHoleDrillParams::validate() const {
@@ -56,9 +63,16 @@ std::vector<rt::ParamError> DeepHoleDrillParams::validate() const {
   rt::require_finite(errs, "wear_ratio_default", wear_ratio_default);
   rt::require_non_negative(errs, "wear_ratio_default", wear_ratio_default);
   rt::require_positive(errs, "kg", kg);
-  rt::require_positive(errs, "tdr_us", tdr_us);
+  rt::require_positive(errs, "tdr_default_us", tdr_default_us);
   rt::require_positive(errs, "hole_area_mm2", hole_area_mm2);
   rt::require_positive(errs, "electrode_area_mm2", electrode_area_mm2);
+  if (breakthrough_cycles < 1) {
+    errs.push_back({"breakthrough_cycles", "breakthrough_cycles must be >= 1"});
+  }
+  rt::require_finite(errs, "breakthrough_min_mm", breakthrough_min_mm);
+  rt::require_non_negative(errs, "breakthrough_min_mm", breakthrough_min_mm);
+  rt::require_finite(errs, "overtravel_mm", overtravel_mm);
+  rt::require_non_negative(errs, "overtravel_mm", overtravel_mm);
   if (td_window < 1 || td_window > blocks::TdDetectorParams::kMaxWindow) {
     errs.push_back({"td_window", "td_window must be in 1..65536"});
   }
@@ -80,12 +94,15 @@ void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
   v.input("depth_mm", depth_mm_, "mm");
   v.input("wear_ratio", wear_ratio_);
   v.input("enable_wear_comp", enable_wear_comp_);
+  v.input("tdr_us", tdr_us_, "us");
+  v.input("through", through_);
   v.output("vz_cmd_mm_s", vz_cmd_mm_s_, "mm/s");
   v.output("gen_on", gen_on_);
   v.output("state", state_);
   v.output("depth_reached_mm", depth_reached_mm_, "mm");
   v.output("touch_z_mm", touch_z_mm_, "mm");
   v.output("done", done_);
+  v.output("breakthrough", breakthrough_);
 }
 
 std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& setup) {
@@ -100,7 +117,7 @@ std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& 
   append_child_errors(errs, "td", td_.validate());
   append_child_errors(errs, "td", td_.configure(setup));
 
-  params_changed();  // gap: kg, tdr_us, idle feed
+  params_changed();  // gap: kg, tdr_default_us, idle feed
   append_child_errors(errs, "gap", gap_.validate());
   append_child_errors(errs, "gap", gap_.configure(setup));
 
@@ -124,6 +141,7 @@ std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& 
   if (td_valid != nullptr) {
     wire_child(errs, gap_, "gap", "valid", *td_valid);
   }
+  wire_child(errs, gap_, "gap", "tdr_us", c_tdr_us_);
   gap_vz_ = child_output<double>(errs, gap_, "gap", "vz_mm_s");
   if (gap_vz_ != nullptr) {
     wire_child(errs, wear_, "wear", "vz_in_mm_s", *gap_vz_);
@@ -141,7 +159,7 @@ void DeepHoleDrill::params_changed() noexcept {
   // of their own, so nothing reads its shadow copy concurrently.
   blocks::GapControllerPParams gp = gap_.params();
   gp.kg = params_.kg;
-  gp.tdr_default_us = params_.tdr_us;
+  gp.tdr_default_us = params_.tdr_default_us;
   gp.idle_feed_mm_s = -params_.approach_speed_mm_s;
   gap_.set_params(gp);
 }
@@ -156,6 +174,8 @@ std::vector<rt::ParamError> DeepHoleDrill::stage_param(std::size_t index, const 
 void DeepHoleDrill::activate_self() noexcept {
   prev_start_ = false;
   spark_cycles_ = 0;
+  dark_cycles_ = 0;
+  breakthrough_.set(false);
   target_depth_mm_ = params_.depth_default_mm;
   retract_to_z_mm_ = 0.0;
   safe_retract_ = false;
@@ -179,8 +199,10 @@ void DeepHoleDrill::begin_cycle() noexcept {
   const double d = depth_mm_.get();
   target_depth_mm_ = d > 0.0 ? d : params_.depth_default_mm;
   spark_cycles_ = 0;
+  dark_cycles_ = 0;
   safe_retract_ = false;
   done_.set(false);
+  breakthrough_.set(false);
   depth_reached_mm_.set(0.0);
   set_state(State::kApproach);
 }
@@ -192,7 +214,7 @@ void DeepHoleDrill::begin_retract(double target_z) noexcept {
 
 void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
   gen_on_.set(false);
-  if (state_value_ == State::kDrill) {
+  if (state_value_ == State::kDrill || state_value_ == State::kBreakthrough) {
     begin_retract(touch_z_mm_.get() + params_.clearance_mm);
     safe_retract_ = true;
   } else if (state_value_ == State::kApproach) {
@@ -221,8 +243,11 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
   const double w = wear_ratio_.get();
   c_wear_ratio_.set(w > 0.0 ? w : params_.wear_ratio_default);
   c_wear_enable_.set(comp);
+  const double tdr = tdr_us_.get();
+  c_tdr_us_.set(tdr > 0.0 && std::isfinite(tdr) ? tdr : 0.0);  // 0: the gap child's parameter
 
-  if (safe && (state_value_ == State::kApproach || state_value_ == State::kDrill)) {
+  if (safe && (state_value_ == State::kApproach || state_value_ == State::kDrill ||
+               state_value_ == State::kBreakthrough)) {
     // Normally done by safe_state_self(); kept here so no path can drill in a safe state.
     safe_state_self(rt::SafeStateRequest{});
   }
@@ -260,11 +285,26 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
     const double wear_mm = comp && wear_mm_ != nullptr ? wear_mm_->get() : 0.0;
     const double depth = (touch_z_mm_.get() - z) - wear_mm;
     depth_reached_mm_.set(depth);
+    dark_cycles_ = td_count_.get() > 0 ? 0 : dark_cycles_ + 1;
     if (depth >= target_depth_mm_) {
       begin_retract(touch_z_mm_.get() + params_.clearance_mm);
+    } else if (through_.get() && depth >= params_.breakthrough_min_mm &&
+               dark_cycles_ >= params_.breakthrough_cycles) {
+      breakthrough_.set(true);
+      breakthrough_z_mm_ = z;
+      set_state(State::kBreakthrough);
     } else {
       gen_on_.set(true);
       vz_cmd_mm_s_.set(wear_vz_ != nullptr ? wear_vz_->get() : 0.0);
+    }
+  }
+
+  if (state_value_ == State::kBreakthrough) {
+    gen_on_.set(false);
+    if (z <= breakthrough_z_mm_ - params_.overtravel_mm) {
+      begin_retract(touch_z_mm_.get() + params_.clearance_mm);
+    } else {
+      vz_cmd_mm_s_.set(-params_.approach_speed_mm_s);
     }
   }
 

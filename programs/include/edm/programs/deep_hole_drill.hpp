@@ -17,7 +17,12 @@
 //   2 DRILL     td → gap → wear → vz_cmd_mm_s (wear compensation only if enable_wear_comp).
 //               Hole depth estimate (the electrode front is z − accumulated wear):
 //                 depth_reached_mm = (touch_z_mm − z_mm) − (enable_wear_comp ? wear.wear_mm : 0)
-//               When it reaches the target → RETRACT.
+//               When it reaches the target → RETRACT. With `through` set, breakthrough_cycles
+//               consecutive cycles without an ignited pulse (td_count = 0) once depth ≥
+//               breakthrough_min_mm mean the front has left the work: breakthrough = true →
+//               BREAKTHROUGH.
+//   5 BREAKTHROUGH generator off, vz = −approach_speed_mm_s for overtravel_mm below the z of
+//               the detection (clears the exit burr), then RETRACT; done = true at the end.
 //   3 RETRACT   generator off, vz = +retract_speed_mm_s until z_mm ≥ touch_z_mm + clearance_mm
 //               → DONE (vz = 0, done = true).
 //   4 DONE      generator off, vz = 0; a new rising edge of `start` begins another cycle.
@@ -29,9 +34,10 @@
 // the current z); a retract that completes in the safe state ends in IDLE (done stays false: the
 // hole is not finished). `start` is ignored while the machine is in a safe state.
 //
-// Child parameters: kg, tdr_us (gap) and hole_area_mm2, electrode_area_mm2 (wear) and td_window
-// (td) are the composite's own and are copied into the children at configure time; kg and tdr_us
-// are also copied on a runtime write. The other child parameters keep their defaults, except
+// Inputs tdr_us (> 0: the active condition's Tdr, else the parameter) and through.
+// Child parameters: kg, tdr_default_us (gap) and hole_area_mm2, electrode_area_mm2 (wear) and
+// td_window (td) are the composite's own and are copied into the children at configure time; kg and
+// tdr_us are also copied on a runtime write. The other child parameters keep their defaults, except
 // gap.idle_feed_mm_s = −approach_speed_mm_s.
 //
 // Accuracy on the simulator (drill preset, 20 mm, tests/programs): the hole ends ≈ 0.25 mm short
@@ -60,10 +66,13 @@ struct DeepHoleDrillParams {
   double clearance_mm{1.0};         // [mm] ≥ 0, retract to touch_z + this
   double wear_ratio_default{0.6};   // [-] ≥ 0, electrode/workpiece volume when the input is 0
   double kg{0.05};                  // [mm/s per µs] > 0 → gap.kg
-  double tdr_us{8.0};               // [µs] > 0 → gap.tdr_default_us (gap.tdr_us input unwired)
+  double tdr_default_us{8.0};  // [µs] > 0 → gap.tdr_default_us (while the tdr_us input ≤ 0)
   double hole_area_mm2{blocks::WearCompensatorParams{}.hole_area_mm2};            // → wear
   double electrode_area_mm2{blocks::WearCompensatorParams{}.electrode_area_mm2};  // → wear
-  std::int64_t td_window{8};  // cycles, → td.window (load time only)
+  std::int64_t td_window{8};              // cycles, → td.window (load time only)
+  std::int64_t breakthrough_cycles{300};  // ≥ 1 cycles without ignition = breakthrough (through)
+  double breakthrough_min_mm{0.5};        // [mm] ≥ 0, no breakthrough before this depth
+  double overtravel_mm{0.3};              // [mm] ≥ 0, feed on after breakthrough, then retract
 
   void visit(rt::ParamVisitor& v);
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
@@ -71,7 +80,14 @@ struct DeepHoleDrillParams {
 
 class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::CompositeBlock> {
  public:
-  enum class State : std::int64_t { kIdle = 0, kApproach = 1, kDrill = 2, kRetract = 3, kDone = 4 };
+  enum class State : std::int64_t {
+    kIdle = 0,
+    kApproach = 1,
+    kDrill = 2,
+    kRetract = 3,
+    kDone = 4,
+    kBreakthrough = 5
+  };
 
   DeepHoleDrill();
 
@@ -103,17 +119,21 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<double> depth_mm_;    // 0: use the parameter
   rt::Input<double> wear_ratio_;  // ≤ 0 (unwired): use the parameter
   rt::Input<bool> enable_wear_comp_{true};
+  rt::Input<double> tdr_us_;  // ≤ 0 (unwired): the tdr_us parameter
+  rt::Input<bool> through_;   // a through hole: detect the breakthrough
   rt::Output<double> vz_cmd_mm_s_;
   rt::Output<bool> gen_on_;
   rt::Output<std::int64_t> state_;
   rt::Output<double> depth_reached_mm_, touch_z_mm_;
   rt::Output<bool> done_;
+  rt::Output<bool> breakthrough_;
 
   // Private cells the children's inputs are wired to (an input cannot be wired to an input).
   rt::Output<std::int64_t> c_td_sum_ns_, c_td_count_, c_n_open_, c_n_short_;
   rt::Output<double> c_wear_ratio_;
   rt::Output<bool> c_wear_enable_{true};
   rt::Output<bool> c_reset_wear_;
+  rt::Output<double> c_tdr_us_;
   // Children's outputs read by the sequence.
   const rt::Output<double>* gap_vz_{nullptr};
   const rt::Output<double>* wear_vz_{nullptr};
@@ -122,6 +142,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   State state_value_{State::kIdle};
   bool prev_start_{false};
   std::int64_t spark_cycles_{0};
+  std::int64_t dark_cycles_{0};    // consecutive DRILL cycles without an ignited pulse
+  double breakthrough_z_mm_{0.0};  // z where the breakthrough was detected
   double target_depth_mm_{0.0};
   double retract_to_z_mm_{0.0};
   bool safe_retract_{false};  // the running retract was started by the safe state
