@@ -1,0 +1,164 @@
+// EdmJob on the whole drilling machine (config/machines/drill-sim.yaml): a part program of motion
+// blocks, fed straight into the runtime's JobStore (the bridge's program.commit does the same),
+// drills a 20 mm blind hole with E1 and finishes its wall with E2 to +0.05 mm radius.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "edm/blocks/register.hpp"
+#include "edm/machining/motion_block.hpp"
+#include "edm/machining/program_check.hpp"
+#include "edm/programs/register.hpp"
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/loopback_driver.hpp"
+#include "edm/runtime/runtime.hpp"
+#include "edm/sim/sim_driver.hpp"
+
+namespace edm::test {
+namespace {
+
+using namespace std::chrono_literals;
+using machining::MotionBlock;
+using machining::MotionKind;
+
+MotionBlock blk(MotionKind k, int line) {
+  MotionBlock b;
+  b.kind = k;
+  b.line = line;
+  b.col = 1;
+  return b;
+}
+
+// The program edmhmi's interpreter makes of: G00 Z1 / E1 / G01 Z-20 / G00 Z-19.8 / E2 /
+// G160 R0.60 / G00 Z5 / M30 (drill at X0 Y0, where the tube starts).
+std::vector<MotionBlock> drill_then_finish(double depth, double final_radius) {
+  std::vector<MotionBlock> p;
+  MotionBlock r = blk(MotionKind::kRapid, 1);
+  r.target = {0, 0, 0.1};
+  p.push_back(r);
+  MotionBlock m8 = blk(MotionKind::kFlushing, 2);
+  m8.on = true;
+  p.push_back(m8);
+  MotionBlock e1 = blk(MotionKind::kCondition, 2);
+  e1.condition = 1;
+  p.push_back(e1);
+  MotionBlock d = blk(MotionKind::kDrill, 3);
+  d.target = {0, 0, -depth};
+  d.condition = 1;
+  d.z_travel_mm = depth * 1.6213;
+  p.push_back(d);
+  MotionBlock in = blk(MotionKind::kRapid, 4);  // back into the hole, tip 0.2 mm off the bottom
+  in.target = {0, 0, -depth + 0.2};
+  p.push_back(in);
+  MotionBlock e2 = blk(MotionKind::kCondition, 4);
+  e2.condition = 2;
+  p.push_back(e2);
+  MotionBlock o = blk(MotionKind::kOrbitFinish, 5);
+  o.condition = 2;
+  o.final_radius_mm = final_radius;
+  p.push_back(o);
+  MotionBlock e0 = blk(MotionKind::kCondition, 6);
+  p.push_back(e0);
+  MotionBlock up = blk(MotionKind::kRapid, 7);
+  up.target = {0, 0, 5};
+  p.push_back(up);
+  p.push_back(blk(MotionKind::kEnd, 8));
+  return p;
+}
+
+struct JobResult {
+  bool finished{false};
+  double depth_mm{0.0};
+  double r0_mm{0.0}, r_min_mm{0.0}, r_max_mm{0.0};
+  double z_end_mm{0.0};
+  double time_s{0.0};
+  double short_fraction{0.0};
+};
+
+JobResult run_job(int seed, double depth, double final_radius) {
+  JobResult res;
+  rt::BlockRegistry blocks;
+  blocks::register_builtin_blocks(blocks);
+  programs::register_builtin_programs(blocks);
+  rt::DriverRegistry drivers;
+  rt::register_runtime_drivers(drivers);
+  sim::register_sim_driver(drivers);
+  rt::BuildOptions opts;
+  opts.seed = static_cast<std::uint64_t>(seed);
+  auto r = rt::Runtime::build(
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"),
+      blocks, drivers, opts);
+  const auto program = drill_then_finish(depth, final_radius);
+  const auto issues = machining::check_program(program, r->tables(), {0, 0, 0.1});
+  EXPECT_TRUE(issues.empty()) << issues[0].message;
+  EXPECT_EQ(r->job().load(program), rt::LoadResult::kOk);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  EXPECT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(r->driver()).plant();
+  res.r0_mm = plant.wall_bin_radius_mm(0);
+  auto& vars = r->variables();
+  rt::VirtualClock clock;
+  rt::Task& motion = *r->tasks()[0];
+  rt::Task& supervisor = *r->tasks()[1];
+  std::ostringstream sink;
+  double shorts = 0.0, pulses = 0.0;
+  std::int64_t k = 0;
+  for (; k < 300'000; ++k) {
+    const rt::TimePoint t{1ms * k};
+    clock.advance_to(t);
+    motion.run_cycle(t, clock);
+    if (k % 10 == 0) supervisor.run_cycle(t, clock);
+    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    if (vars.read("cnc.job.drill.state").value() == 2.0) {
+      shorts += vars.read("io.n_short").value();
+      for (const char* n :
+           {"io.n_open", "io.n_normal", "io.n_short", "io.n_transient_arc", "io.n_stable_arc"}) {
+        pulses += vars.read(n).value();
+      }
+    }
+    if (r->job().progress().outcome == rt::JobOutcome::kFinished) {
+      res.finished = true;
+      break;
+    }
+    if (rt::is_safe_state(r->machine().state())) break;
+  }
+  res.time_s = static_cast<double>(k) * 1e-3;
+  res.depth_mm = vars.read("io.depth_mm").value();
+  res.z_end_mm = vars.read("io.z_mm").value();
+  res.short_fraction = pulses > 0 ? shorts / pulses : 0.0;
+  res.r_min_mm = 1e9;
+  res.r_max_mm = 0.0;
+  for (int j = 0; j < 64; ++j) {
+    res.r_min_mm = std::min(res.r_min_mm, plant.wall_bin_radius_mm(j));
+    res.r_max_mm = std::max(res.r_max_mm, plant.wall_bin_radius_mm(j));
+  }
+  EXPECT_EQ(r->machine().state(), rt::MachineState::kReady) << "the job stops the machine";
+  return res;
+}
+
+class JobSeeds : public ::testing::TestWithParam<int> {};
+
+TEST_P(JobSeeds, DrillThenFinishFromTheJobStore) {
+  const JobResult j = run_job(GetParam(), 20.0, 0.6);
+  std::printf(
+      "[edm_job] seed %d finished %d in %.1f s: depth %.4f mm, wall r %.4f..%.4f (initial %.4f), "
+      "z end %.3f, shorts %.2f %%\n",
+      GetParam(), j.finished, j.time_s, j.depth_mm, j.r_min_mm, j.r_max_mm, j.r0_mm, j.z_end_mm,
+      100 * j.short_fraction);
+  ASSERT_TRUE(j.finished);
+  EXPECT_NEAR(j.depth_mm, 20.0, 0.02);
+  EXPECT_NEAR(j.r_min_mm, j.r0_mm + 0.05, 0.005);
+  EXPECT_NEAR(j.r_max_mm, j.r0_mm + 0.05, 0.005);
+  EXPECT_NEAR(j.z_end_mm, 5.0, 0.05) << "the last rapid was executed";
+  EXPECT_LE(j.short_fraction, 0.05);
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, JobSeeds, ::testing::Values(1, 2, 3));
+
+}  // namespace
+}  // namespace edm::test
