@@ -8,6 +8,7 @@
 #include <new>
 #include <sstream>
 
+#include "edm/machining/motion_block.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/sim/sim_driver.hpp"
 #include "support/runtime_fixture.hpp"
@@ -187,11 +188,25 @@ std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
-  // The simulator runs inside the I/O task's input latch: pulses, axes, debris and sensors must
-  // not allocate either. 3 s of drilling, ~60 000 pulses.
+  // The whole machine of config/machines/drill-sim.yaml running a job from its JobStore: the
+  // EdmJob sequencer (rapid, condition, gap-controlled drilling with wear compensation) and the
+  // simulator inside the I/O task's input latch. 3 s of drilling, ~60 000 pulses.
   auto r = build_shipped("drill-sim");
+  std::vector<machining::MotionBlock> job(4);
+  job[0].kind = machining::MotionKind::kRapid;
+  job[0].target = {0, 0, 0.1};
+  job[1].kind = machining::MotionKind::kCondition;
+  job[1].condition = 1;
+  job[2].kind = machining::MotionKind::kDrill;
+  job[2].target = {0, 0, -5};
+  job[2].condition = 1;
+  job[2].z_travel_mm = 8;
+  job[3].kind = machining::MotionKind::kEnd;
+  ASSERT_EQ(r->job().load(job), rt::LoadResult::kOk);  // non-RT, before the counted cycles
+  ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
-  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.5) << "it really drilled";
+  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "it really drilled";
+  EXPECT_EQ(r->variables().read("cnc.job.drill.state"), 2.0) << "drilling from the job";
 }
 
 // Every seed-004 block in one program on the simulated drill: Td detector → P gap controller →
