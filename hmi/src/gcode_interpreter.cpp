@@ -331,7 +331,7 @@ class Interpreter {
       if (lim == nullptr || (v >= lim->min_mm - kEps && v <= lim->max_mm + kEps)) continue;
       const Word* w = b[axis] != nullptr ? b[axis] : at;
       error(b, w,
-            what + std::string(1, axis) + " " + mm(v) + " mm, beyond the " + axis +
+            what + std::string(1, axis) + " " + mm(v) + " mm is beyond the " + axis +
                 " soft limit (" + mm(lim->min_mm) + ".." + mm(lim->max_mm) + " mm)");
     }
   }
@@ -516,7 +516,7 @@ class Interpreter {
     mb.final_radius_mm = r;
     if (need_feed(b, b.nonmodal_g, "G160")) mb.feed_mm_s = feed_mm_min_ / 60.0;
     result_.blocks.push_back(mb);
-    const std::string what = "orbit of radius " + mm(r) + " mm reaches ";
+    const std::string what = "G160 orbit of radius " + mm(r) + " mm: ";
     check_limits(b, {pos_.x - r, pos_.y - r, pos_.z}, b.nonmodal_g, what);
     check_limits(b, {pos_.x + r, pos_.y + r, pos_.z}, b.nonmodal_g, what);
   }
@@ -630,7 +630,7 @@ class Interpreter {
     const ArcBox box =
         arc_bounding_box(start.x - centre.x, start.y - centre.y, target.x - centre.x,
                          target.y - centre.y, mode_ == Motion::kArcCw, full || mb.turns > 0);
-    const std::string what = std::string(name) + " arc reaches ";
+    const std::string what = std::string(name) + " arc: ";
     check_limits(b, {centre.x + box.min_x, centre.y + box.min_y, start.z}, at, what);
     check_limits(b, {centre.x + box.max_x, centre.y + box.max_y, start.z}, at, what);
   }
