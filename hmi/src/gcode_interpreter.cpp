@@ -324,12 +324,14 @@ class Interpreter {
     return mb;
   }
 
+  /// Reports each coordinate of p outside its axis's soft limits, at the axis word of the block
+  /// when `what` is empty (an end point), else at `at` (an arc's or orbit's extent).
   void check_limits(const Block& b, const Vec3& p, const Word* at, const std::string& what) {
     const std::array<std::pair<char, double>, 3> coords{{{'X', p.x}, {'Y', p.y}, {'Z', p.z}}};
     for (const auto& [axis, v] : coords) {
       const machining::AxisLimits* lim = tables_.axis(axis);
       if (lim == nullptr || (v >= lim->min_mm - kEps && v <= lim->max_mm + kEps)) continue;
-      const Word* w = b[axis] != nullptr ? b[axis] : at;
+      const Word* w = what.empty() && b[axis] != nullptr ? b[axis] : at;
       error(b, w,
             what + std::string(1, axis) + " " + mm(v) + " mm is beyond the " + axis +
                 " soft limit (" + mm(lim->min_mm) + ".." + mm(lim->max_mm) + " mm)");
