@@ -1,0 +1,3 @@
+; expect: missing-number.nc:2:5: missing number after 'X'
+G00 X Y1
+M30

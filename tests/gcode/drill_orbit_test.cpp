@@ -1,0 +1,139 @@
+// Gap-controlled drilling blocks with eq. 9-11 wear pre-compensation, rapids while armed, the
+// G160 orbit-finishing cycle and the soft limits.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "gcode_fixture.hpp"
+
+namespace edm::hmi::test {
+namespace {
+
+using machining::Vec3;
+
+// Seed 004 eq. (9)-(11) written out with explicit rates, independently of the library:
+// Tw = lz/(MRRw/A), δ = Vd·Tw with Vd = MRRe/A (eq. 8), lz' = lz + δ; θ = MRRe/MRRw.
+double precompensated_travel(double lz, double theta) {
+  const double area = std::numbers::pi * 0.5 * 0.5;  // Ø1 mm electrode, mm²
+  const double mrr_w = 2.7;                          // mm³/s, any value
+  const double mrr_e = theta * mrr_w;
+  const double tw = lz / (mrr_w / area);     // (9)
+  const double delta = (mrr_e / area) * tw;  // (10)
+  return lz + delta;                         // (11)
+}
+
+TEST(GcodeDrill, G01DownWhileArmedIsAGapControlledDrillBlock) {
+  const GcodeResult r = interpret("G00 X3 Y4 Z0.5\nE1\nG01 Z-20 F60\nM30");
+  ASSERT_TRUE(r.ok()) << joined(r);
+  const auto d = of_kind(r.blocks, MotionKind::kDrill);
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_EQ(d[0].target, (Vec3{3, 4, -20}));  // nominal bottom
+  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(20.5, 0.6), 1e-9);
+  EXPECT_NEAR(d[0].z_travel_mm, 32.8, 1e-9);
+  EXPECT_DOUBLE_EQ(d[0].feed_mm_s, 1.0);  // F caps the gap-controlled speed
+  EXPECT_EQ(d[0].condition, 1);
+  EXPECT_EQ(d[0].line, 3);
+  EXPECT_EQ(d[0].col, 1);
+  EXPECT_EQ(r.drill_blocks, 1);
+  EXPECT_NEAR(r.drill_depth_mm, 20.5, 1e-9);
+  EXPECT_NEAR(r.electrode_wear_mm, 0.6 * 20.5, 1e-9);
+}
+
+TEST(GcodeDrill, UsesTheArmedConditionsWearRatio) {
+  const auto d = of_kind(blocks_of("E2\nG91 G01 Z-4 F30\nZ-6"), MotionKind::kDrill);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(4.0, 0.05), 1e-9);
+  EXPECT_NEAR(d[1].z_travel_mm, precompensated_travel(6.0, 0.05), 1e-9);
+  EXPECT_DOUBLE_EQ(d[1].target.z, -10.0);
+  EXPECT_EQ(d[1].condition, 2);
+}
+
+TEST(GcodeDrill, NotADrillWhenDisarmedMovingUpOrSideways) {
+  const auto b = blocks_of("G01 Z-5 F60\nE1\nG01 Z2\nX5\nE0\nZ-3");
+  ASSERT_EQ(b.size(), 6u);
+  EXPECT_EQ(b[0].kind, MotionKind::kLinear);  // not armed yet
+  EXPECT_EQ(b[2].kind, MotionKind::kLinear);  // up, away from the work
+  EXPECT_EQ(b[3].kind, MotionKind::kLinear);  // sideways at constant Z
+  EXPECT_EQ(b[5].kind, MotionKind::kLinear);  // disarmed
+  EXPECT_EQ(of_kind(b, MotionKind::kDrill).size(), 0u);
+}
+
+TEST(GcodeDrill, RapidsNeverDrillEvenWhenArmed) {
+  const auto b = blocks_of("E1\nG00 Z-5");
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[1].kind, MotionKind::kRapid);
+  EXPECT_EQ(b[1].z_travel_mm, 0.0);
+}
+
+TEST(GcodeDrill, MustBeStraight) {
+  EXPECT_EQ(first_error("E1\nG01 X1 Z-5 F60"),
+            "t.nc:2:5: a drilling block (G01 toward -Z with E1 armed) must not move X or Y: drill "
+            "straight, then move");
+  // Repeating the current X is not a move.
+  EXPECT_EQ(of_kind(blocks_of("E1\nG01 X0 Y0 Z-5 F60"), MotionKind::kDrill).size(), 1u);
+}
+
+TEST(GcodeDrill, PrecompensatedTravelMustStayInsideTheZLimits) {
+  // Nominal −50 is inside −60..20, but the Z axis travels 50·1.6 = 80 mm, to −80.
+  EXPECT_EQ(
+      first_error("E1\nG01 Z-50 F60"),
+      "t.nc:2:5: drilling with wear pre-compensation moves Z to -80.000 mm (nominal -50.000 - "
+      "wear 30.000 mm), beyond the Z soft limit (-60.000..20.000 mm)");
+  EXPECT_TRUE(interpret("E1\nG01 Z-37.5 F60\nM30").ok());  // travel 60: exactly at the limit
+}
+
+TEST(GcodeSoftLimits, EndPointsOutsideTheAxesAreRefusedAtTheirWord) {
+  EXPECT_EQ(first_error("G00 X50 Y101"),
+            "t.nc:1:9: Y 101.000 mm is beyond the Y soft limit (-100.000..100.000 mm)");
+  EXPECT_EQ(first_error("G00 Z21"),
+            "t.nc:1:5: Z 21.000 mm is beyond the Z soft limit (-60.000..20.000 mm)");
+  EXPECT_EQ(first_error("G00 X90\nG91 G01 X20 F10"),
+            "t.nc:2:9: X 110.000 mm is beyond the X soft limit (-100.000..100.000 mm)");
+  EXPECT_TRUE(interpret("G00 X100 Y-100 Z20\nZ-60\nM30").ok());
+  // Axes missing from the table are unlimited.
+  machining::MachineTables t;
+  EXPECT_TRUE(interpret_gcode("G00 X5000 Z-900\nM30", "u.nc", t).ok());
+}
+
+TEST(GcodeOrbit, G160FinishesAboutTheCurrentPoint) {
+  const auto b = blocks_of("G00 X-20 Y10 Z0.5\nE1\nG01 Z-15 F60\nE2\nG160 R0.55 F30");
+  const auto o = of_kind(b, MotionKind::kOrbitFinish);
+  ASSERT_EQ(o.size(), 1u);
+  EXPECT_EQ(o[0].centre, (Vec3{-20, 10, -15}));
+  EXPECT_EQ(o[0].target, (Vec3{-20, 10, -15}));  // back at the centre afterwards
+  EXPECT_DOUBLE_EQ(o[0].final_radius_mm, 0.55);
+  EXPECT_DOUBLE_EQ(o[0].feed_mm_s, 0.5);
+  EXPECT_EQ(o[0].condition, 2);
+  EXPECT_EQ(o[0].line, 5);
+  EXPECT_EQ(o[0].col, 1);
+  // E in the same block arms before the cycle runs.
+  EXPECT_EQ(of_kind(blocks_of("G160 R1 E2 F30"), MotionKind::kOrbitFinish).size(), 1u);
+}
+
+TEST(GcodeOrbit, WordsArmingAndPolarity) {
+  EXPECT_EQ(first_error("E2\nG160 F30"), "t.nc:2:1: G160 needs R (the final hole radius, mm)");
+  EXPECT_EQ(first_error("E2\nG160 R0 F30"), "t.nc:2:6: final radius 'R0' must be > 0 mm");
+  EXPECT_EQ(first_error("G160 R1 F30"),
+            "t.nc:1:1: G160 needs an armed condition: select a positive-polarity finishing "
+            "condition with E<n> first");
+  EXPECT_EQ(first_error("E1\nG160 R1 F30"),
+            "t.nc:2:1: G160 orbit finishing needs a positive-polarity condition; E1 'drill-rough' "
+            "is negative");
+  EXPECT_EQ(first_error("E2\nG160 R1 X1 F30"), "t.nc:2:9: 'X1' cannot share a block with 'G160'");
+  EXPECT_EQ(first_error("E2\nG160 R1"),
+            "t.nc:2:1: G160 needs a feed rate: program F (mm/min) before the first feed move");
+  EXPECT_EQ(first_error("G00 X99.8\nE2\nG160 R0.5 F30"),
+            "t.nc:3:1: G160 orbit of radius 0.500 mm: X 100.300 mm is beyond the X soft limit "
+            "(-100.000..100.000 mm)");
+}
+
+TEST(GcodeOrbit, IsNotModal) {
+  const auto b = blocks_of("E2\nG160 R1 F30\nG00 X5");
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(b[2].kind, MotionKind::kRapid);
+}
+
+}  // namespace
+}  // namespace edm::hmi::test

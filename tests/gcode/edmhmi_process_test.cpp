@@ -1,0 +1,98 @@
+// Runs the edmhmi binary: `check` on good and bad part programs, the not-yet-available bridge
+// commands and bad arguments, checking exit codes and output (DESIGN §4).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "support/subprocess.hpp"
+#include "support/temp_dir.hpp"
+
+namespace edm::hmi::test {
+namespace {
+
+struct Outcome {
+  int code{-1};
+  std::string output;  // stdout and stderr together
+};
+
+Outcome edmhmi(const std::vector<std::string>& args) {
+  std::vector<std::string> argv{EDM_EDMHMI_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  edm::test::Child child(argv);
+  Outcome r;
+  r.code = child.wait();
+  r.output = child.output();
+  return r;
+}
+
+const std::string kParts = std::string(EDM_SOURCE_DIR) + "/examples/parts/";
+
+TEST(EdmhmiCheck, GoodProgramPrintsASummaryAndExitsZero) {
+  const Outcome r = edmhmi({"check", kParts + "blind-hole.nc"});
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("blind-hole.nc: ok: 12 blocks, 1 drilling blocks, 20.500 mm drilled, "
+                          "estimated electrode wear 12.300 mm"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST(EdmhmiCheck, BadProgramPrintsLocatedErrorsAndExitsTwo) {
+  edm::test::TempDir dir;
+  const std::string part = dir.file("bad.nc");
+  std::ofstream(part) << "G00 X0\nG20\nG00 X500\nM30\n";
+  const Outcome r = edmhmi({"check", part});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(part + ":2:1: 'G20' (inch units) is not supported"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(part + ":3:5: X 500.000 mm is beyond the X soft limit"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST(EdmhmiCheck, MachineOptionSelectsTheConditionTable) {
+  // sink-sim has no E2: the finishing example is refused there.
+  const std::string sink = std::string(EDM_SOURCE_DIR) + "/config/machines/sink-sim.yaml";
+  const Outcome r = edmhmi({"check", "--machine", sink, kParts + "drill-then-finish.nc"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(
+      r.output.find("drill-then-finish.nc:12:1: unknown condition 'E2' (this machine has E1)"),
+      std::string::npos)
+      << r.output;
+  const Outcome bad =
+      edmhmi({"check", "--machine", "/nonexistent/m.yaml", kParts + "blind-hole.nc"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.output.find("/nonexistent/m.yaml: cannot open"), std::string::npos) << bad.output;
+}
+
+TEST(EdmhmiCheck, MissingPartFileIsBadInput) {
+  const Outcome r = edmhmi({"check", "/nonexistent/part.nc"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("/nonexistent/part.nc: cannot open"), std::string::npos) << r.output;
+}
+
+TEST(EdmhmiCommands, BridgeCommandsAreNotYetAvailable) {
+  for (const char* c : {"status", "run", "estop"}) {
+    const Outcome r = edmhmi({"--host", "127.0.0.1", c});
+    EXPECT_EQ(r.code, 1) << c;
+    EXPECT_NE(r.output.find("not yet available (issue 5: bridge client)"), std::string::npos)
+        << r.output;
+  }
+}
+
+TEST(EdmhmiCommands, BadArgumentsPrintUsageAndExitTwo) {
+  for (const std::vector<std::string>& args : {std::vector<std::string>{},
+                                               {"frobnicate"},
+                                               {"check"},
+                                               {"check", "a.nc", "b.nc"},
+                                               {"--bogus", "check", "a.nc"},
+                                               {"check", "--machine"}}) {
+    const Outcome r = edmhmi(args);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.output.find("usage: edmhmi"), std::string::npos) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace edm::hmi::test
