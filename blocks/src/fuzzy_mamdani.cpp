@@ -41,7 +41,11 @@ class Cursor {
     skip_blanks();
     return pos_ < text_.size() ? text_[pos_] : '\0';
   }
-  [[nodiscard]] std::size_t pos() const { return pos_; }
+  /// Offset of the next token (blanks skipped).
+  [[nodiscard]] std::size_t pos() {
+    skip_blanks();
+    return pos_;
+  }
 
   /// The next token as written (identifier, number or one character), for "found ..." messages.
   [[nodiscard]] std::string found() {
