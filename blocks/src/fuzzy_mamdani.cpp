@@ -142,7 +142,8 @@ class Cursor {
     err_.offset = offset;
     err_.line = line;
     err_.column = col;
-    err_.message = "line " + std::to_string(line) + ", column " + std::to_string(col) + ": " + msg;
+    err_.message =
+        "at line " + std::to_string(line) + ", column " + std::to_string(col) + ": " + msg;
   }
 
  private:

@@ -17,6 +17,11 @@ std::vector<rt::ParamError> GreyPredictorGM11Params::validate() const {
                     static_cast<double>(kMaxWindow));
   rt::require_range(errs, "horizon", static_cast<double>(horizon), 0.0,
                     static_cast<double>(kMaxHorizon));
+  rt::require_finite(errs, "out_min", out_min);
+  rt::require_finite(errs, "out_max", out_max);
+  if (errs.empty()) {
+    rt::require_ordered(errs, "out_min", out_min, "out_max", out_max);
+  }
   return errs;
 }
 
@@ -117,8 +122,11 @@ rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexc
   if (count_ < n) {
     ++count_;
   }
+  const auto clamped = [this](double y) noexcept {
+    return std::min(std::max(y, params_.out_min), params_.out_max);
+  };
   if (count_ < n) {
-    out_.set(x);
+    out_.set(clamped(x));
     valid_.set(false);
     return rt::BlockStatus::kOk;
   }
@@ -130,7 +138,7 @@ rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexc
   const Fit f = predict(work_.data(), n, params_.horizon, params_.paper_exp);
   c_.set(f.c);
   b_.set(f.b);
-  out_.set(f.valid ? f.prediction : x);
+  out_.set(clamped(f.valid ? f.prediction : x));
   valid_.set(f.valid);
   return rt::BlockStatus::kOk;
 }

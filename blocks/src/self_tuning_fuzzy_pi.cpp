@@ -49,6 +49,7 @@ std::vector<rt::ParamError> SelfTuningFuzzyPIParams::validate() const {
   rt::require_range(errs, "overload_error", overload_error, -1.0, 0.0);
   rt::require_non_negative(errs, "dpf_gain", dpf_gain);
   rt::require_non_negative(errs, "psi_min", psi_min);
+  rt::require_range(errs, "settle_samples", static_cast<double>(settle_samples), 0.0, 1e9);
   rt::require_ordered(errs, "u_min_us", u_min_us, "u_max_us", u_max_us);
   rt::require_ordered(errs, "v_min_v", v_min_v, "v_max_v", v_max_v);
   if (errs.empty()) {
@@ -102,6 +103,7 @@ void SelfTuningFuzzyPI::activate() noexcept {
   v_ = std::min(std::max(p.v_initial_v, p.v_min_v), p.v_max_v);
   have_prev_ = false;
   prev_p_ = 0.0;
+  samples_ = 0;
   arc_off_time_us_.set(u_);
   servo_ref_v_.set(v_);
   du_.set(0.0);
@@ -113,16 +115,22 @@ void SelfTuningFuzzyPI::activate() noexcept {
 
 rt::BlockStatus SelfTuningFuzzyPI::update(const rt::CycleContext& /*ctx*/) noexcept {
   const auto& p = params_;
-  const double rab_p = rab_p_.get();
-  const double rab_f = rab_f_.get();
+  const double rab_p_in = rab_p_.get();
+  const double rab_f_in = rab_f_.get();
   const double ref_in = rab_ref_.get();
-  if (!std::isfinite(rab_p) || !std::isfinite(rab_f) || !std::isfinite(ref_in)) {
+  if (!std::isfinite(rab_p_in) || !std::isfinite(rab_f_in) || !std::isfinite(ref_in)) {
     return rt::BlockStatus::kFault;
   }
+  const double rab_p = std::clamp(rab_p_in, 0.0, 1.0);  // a ratio; predictions may overshoot
+  const double rab_f = std::clamp(rab_f_in, 0.0, 1.0);
   const double ce = have_prev_ ? prev_p_ - rab_p : 0.0;
   prev_p_ = rab_p;
   have_prev_ = true;
-  if (!enable_.get()) {
+  const bool settling = samples_ < p.settle_samples;
+  if (settling) {
+    ++samples_;
+  }
+  if (settling || !enable_.get()) {
     du_.set(0.0);
     saturated_.set(false);
     return rt::BlockStatus::kOk;

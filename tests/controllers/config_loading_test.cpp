@@ -72,7 +72,7 @@ TEST(ControllersConfig, a_malformed_rule_names_the_yaml_position_and_the_text_po
     const std::string msg = e.diagnostics().front().str();
     EXPECT_NE(msg.find("ctl.yaml:"), std::string::npos) << msg;
     EXPECT_NE(msg.find("rules"), std::string::npos) << msg;
-    EXPECT_NE(msg.find("line 1, column 29: expected 'and' or 'then', found 'than'"),
+    EXPECT_NE(msg.find("rules at line 1, column 29: expected 'and' or 'then', found 'than'"),
               std::string::npos)
         << msg;
   }

@@ -195,7 +195,7 @@ TEST(FuzzyServoLUT, malformed_text_is_a_configure_error_naming_field_line_and_co
         ++col;
       }
     }
-    const std::string pos = "line " + std::to_string(line) + ", column " + std::to_string(col);
+    const std::string pos = "at line " + std::to_string(line) + ", column " + std::to_string(col);
     EXPECT_EQ(errs[0].message.rfind(pos, 0), 0u) << c.text << " → " << errs[0].message;
   }
 }

@@ -30,7 +30,7 @@ TEST_P(GreyExponential, predicts_exponential_sequences_exactly) {
   const auto [c, alpha, n, p] = GetParam();
   BlockHarness<GreyPredictorGM11> h;
   ASSERT_TRUE(h.start({.window = n, .horizon = p, .paper_exp = false}).empty());
-  for (int k = 0; k < 60; ++k) {
+  for (int k = 0; k < 25; ++k) {  // 0.42·e^(25+3) stays inside the default clamp (10¹²)
     ASSERT_EQ(h.step(c * std::exp(alpha * k)), BlockStatus::kOk);
     if (k + 1 < n) {
       EXPECT_FALSE(h.out<bool>("valid"));
@@ -174,6 +174,19 @@ TEST(GreyPredictorGM11, non_finite_input_is_not_stored) {
     b.step(x);
     ASSERT_EQ(a.out(), b.out());
   }
+}
+
+TEST(GreyPredictorGM11, out_is_clamped_to_its_range) {
+  // A signal rising from ~0 by a factor 2 per sample: the exact prediction 10 steps ahead is
+  // 1024 × the latest sample; with the Rab range it stays at 1.
+  BlockHarness<GreyPredictorGM11> h;
+  ASSERT_TRUE(h.start({.window = 4, .horizon = 10, .out_min = 0.0, .out_max = 1.0}).empty());
+  for (int k = 0; k < 8; ++k) {
+    h.step(1e-3 * std::exp2(k));
+  }
+  EXPECT_TRUE(h.out<bool>("valid"));
+  EXPECT_EQ(h.out(), 1.0);
+  EXPECT_FALSE((GreyPredictorGM11Params{.out_min = 1.0, .out_max = 0.0}.validate().empty()));
 }
 
 TEST(GreyPredictorGM11, window_is_load_time_only_and_validated) {

@@ -61,7 +61,10 @@ class Pi {
 };
 
 TEST(SelfTuningFuzzyPI, rule_base_at_term_peaks_reproduces_table_3) {
-  const SelfTuningFuzzyPIParams p;  // Ge = 5, Gce = 40, Rab_ref = 0.6
+  // Ge = 10 (not 5) keeps every Rab of the 49 cases inside [0, 1]; the peaks do not depend on Ge.
+  SelfTuningFuzzyPIParams p;
+  p.ge = 10.0;
+  p.rab_ref_default = 0.5;
   for (int row = 0; row < 7; ++row) {
     const int j = 3 - row;  // CE index
     for (int col = 0; col < 7; ++col) {
@@ -282,6 +285,38 @@ TEST(SelfTuningFuzzyPI, closed_loop_with_the_butterworth_and_grey_predictor_chai
     }
   }
   EXPECT_LT(sum_late / n_late, 0.1) << "mean |e| over the second half (started at 0.3)";
+}
+
+TEST(SelfTuningFuzzyPI, rab_inputs_are_clamped_to_the_unit_interval) {
+  // A grey prediction of 3066 (seen on a start-up transient) acts like Rab = 1, not like e = −3066.
+  const SelfTuningFuzzyPIParams p;
+  Pi wild(p);
+  wild.step(1.0, 0.2);
+  wild.step(3066.0, 0.2);
+  Pi one(p);
+  one.step(1.0, 0.2);
+  one.step(1.0, 0.2);
+  EXPECT_EQ(wild.u(), one.u());
+  EXPECT_EQ(wild.psi(), one.psi());
+  EXPECT_NEAR(wild.psi(), p.ol * (1.0 + 100.0 * 0.8), 1e-9);
+  Pi negative(p);
+  negative.step(-0.5);
+  EXPECT_NEAR(negative.du(), SelfTuningFuzzyPI::rule_output(p.ge * p.rab_ref_default, 0.0), 1e-12);
+}
+
+TEST(SelfTuningFuzzyPI, settle_samples_hold_the_actuators_after_activation) {
+  SelfTuningFuzzyPIParams p;
+  p.settle_samples = 10;
+  Pi pi(p);
+  for (int k = 0; k < 10; ++k) {
+    pi.step(0.9 + 0.001 * k);
+    ASSERT_EQ(pi.u(), p.u_initial_us) << "k = " << k;
+    ASSERT_EQ(pi.v(), p.v_initial_v);
+  }
+  pi.step(0.9 + 0.01);  // ce from the tracked previous sample: −0.001
+  EXPECT_GT(pi.u(), p.u_initial_us);
+  EXPECT_NEAR(pi.du(), SelfTuningFuzzyPI::rule_output(p.ge * (0.6 - 0.91), p.gce * (0.909 - 0.91)),
+              1e-12);
 }
 
 TEST(SelfTuningFuzzyPI, validate_refuses_bad_ranges) {

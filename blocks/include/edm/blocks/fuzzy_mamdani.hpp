@@ -11,7 +11,7 @@
 //   if open is L and short is Z then v is PB; if open is Z and short is L then v is NB
 //   keywords `if`, `and`, `is`, `then` in lower case; variable and term names are case-sensitive
 //   identifiers [A-Za-z_][A-Za-z0-9_]*. Only AND (min) is supported: write OR as two rules.
-// Errors name the position in the text as "line L, column C" (1-based, within the string).
+// Errors name the position in the text as "at line L, column C" (1-based, within the string).
 //
 // Inference: rule strength w = min over its clauses of μ(x); implication clips the consequent at
 // w (min); aggregation is max over rules; the crisp output is the centroid of the aggregated set
@@ -61,7 +61,7 @@ struct Rule {
 };
 
 /// A problem in a term or rule text: its 0-based offset, 1-based line and column, and a message
-/// that already starts with "line L, column C: ".
+/// that already starts with "at line L, column C: ".
 struct SyntaxError {
   std::size_t offset{0};
   int line{1};

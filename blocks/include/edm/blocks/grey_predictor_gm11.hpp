@@ -18,7 +18,10 @@
 // as (b − c·x⁰(1))·expm1(c)/c·e^(−c(n+p−1)). Both forms are written without b/c, so c = 0 is
 // not a special case.
 //
-// Outputs: out = x̂⁰(n+p); c and b of the fit; valid = true when out is a prediction.
+// Outputs: out = x̂⁰(n+p) clamped to [out_min, out_max]; c and b of the fit; valid = true when
+// out is a prediction. The clamp matters for a ratio such as Rab: on a start-up transient (the
+// filtered Rab rising from 0) the fit sees explosive relative growth and x̂⁰ can reach 10³ or
+// more; wire out_min = 0, out_max = 1 there.
 // Degenerate windows (documented outputs, never NaN):
 //   - fewer than n samples since activate(): out = the latest sample, valid = false;
 //   - Σ(z−z̄)² = 0 (all zeros, or x⁰ alternating ±v): out = the latest sample, valid = false;
@@ -43,12 +46,16 @@ struct GreyPredictorGM11Params {
   std::int64_t window{5};    // n samples in the fit, 4..kMaxWindow (load time only)
   std::int64_t horizon{37};  // p samples ahead, 0..kMaxHorizon (seed 000: 37 at Wn = 0.012)
   bool paper_exp{false};     // use e^(−c) of eq. (1) instead of the exact discrete ρ
+  double out_min{-1e12};     // out is clamped to [out_min, out_max] (Rab: 0 and 1)
+  double out_max{1e12};
 
   void visit(rt::ParamVisitor& v) {
     v.param("window", window, "samples", "samples in the GM(1,1) fit (4..1024), load time only");
     v.param("horizon", horizon, "samples", "prediction horizon p (0..100000)");
     v.param("paper_exp", paper_exp, "",
             "use exp(-c) of the paper's eq. 1 (not exact on exponentials) instead of rho");
+    v.param("out_min", out_min, "", "lower clamp of out (Rab: 0)");
+    v.param("out_max", out_max, "", "upper clamp of out (Rab: 1)");
   }
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };

@@ -31,6 +31,12 @@
 // - Units: u in µs and v in V (Table 1: 9…50 µs, 30…70 V); Ku in µs and Kv in V per unit of
 //   dU·|e|. The initial u and v (Table 4 is not legible) are parameters.
 // - Rab_ref: the input rab_ref when > 0, else the parameter rab_ref_default.
+// - Rab_p and Rab_f are clamped to [0, 1] (Rab is a ratio) before use: a grey prediction far
+//   outside it (start-up transients) would otherwise multiply the gain through |e| and Ψ.
+// - Start-up: the Butterworth filter and the grey predictor need ~5/(0.7·π·Wn) samples to settle
+//   (≈ 190 at Wn = 0.012); during that transient the prediction is wild and the overload factor
+//   Ψ drives u and v to their limits. settle_samples (default 0, as in the paper) holds u and v
+//   for that many samples after activate() while Rab_p is tracked.
 // - enable = false holds u and v (and remembers Rab_p, so re-enabling does not see a jump in ce).
 // - The paper samples every 40 ms: run the block on a 40 ms task (Ge, Gce, Ku, Kv are per sample).
 //
@@ -38,6 +44,7 @@
 // outputs and returns kFault.
 // RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
 
+#include <cstdint>
 #include <vector>
 
 #include "edm/runtime/block.hpp"
@@ -60,7 +67,8 @@ struct SelfTuningFuzzyPIParams {
   double u_initial_us{20.0};  // arc-off time after activate() [µs]
   double v_min_v{30.0};       // servo reference voltage range, Table 1 [V]
   double v_max_v{70.0};
-  double v_initial_v{40.0};  // servo reference voltage after activate() [V]
+  double v_initial_v{40.0};        // servo reference voltage after activate() [V]
+  std::int64_t settle_samples{0};  // hold u, v for this many samples after activate()
 
   void visit(rt::ParamVisitor& v) {
     v.param("ge", ge, "1", "error scaling Ge (> 0)");
@@ -79,6 +87,8 @@ struct SelfTuningFuzzyPIParams {
     v.param("v_min_v", v_min_v, "V", "lowest servo reference voltage");
     v.param("v_max_v", v_max_v, "V", "highest servo reference voltage");
     v.param("v_initial_v", v_initial_v, "V", "servo reference voltage after activation");
+    v.param("settle_samples", settle_samples, "samples",
+            "hold u and v this many samples after activation while filter and predictor settle");
   }
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
@@ -103,6 +113,7 @@ class SelfTuningFuzzyPI final : public rt::BlockWithParams<SelfTuningFuzzyPIPara
   double v_{0.0};
   double prev_p_{0.0};
   bool have_prev_{false};
+  std::int64_t samples_{0};  // samples since activate(), saturating at settle_samples
 };
 
 }  // namespace edm::blocks
