@@ -1,8 +1,12 @@
 #include "edm/blocks/register.hpp"
 
+#include "edm/blocks/butterworth_low_pass.hpp"
 #include "edm/blocks/circular_interpolator.hpp"
+#include "edm/blocks/discharge_state_counter.hpp"
+#include "edm/blocks/fuzzy_servo_lut.hpp"
 #include "edm/blocks/gain.hpp"
 #include "edm/blocks/gap_controller_p.hpp"
+#include "edm/blocks/grey_predictor_gm11.hpp"
 #include "edm/blocks/integrator.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/linear_interpolator.hpp"
@@ -11,6 +15,7 @@
 #include "edm/blocks/orbit_expander.hpp"
 #include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/position_loop.hpp"
+#include "edm/blocks/self_tuning_fuzzy_pi.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/sine_source.hpp"
 #include "edm/blocks/td_detector.hpp"
@@ -36,6 +41,18 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<LinearInterpolator>("LinearInterpolator", "seed 004 eq. 12-13, exact end point");
   r.add<CircularInterpolator>("CircularInterpolator", "seed 004 eq. 14-19, G02/G03, full circles");
   r.add<OrbitExpander>("OrbitExpander", "seed 004 eq. 20-21: radius += kr·mean Td per revolution");
+  // Seed 003: discharge-state statistics and the fuzzy servo lookup table.
+  r.add<DischargeStateCounter>("DischargeStateCounter",
+                               "seed 003: open/normal/short counts of the last 32 pulses, latched");
+  r.add<FuzzyServoLUT>("FuzzyServoLUT",
+                       "seed 003: Mamdani servo surface precomputed into a 33x33 lookup table");
+  // Seed 000: wire-EDM rupture prevention (Rab filter, grey predictor, self-tuning fuzzy PI).
+  r.add<ButterworthLowPass>("ButterworthLowPass",
+                            "seed 000: 2nd-order Butterworth low-pass, cut-off Wn of Nyquist");
+  r.add<GreyPredictorGM11>("GreyPredictorGM11", "seed 000 eq. 1: GM(1,1) prediction p steps ahead");
+  r.add<SelfTuningFuzzyPI>(
+      "SelfTuningFuzzyPI",
+      "seed 000 eq. 3-9: self-tuning fuzzy PI on Rab -> arc-off time, servo V");
 }
 
 }  // namespace edm::blocks

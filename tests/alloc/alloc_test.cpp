@@ -277,6 +277,65 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
   EXPECT_GT(r->variables().read("drill.arc.swept_rad").value(), 1.0) << "the arc moved";
 }
 
+// Every seed-003 and seed-000 block on the simulated wire machine: discharge-state counter →
+// fuzzy servo table → Z feed; Rab → Butterworth → GM(1,1) → self-tuning fuzzy PI → arc-off time
+// and servo reference voltage. The fuzzy rules come from YAML text (parsed at load time only).
+constexpr const char* kSeed003And000 = R"yaml(version: 1
+machine:
+  name: alloc-003-000
+  io: {driver: sim, params: {preset: wire, seed: 5}}
+tasks:
+  - {name: servo, interval: 1ms, priority: 0, programs: [wire]}
+programs:
+  - name: wire
+    blocks:
+      - {name: dsc, type: DischargeStateCounter, params: {interval: 8}}
+      - name: lut
+        type: FuzzyServoLUT
+        params:
+          v_max_mm_s: 0.5
+          velocity_terms: "NB=tri(-1.5,-1,-0.5) ZE=tri(-0.5,0,0.5) PB=tri(0.5,1,1.5)"
+          rules: |
+            if open is Z and short is Z then v is ZE;
+            if open is M and short is Z then v is PB; if open is L then v is PB;
+            if short is M then v is NB; if short is L then v is NB;
+            if open is Z and short is Z then v is ZE
+      - {name: dir, type: Gain, params: {k: -1.0}}
+      - {name: lp, type: ButterworthLowPass, params: {cutoff: 0.012}}
+      - {name: gm, type: GreyPredictorGM11, params: {window: 5, horizon: 37}}
+      - {name: pi, type: SelfTuningFuzzyPI, params: {ku: 0.06, kv: 0.03, rab_ref_default: 0.3}}
+    wires:
+      dsc.n_open: io.n_open
+      dsc.n_normal: io.n_normal
+      dsc.n_short: io.n_short
+      dsc.n_transient_arc: io.n_transient_arc
+      dsc.n_stable_arc: io.n_stable_arc
+      lut.open_count: dsc.open_count
+      lut.short_count: dsc.short_count
+      dir.in: lut.v_mm_s
+      io.vz_cmd: dir.out
+      lp.in: io.rab
+      gm.in: lp.out
+      pi.rab_p: gm.out
+      pi.rab_f: lp.out
+      io.arc_off_time_us: pi.arc_off_time_us
+      io.servo_ref_v: pi.servo_ref_v
+      io.gen_arm: true
+      io.gen_on: true
+trace:
+  variables: [io.rab, wire.lut.v_mm_s, wire.pi.arc_off_time_us, wire.gm.out]
+)yaml";
+
+TEST(Allocations, NoneInsideCyclesOfTheSeed003And000Blocks) {
+  auto r = build_sim_machine(rt::parse_config_text(kSeed003And000, "alloc-003-000.yaml"));
+  EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
+  const double pulses = r->variables().read("wire.dsc.open_count").value() +
+                        r->variables().read("wire.dsc.normal_count").value() +
+                        r->variables().read("wire.dsc.short_count").value();
+  EXPECT_EQ(pulses, 32.0) << "the counter saw pulses";
+  EXPECT_NE(r->variables().read("wire.pi.arc_off_time_us").value(), 20.0) << "the PI acted";
+}
+
 TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
   // Approach, touch, drilling with wear compensation, on the simulated machine.
   auto r = build_shipped("drill-sim-program");

@@ -1,0 +1,114 @@
+#pragma once
+// FuzzyServoLUT: the servo-feed fuzzy controller of seed 003 (Liu 2011, §2), made real-time the
+// way the paper does it: the fuzzy surface is precomputed into a 2-D lookup table indexed by the
+// open count (high address) and the short count (low address), and each cycle is one read.
+//
+//   configure():  T[o][s] = clamp(centroid(o, s), −1, +1),   o, s = 0…32          (33 × 33 cells)
+//   update():     v_mm_s = v_max_mm_s · T[open_count][short_count]
+//
+// centroid() is a Mamdani inference (fuzzy_mamdani.hpp: min for AND, min implication, max
+// aggregation, centroid on a sampled output universe) over the input variables
+//   open   = open count   [pulses of the last 32]      (terms: open_terms)
+//   short  = short count  [pulses of the last 32]      (terms: short_terms)
+//   normal = 32 − open − short, floored at 0           (terms: normal_terms, optional)
+// and the output variable `v` in normalised units (terms: velocity_terms; ±1 = ±v_max_mm_s).
+// The paper quantises the surface to integers (round(30000·v/366)); we keep doubles.
+//
+// Sign (the paper's): v > 0 advances the electrode into the work (all-open → +v_max), v < 0
+// retracts (all-short → −v_max), all-normal → 0 (hold). On this project's Z axis (+z away from the
+// work) wire io.vz_cmd through a Gain with k = −1.
+//
+// Defaults: three Ruspini-partition terms per input, Z=tri(-14,0,14) M=tri(0,14,32)
+// L=tri(14,32,50) (the paper's example: an open count of 23 is 50 % "open", 32 is 100 %), five
+// symmetric output terms NB…PB at −1, −0.5, 0, +0.5, +1 and the 3 × 3 rule table
+// v = (index(open) − index(short))/2. They give the three corners exactly and a surface that is
+// non-decreasing in the open count and non-increasing in the short count (tests/controllers).
+//
+// Only cells with open + short ≤ 32 are reachable from a DischargeStateCounter; the others are
+// filled too (normal floored at 0) so every in-range read is defined. configure() refuses terms
+// or rules that do not parse (the error names the parameter and "line L, column C"), and a rule
+// base under which no rule fires for some reachable cell; unreachable cells where nothing fires
+// hold 0.
+//
+// Inputs outside 0…32 are a broken signal: v_mm_s is held and update() returns kFault.
+// The term and rule strings are load-time only (string parameters cannot be written at run
+// time); v_max_mm_s can be written at run time (the table is normalised).
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "edm/blocks/fuzzy_mamdani.hpp"
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct FuzzyServoLUTParams {
+  static constexpr const char* kDefaultInputTerms =
+      "Z=tri(-14,0,14) M=tri(0,14,32) L=tri(14,32,50)";
+  static constexpr const char* kDefaultVelocityTerms =
+      "NB=tri(-1.5,-1,-0.5) NS=tri(-1,-0.5,0) ZE=tri(-0.5,0,0.5) PS=tri(0,0.5,1) "
+      "PB=tri(0.5,1,1.5)";
+  static constexpr const char* kDefaultRules =
+      "if open is Z and short is Z then v is ZE; "
+      "if open is Z and short is M then v is NS; "
+      "if open is Z and short is L then v is NB; "
+      "if open is M and short is Z then v is PS; "
+      "if open is M and short is M then v is ZE; "
+      "if open is M and short is L then v is NS; "
+      "if open is L and short is Z then v is PB; "
+      "if open is L and short is M then v is PS; "
+      "if open is L and short is L then v is ZE";
+
+  std::string open_terms{kDefaultInputTerms};
+  std::string short_terms{kDefaultInputTerms};
+  std::string normal_terms{};  // optional; rules may then use `normal is ...`
+  std::string velocity_terms{kDefaultVelocityTerms};
+  std::string rules{kDefaultRules};
+  std::int64_t samples{301};  // points of the sampled output universe, 3..100000
+  double v_max_mm_s{5.0};     // [mm/s] > 0: |v| at a normalised output of 1 (paper: ±5)
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("open_terms", open_terms, "pulses",
+            "terms of the open count, e.g. 'Z=tri(-14,0,14) ...'");
+    v.param("short_terms", short_terms, "pulses", "terms of the short count");
+    v.param("normal_terms", normal_terms, "pulses",
+            "terms of the normal count 32 - open - short (optional)");
+    v.param("velocity_terms", velocity_terms, "1", "output terms in units of v_max_mm_s");
+    v.param("rules", rules, "", "'if open is L and short is Z then v is PB; ...'");
+    v.param("samples", samples, "", "points of the sampled output universe (3..100000)");
+    v.param("v_max_mm_s", v_max_mm_s, "mm/s", "speed at a normalised output of +-1 (> 0)");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class FuzzyServoLUT final : public rt::BlockWithParams<FuzzyServoLUTParams> {
+ public:
+  static constexpr int kCounts = 33;  // counts 0…32
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Parses terms and rules, builds the engine and fills the table.
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. v_mm_s = table value at (0, 0) · v_max.
+  void activate() noexcept override;
+  /// RT-safe. One table read. kOk, or kFault (output held) for counts outside 0…32.
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+
+  /// The normalised table value T[o][s] in [−1, 1]. Owning thread only (tests).
+  [[nodiscard]] double table(int open, int shorts) const noexcept {
+    return table_[static_cast<std::size_t>(open * kCounts + shorts)];
+  }
+  /// The engine built by configure() (null before). Inputs are {open, short, normal}.
+  [[nodiscard]] const fuzzy::MamdaniEngine* engine() const noexcept { return engine_.get(); }
+
+ private:
+  rt::Input<std::int64_t> open_count_, short_count_;
+  rt::Output<double> v_mm_s_;
+  std::array<double, static_cast<std::size_t>(kCounts* kCounts)> table_{};
+  std::unique_ptr<fuzzy::MamdaniEngine> engine_;
+};
+
+}  // namespace edm::blocks

@@ -1,0 +1,119 @@
+#pragma once
+// SelfTuningFuzzyPI: the gain self-tuning PI-type fuzzy controller of seed 000 (Lee & Liao 2003,
+// §3.3, eq. 3-9, Tables 3 and 5) that holds the abnormal ratio Rab of a wire-EDM at its set point
+// by acting on the arc-off time u and the servo reference voltage v.
+//
+//   e(k)  = Rab_ref − Rab_p(k)                      ce(k) = Rab_p(k−1) − Rab_p(k)   (0 at start)
+//   E     = Ge·e,   CE = Gce·ce                                                  (eq. 3a, 3b)
+//   dU    = height defuzzification of the 7 × 7 rule base of Table 3,
+//           rule (E is A_i, CE is A_j) → dU is A_clamp(−(i+j), −3, 3),  i, j = −3…+3 (NB…PB)
+//           = Σ w_ij·clamp(−(i+j)) / Σ w_ij,   w_ij = min(μ_i(E), μ_j(CE))
+//   Φ     = g1 + g2·f(CE, 5E),  g1 = (1+α)/2, g2 = (1−α)/2, f(x, a) = (1 − e^(−a·x))/(1 + e^(−a·x))
+//   Ψ     = max(psi_min, ol·(1 + dpf_gain·d_pf)) if e < overload_error, else 1;  d_pf = Rab_p −
+//   Rab_f Gu    = Ku·|e|·Φ·Ψ,   Gv = Kv·|e|·Φ·Ψ                                          (eq. 6a,
+//   6b) u(k)  = clamp(u(k−1) + dU·Gu, u_min_us, u_max_us)                          (eq. 4a, 5a)
+//   v(k)  = clamp(v(k−1) + dU·Gv, v_min_v, v_max_v)                            (eq. 4b, 5b)
+//
+// Raising u or v lowers Rab (paper, Figs. 2-3): Rab above the set point gives e < 0, dU > 0, and
+// both actuators rise. Φ → 1 when E and CE have the same sign (the error grows) and → α when they
+// differ (approaching the set point: overshoot attenuation). Ψ boosts the action in overload.
+//
+// Choices where the paper is silent or garbled (see docs/controllers.md):
+// - Terms (Fig. 6 is not legible): seven triangles with peaks at −3…+3 and half-width 1 on E, CE
+//   and dU; E and CE beyond ±3 saturate to the outer terms (NB/PB shoulders). At term peaks dU is
+//   exactly the table value; between them it interpolates.
+// - Table 3 is read back as dU = clamp(−(E + CE)) (SEEDS.md; the extracted table has a missing
+//   cell in column PS and agrees with the formula elsewhere).
+// - Eq. (8) reads "e < 0.01" in the extracted text; SEEDS.md gives e < −0.01 (Rab above the set
+//   point), which we use as the default of `overload_error`.
+// - Ψ is floored at psi_min (default 0): ol·(1 + 100·d_pf) turns negative for d_pf < −0.01 and
+//   would reverse the action; the floor only prevents that reversal.
+// - Units: u in µs and v in V (Table 1: 9…50 µs, 30…70 V); Ku in µs and Kv in V per unit of
+//   dU·|e|. The initial u and v (Table 4 is not legible) are parameters.
+// - Rab_ref: the input rab_ref when > 0, else the parameter rab_ref_default.
+// - Rab_p and Rab_f are clamped to [0, 1] (Rab is a ratio) before use: a grey prediction far
+//   outside it (start-up transients) would otherwise multiply the gain through |e| and Ψ.
+// - Start-up: the Butterworth filter and the grey predictor need ~5/(0.7·π·Wn) samples to settle
+//   (≈ 190 at Wn = 0.012); during that transient the prediction is wild and the overload factor
+//   Ψ drives u and v to their limits. settle_samples (default 0, as in the paper) holds u and v
+//   for that many samples after activate() while Rab_p is tracked.
+// - enable = false holds u and v (and remembers Rab_p, so re-enabling does not see a jump in ce).
+// - The paper samples every 40 ms: run the block on a 40 ms task (Ge, Gce, Ku, Kv are per sample).
+//
+// Status: kSaturated when an actuator clamp cut the step, else kOk. A non-finite input holds the
+// outputs and returns kFault.
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+
+#include <cstdint>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct SelfTuningFuzzyPIParams {
+  double ge{5.0};                // Ge [1/Rab], Table 5
+  double gce{40.0};              // Gce [1/Rab], Table 5
+  double alpha{0.7};             // α in (0, 1], Table 5
+  double ol{2.0};                // overloading parameter, Table 5
+  double ku{0.06};               // Ku [µs], Table 5 case 1
+  double kv{0.03};               // Kv [V], Table 5 case 1
+  double rab_ref_default{0.6};   // Rab_ref in (0, 1] while the rab_ref input is 0, Table 5 case 1
+  double overload_error{-0.01};  // Ψ applies when e < this (eq. 8)
+  double dpf_gain{100.0};        // the 100 of eq. 8
+  double psi_min{0.0};           // floor of Ψ in overload (≥ 0)
+  double u_min_us{9.0};          // arc-off time range, Table 1 [µs]
+  double u_max_us{50.0};
+  double u_initial_us{20.0};  // arc-off time after activate() [µs]
+  double v_min_v{30.0};       // servo reference voltage range, Table 1 [V]
+  double v_max_v{70.0};
+  double v_initial_v{40.0};        // servo reference voltage after activate() [V]
+  std::int64_t settle_samples{0};  // hold u, v for this many samples after activate()
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("ge", ge, "1", "error scaling Ge (> 0)");
+    v.param("gce", gce, "1", "change-of-error scaling Gce (> 0)");
+    v.param("alpha", alpha, "1", "overshoot attenuation alpha in (0, 1]");
+    v.param("ol", ol, "1", "overloading parameter ol (> 0)");
+    v.param("ku", ku, "us", "global gain of the arc-off time (>= 0)");
+    v.param("kv", kv, "V", "global gain of the servo reference voltage (>= 0)");
+    v.param("rab_ref_default", rab_ref_default, "1", "Rab set point while rab_ref is 0, (0, 1]");
+    v.param("overload_error", overload_error, "1", "Psi applies when e is below this (<= 0)");
+    v.param("dpf_gain", dpf_gain, "1", "gain on d_pf = Rab_p - Rab_f in Psi (>= 0)");
+    v.param("psi_min", psi_min, "1", "floor of Psi in overload (>= 0)");
+    v.param("u_min_us", u_min_us, "us", "shortest arc-off time");
+    v.param("u_max_us", u_max_us, "us", "longest arc-off time");
+    v.param("u_initial_us", u_initial_us, "us", "arc-off time after activation");
+    v.param("v_min_v", v_min_v, "V", "lowest servo reference voltage");
+    v.param("v_max_v", v_max_v, "V", "highest servo reference voltage");
+    v.param("v_initial_v", v_initial_v, "V", "servo reference voltage after activation");
+    v.param("settle_samples", settle_samples, "samples",
+            "hold u and v this many samples after activation while filter and predictor settle");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class SelfTuningFuzzyPI final : public rt::BlockWithParams<SelfTuningFuzzyPIParams> {
+ public:
+  /// Crisp dU of the rule base for E and CE (height defuzzification, see above). Pure, RT-safe.
+  static double rule_output(double e_scaled, double ce_scaled) noexcept;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. u = u_initial_us, v = v_initial_v (clamped), du = 0, phi = psi = 1.
+  void activate() noexcept override;
+  /// RT-safe. kOk, kSaturated (an actuator limit cut the step) or kFault (non-finite input).
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+
+ private:
+  rt::Input<double> rab_p_, rab_f_, rab_ref_;
+  rt::Input<bool> enable_{true};
+  rt::Output<double> arc_off_time_us_, servo_ref_v_, du_, phi_, psi_, error_;
+  rt::Output<bool> saturated_;
+  double u_{0.0};
+  double v_{0.0};
+  double prev_p_{0.0};
+  bool have_prev_{false};
+  std::int64_t samples_{0};  // samples since activate(), saturating at settle_samples
+};
+
+}  // namespace edm::blocks

@@ -1,0 +1,98 @@
+#include "edm/blocks/fuzzy_servo_lut.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace edm::blocks {
+namespace {
+
+constexpr int kWindow = 32;  // pulses in the seed-003 shift registers
+
+}  // namespace
+
+std::vector<rt::ParamError> FuzzyServoLUTParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "samples", static_cast<double>(samples), 3.0, 100000.0);
+  rt::require_finite(errs, "v_max_mm_s", v_max_mm_s);
+  if (errs.empty()) {
+    rt::require_positive(errs, "v_max_mm_s", v_max_mm_s);
+  }
+  return errs;
+}
+
+void FuzzyServoLUT::visit_pins(rt::PinVisitor& v) {
+  v.input("open_count", open_count_, "pulses");
+  v.input("short_count", short_count_, "pulses");
+  v.output("v_mm_s", v_mm_s_, "mm/s");
+}
+
+std::vector<rt::ParamError> FuzzyServoLUT::configure(const rt::BlockSetup& /*setup*/) {
+  std::vector<rt::ParamError> errs = params_.validate();
+  if (!errs.empty()) {
+    return errs;
+  }
+  fuzzy::SyntaxError se;
+  const auto terms = [&](const char* field, const std::string& text, bool optional,
+                         fuzzy::Variable& var) {
+    if (optional && std::all_of(text.begin(), text.end(), [](char c) {
+          return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+        })) {
+      return;  // an empty optional variable: rules that use it get "unknown term"
+    }
+    if (auto t = fuzzy::parse_terms(text, se)) {
+      var.terms = std::move(*t);
+    } else {
+      errs.push_back({field, se.message});
+    }
+  };
+  std::vector<fuzzy::Variable> inputs(3);
+  inputs[0].name = "open";
+  inputs[1].name = "short";
+  inputs[2].name = "normal";
+  fuzzy::Variable out;
+  out.name = "v";
+  terms("open_terms", params_.open_terms, false, inputs[0]);
+  terms("short_terms", params_.short_terms, false, inputs[1]);
+  terms("normal_terms", params_.normal_terms, true, inputs[2]);
+  terms("velocity_terms", params_.velocity_terms, false, out);
+  if (!errs.empty()) {
+    return errs;
+  }
+  auto rules = fuzzy::parse_rules(params_.rules, inputs, out, se);
+  if (!rules) {
+    return {{"rules", se.message}};
+  }
+  engine_ =
+      std::make_unique<fuzzy::MamdaniEngine>(std::move(inputs), std::move(out), std::move(*rules),
+                                             static_cast<std::size_t>(params_.samples));
+  for (int o = 0; o < kCounts; ++o) {
+    for (int s = 0; s < kCounts; ++s) {
+      const double x[3] = {static_cast<double>(o), static_cast<double>(s),
+                           static_cast<double>(std::max(0, kWindow - o - s))};
+      const double y = engine_->infer(x);
+      const bool reachable = o + s <= kWindow;
+      if (std::isnan(y) && reachable) {
+        return {{"rules", "no rule fires at open = " + std::to_string(o) + ", short = " +
+                              std::to_string(s) + " (every reachable cell needs one)"}};
+      }
+      table_[static_cast<std::size_t>(o * kCounts + s)] =
+          std::isnan(y) ? 0.0 : std::clamp(y, -1.0, 1.0);
+    }
+  }
+  return errs;
+}
+
+void FuzzyServoLUT::activate() noexcept { v_mm_s_.set(params_.v_max_mm_s * table(0, 0)); }
+
+rt::BlockStatus FuzzyServoLUT::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const std::int64_t o = open_count_.get();
+  const std::int64_t s = short_count_.get();
+  if (o < 0 || o > kWindow || s < 0 || s > kWindow) {
+    return rt::BlockStatus::kFault;
+  }
+  v_mm_s_.set(params_.v_max_mm_s * table_[static_cast<std::size_t>(o * kCounts + s)]);
+  return rt::BlockStatus::kOk;
+}
+
+}  // namespace edm::blocks

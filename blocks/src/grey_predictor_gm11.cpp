@@ -1,0 +1,154 @@
+#include "edm/blocks/grey_predictor_gm11.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edm::blocks {
+namespace {
+
+// Index of `window` in GreyPredictorGM11Params::visit().
+constexpr std::size_t kWindowIndex = 0;
+
+}  // namespace
+
+std::vector<rt::ParamError> GreyPredictorGM11Params::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "window", static_cast<double>(window), 4.0,
+                    static_cast<double>(kMaxWindow));
+  rt::require_range(errs, "horizon", static_cast<double>(horizon), 0.0,
+                    static_cast<double>(kMaxHorizon));
+  rt::require_finite(errs, "out_min", out_min);
+  rt::require_finite(errs, "out_max", out_max);
+  if (errs.empty()) {
+    rt::require_ordered(errs, "out_min", out_min, "out_max", out_max);
+  }
+  return errs;
+}
+
+GreyPredictorGM11::Fit GreyPredictorGM11::predict(const double* x, std::size_t n,
+                                                  std::int64_t horizon, bool paper_exp) noexcept {
+  Fit f;
+  if (n < 2) {
+    return f;
+  }
+  // Means of z(k) and x⁰(k) over k = 2…n.
+  const auto m = static_cast<double>(n - 1);
+  double x1 = x[0];  // x¹(k−1)
+  double zsum = 0.0;
+  double xsum = 0.0;
+  for (std::size_t k = 1; k < n; ++k) {
+    zsum += x1 + 0.5 * x[k];
+    xsum += x[k];
+    x1 += x[k];
+  }
+  const double zbar = zsum / m;
+  const double xbar = xsum / m;
+  double szz = 0.0;
+  double szx = 0.0;
+  x1 = x[0];
+  for (std::size_t k = 1; k < n; ++k) {
+    const double dz = x1 + 0.5 * x[k] - zbar;
+    szz += dz * dz;
+    szx += dz * (x[k] - xbar);
+    x1 += x[k];
+  }
+  if (!(szz > 0.0)) {
+    return f;  // all z equal: no slope to fit
+  }
+  const double c = -szx / szz;
+  const double b = xbar + c * zbar;
+  if (!std::isfinite(c) || !std::isfinite(b)) {
+    return f;  // huge inputs overflowed the sums
+  }
+  f.c = c;
+  f.b = b;
+  if (!(std::fabs(c) < 2.0)) {
+    return f;
+  }
+  const double k_ahead = static_cast<double>(n) + static_cast<double>(horizon);  // index n + p
+  double y = 0.0;
+  if (paper_exp) {
+    const double e = c == 0.0 ? 1.0 : std::expm1(c) / c;
+    y = (b - c * x[0]) * e * std::exp(-c * (k_ahead - 1.0));
+  } else {
+    const double rho = (1.0 - 0.5 * c) / (1.0 + 0.5 * c);
+    y = (b - c * x[0]) / (1.0 + 0.5 * c) * std::pow(rho, k_ahead - 2.0);
+  }
+  if (!std::isfinite(y)) {
+    return f;
+  }
+  f.prediction = y;
+  f.valid = true;
+  return f;
+}
+
+void GreyPredictorGM11::visit_pins(rt::PinVisitor& v) {
+  v.input("in", in_);
+  v.output("out", out_);
+  v.output("c", c_, "1");
+  v.output("b", b_);
+  v.output("valid", valid_);
+}
+
+std::vector<rt::ParamError> GreyPredictorGM11::configure(const rt::BlockSetup& /*setup*/) {
+  auto errs = params_.validate();
+  if (!errs.empty()) {
+    return errs;
+  }
+  ring_.assign(static_cast<std::size_t>(params_.window), 0.0);
+  work_.assign(ring_.size(), 0.0);
+  activate();
+  return errs;
+}
+
+void GreyPredictorGM11::activate() noexcept {
+  std::fill(ring_.begin(), ring_.end(), 0.0);
+  next_ = 0;
+  count_ = 0;
+  out_.set(0.0);
+  c_.set(0.0);
+  b_.set(0.0);
+  valid_.set(false);
+}
+
+rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const double x = in_.get();
+  const std::size_t n = ring_.size();
+  if (!std::isfinite(x) || n == 0) {
+    return rt::BlockStatus::kFault;
+  }
+  ring_[next_] = x;
+  next_ = next_ + 1 == n ? 0 : next_ + 1;
+  if (count_ < n) {
+    ++count_;
+  }
+  const auto clamped = [this](double y) noexcept {
+    return std::min(std::max(y, params_.out_min), params_.out_max);
+  };
+  if (count_ < n) {
+    out_.set(clamped(x));
+    valid_.set(false);
+    return rt::BlockStatus::kOk;
+  }
+  // next_ is now the oldest slot.
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = next_ + i;
+    work_[i] = ring_[j < n ? j : j - n];
+  }
+  const Fit f = predict(work_.data(), n, params_.horizon, params_.paper_exp);
+  c_.set(f.c);
+  b_.set(f.b);
+  out_.set(clamped(f.valid ? f.prediction : x));
+  valid_.set(f.valid);
+  return rt::BlockStatus::kOk;
+}
+
+std::vector<rt::ParamError> GreyPredictorGM11::stage_param(std::size_t index,
+                                                           const rt::ParamValue& v) {
+  if (index == kWindowIndex) {
+    return {{"window", "cannot change at run time (it sizes the ring); reload the config"}};
+  }
+  return BlockWithParams::stage_param(index, v);
+}
+
+}  // namespace edm::blocks

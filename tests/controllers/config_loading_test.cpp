@@ -1,0 +1,82 @@
+// The controller blocks through the YAML loader: the fuzzy term/rule text arrives as string
+// parameters, and a malformed rule is reported with the file position of the parameter and the
+// line/column inside the text.
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "edm/blocks/register.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/diagnostics.hpp"
+#include "edm/runtime/loopback_driver.hpp"
+#include "edm/runtime/runtime.hpp"
+
+namespace edm::blocks {
+namespace {
+
+std::unique_ptr<rt::Runtime> build(const std::string& yaml) {
+  static const auto regs = [] {
+    std::pair<rt::BlockRegistry, rt::DriverRegistry> r;
+    register_builtin_blocks(r.first);
+    rt::register_runtime_drivers(r.second);
+    return r;
+  }();
+  return rt::Runtime::build(rt::parse_config_text(yaml, "ctl.yaml"), regs.first, regs.second);
+}
+
+std::string config(const std::string& rules) {
+  return R"yaml(version: 1
+machine:
+  name: ctl
+  io: {driver: loopback, task: t, params: {channels: 1}}
+tasks:
+  - {name: t, interval: 40ms, priority: 0, programs: [p]}
+programs:
+  - name: p
+    blocks:
+      - {name: dsc, type: DischargeStateCounter, params: {interval: 32}}
+      - name: lut
+        type: FuzzyServoLUT
+        params:
+          rules: )yaml" +
+         rules + R"yaml(
+      - {name: lp, type: ButterworthLowPass, params: {cutoff: 0.012}}
+      - {name: gm, type: GreyPredictorGM11, params: {window: 5, horizon: 37}}
+      - {name: pi, type: SelfTuningFuzzyPI, params: {ku: 0.08, kv: 0.16, rab_ref_default: 0.42}}
+    wires:
+      lut.open_count: dsc.open_count
+      lut.short_count: dsc.short_count
+      gm.in: lp.out
+      pi.rab_p: gm.out
+      pi.rab_f: lp.out
+)yaml";
+}
+
+TEST(ControllersConfig, a_full_seed_003_and_000_program_loads_from_yaml) {
+  const std::string rules =
+      "\"if open is L then v is PB; if short is L then v is NB; if open is Z and short is Z "
+      "then v is ZE; if open is M and short is Z then v is PS; if open is Z and short is M then v "
+      "is NS; if open is M and short is M then v is ZE\"";
+  auto r = build(config(rules));
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->variables().read("p.pi.ku"), 0.08);
+  EXPECT_EQ(r->variables().read("p.gm.horizon"), 37.0);
+}
+
+TEST(ControllersConfig, a_malformed_rule_names_the_yaml_position_and_the_text_position) {
+  try {
+    build(config("\"if open is L and short is Z than v is PB\""));
+    FAIL() << "accepted";
+  } catch (const rt::ConfigError& e) {
+    const std::string msg = e.diagnostics().front().str();
+    EXPECT_NE(msg.find("ctl.yaml:"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("rules"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("rules at line 1, column 29: expected 'and' or 'then', found 'than'"),
+              std::string::npos)
+        << msg;
+  }
+}
+
+}  // namespace
+}  // namespace edm::blocks
