@@ -151,3 +151,67 @@ INSTANTIATE_TEST_SUITE_P(Seeds, DrillSeeds, ::testing::Values(1, 2, 3));
 
 }  // namespace
 }  // namespace edm::test
+
+namespace edm::test {
+namespace {
+
+// A through hole in a 3 mm plate: sparks stop when the front leaves the work; with `through` set
+// DeepHoleDrill sees the breakthrough, feeds on overtravel_mm, retracts and ends DONE well before
+// the 10 mm it was asked for. The same plate without `through` keeps feeding (a blind-hole cycle
+// must never stop early on a dark spell).
+struct Through {
+  bool done{false};
+  bool breakthrough{false};
+  double depth_reached_mm{0.0};
+  double z_at_done_mm{0.0};
+};
+
+Through run_through(bool through) {
+  Through t;
+  std::string text = slurp(kConfig);
+  replace_once(text, "params: {preset: drill, seed: 1}",
+               "params: {preset: drill, seed: 1, work_thickness_mm: 3}");
+  replace_once(text, "depth_default_mm: 20", "depth_default_mm: 10");
+  replace_once(
+      text, "      drill.start: true",
+      std::string("      drill.start: true\n      drill.through: ") + (through ? "true" : "false"));
+  rt::BlockRegistry blocks;
+  blocks::register_builtin_blocks(blocks);
+  programs::register_builtin_programs(blocks);
+  rt::DriverRegistry drivers;
+  rt::register_runtime_drivers(drivers);
+  sim::register_sim_driver(drivers);
+  auto r = rt::Runtime::build(rt::parse_config_text(text, "through.yaml"), blocks, drivers);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  auto& vars = r->variables();
+  std::ostringstream sink;
+  for (std::int64_t k = 0; k < 60'000; ++k) {
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    if (vars.read("cycle.drill.breakthrough").value() != 0.0) t.breakthrough = true;
+    if (vars.read("cycle.drill.state").value() == 4.0) {
+      t.done = true;
+      break;
+    }
+  }
+  t.depth_reached_mm = vars.read("cycle.drill.depth_reached_mm").value();
+  t.z_at_done_mm = vars.read("io.z_mm").value();
+  return t;
+}
+
+TEST(DrillThrough, BreakthroughIsDetectedOnlyForThroughHoles) {
+  const Through t = run_through(true);
+  ASSERT_TRUE(t.done) << "a through hole in a 3 mm plate ends";
+  EXPECT_TRUE(t.breakthrough);
+  EXPECT_GT(t.depth_reached_mm, 3.0 - 0.2) << "not before the front reached the far side";
+  EXPECT_LT(t.depth_reached_mm, 10.0 - 1.0) << "well before the commanded 10 mm";
+  const Through blind = run_through(false);
+  EXPECT_FALSE(blind.breakthrough);
+}
+
+}  // namespace
+}  // namespace edm::test
