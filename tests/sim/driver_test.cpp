@@ -22,7 +22,7 @@ std::string slurp(const std::string& p) {
   return ss.str();
 }
 
-const std::string kDrill = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml";
+const std::string kDrill = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim-program.yaml";
 
 TEST(SimDriver, SameSeedGivesByteIdenticalTracesAndAnotherSeedDoesNot) {
   TempDir dir("edm-sim");
