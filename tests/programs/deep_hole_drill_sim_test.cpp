@@ -18,6 +18,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "sim_machine.hpp"
 
 namespace edm::test {
 namespace {
@@ -58,14 +59,8 @@ Outcome run(int seed, bool wear_comp, double limit_s = 200.0) {
   if (!wear_comp) {
     replace_once(text, "drill.enable_wear_comp: true", "drill.enable_wear_comp: false");
   }
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  rt::register_runtime_drivers(drivers);
-  sim::register_sim_driver(drivers);
   rt::Config cfg = rt::parse_config_text(text, "drill-sim-program.yaml");
-  auto r = rt::Runtime::build(cfg, blocks, drivers);
+  auto r = build_sim_machine(cfg);
   r->machine().command(rt::MachineCommand::kPowerOn);
   rt::VirtualClock clock;
   auto& task = *r->tasks()[0];
@@ -175,13 +170,7 @@ Through run_through(bool through) {
   replace_once(
       text, "      drill.start: true",
       std::string("      drill.start: true\n      drill.through: ") + (through ? "true" : "false"));
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  rt::register_runtime_drivers(drivers);
-  sim::register_sim_driver(drivers);
-  auto r = rt::Runtime::build(rt::parse_config_text(text, "through.yaml"), blocks, drivers);
+  auto r = build_sim_machine(rt::parse_config_text(text, "through.yaml"));
   r->machine().command(rt::MachineCommand::kPowerOn);
   rt::VirtualClock clock;
   auto& task = *r->tasks()[0];

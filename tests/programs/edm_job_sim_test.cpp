@@ -18,6 +18,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "sim_machine.hpp"
 
 namespace edm::test {
 namespace {
@@ -82,17 +83,10 @@ struct JobResult {
 
 JobResult run_job(int seed, double depth, double final_radius) {
   JobResult res;
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  rt::register_runtime_drivers(drivers);
-  sim::register_sim_driver(drivers);
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(seed);
-  auto r = rt::Runtime::build(
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"),
-      blocks, drivers, opts);
+  auto r = build_sim_machine(
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"), opts);
   const auto program = drill_then_finish(depth, final_radius);
   const auto issues = machining::check_program(program, r->tables(), {0, 0, 0.1});
   EXPECT_TRUE(issues.empty()) << issues[0].message;

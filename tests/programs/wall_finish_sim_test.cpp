@@ -21,6 +21,7 @@
 #include "edm/runtime/runtime.hpp"
 #include "edm/sim/plant.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "sim_machine.hpp"
 
 namespace edm::test {
 namespace {
@@ -61,14 +62,8 @@ Finish run(int seed, double final_offset_mm, double limit_s) {
   replace_once(text, "seed: 1", "seed: " + std::to_string(seed));
   replace_once(text, "finish.final_offset_mm: 0.048",
                "finish.final_offset_mm: " + std::to_string(final_offset_mm));
-  rt::BlockRegistry blocks;
-  blocks::register_builtin_blocks(blocks);
-  programs::register_builtin_programs(blocks);
-  rt::DriverRegistry drivers;
-  rt::register_runtime_drivers(drivers);
-  sim::register_sim_driver(drivers);
   rt::Config cfg = rt::parse_config_text(text, "finish-sim-program.yaml");
-  auto r = rt::Runtime::build(cfg, blocks, drivers);
+  auto r = build_sim_machine(cfg);
   r->machine().command(rt::MachineCommand::kPowerOn);
   rt::VirtualClock clock;
   auto& task = *r->tasks()[0];
