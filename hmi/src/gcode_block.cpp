@@ -1,0 +1,169 @@
+// Word rules of a block; see gcode_block.hpp and docs/gcode.md.
+
+#include "gcode_block.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace edm::hmi::detail {
+
+int code10(const Word& w) noexcept {
+  if (!(w.value >= 0.0 && w.value < 10000.0)) return -1;
+  const double scaled = w.value * 10.0;
+  const double r = std::round(scaled);
+  return std::fabs(scaled - r) < 1e-6 ? static_cast<int>(r) : -1;
+}
+
+std::string word_text(const Word& w) { return "'" + std::string(w.text) + "'"; }
+
+bool is_whole(double v) noexcept { return std::fabs(v) < 1e9 && v == std::floor(v); }
+
+namespace {
+
+class Sorter {
+ public:
+  explicit Sorter(std::vector<GcodeError>& errors) : errors_(errors) {}
+
+  bool set_group(const Block& b, const Word*& slot, const Word& w, const char* group) {
+    if (slot != nullptr) {
+      error(b, &w,
+            word_text(w) + " conflicts with " + word_text(*slot) + " in the same block: both are " +
+                group);
+      return false;
+    }
+    slot = &w;
+    return true;
+  }
+
+  bool sort_g(Block& b, const Word& w) {
+    switch (code10(w)) {
+      case 0:
+      case 10:
+      case 20:
+      case 30:
+        return set_group(b, b.motion_g, w, "motion codes (modal group 1: G00 G01 G02 G03)");
+      case 40:
+      case 1600:
+        return set_group(b, b.nonmodal_g, w, "non-modal codes (group 0: G04 G160)");
+      case 170:
+        return set_group(b, b.plane_g, w, "plane codes (modal group 2)");
+      case 210:
+        return set_group(b, b.units_g, w, "unit codes (modal group 6)");
+      case 900:
+      case 910:
+        return set_group(b, b.distance_g, w, "distance-mode codes (modal group 3: G90 G91)");
+      case 180:
+      case 190:
+        error(b, &w, word_text(w) + " is not supported: arcs are in the XY plane only (G17)");
+        return false;
+      case 200:
+        error(b, &w,
+              word_text(w) + " (inch units) is not supported: this dialect is mm only (G21)");
+        return false;
+      default:
+        error(b, &w, "unknown G code " + word_text(w));
+        return false;
+    }
+  }
+
+  bool sort_m(Block& b, const Word& w) {
+    switch (code10(w)) {
+      case 20:
+      case 300:
+        return set_group(b, b.stop_m, w, "program-end codes (modal group 4: M02 M30)");
+      case 30:
+      case 50:
+        return set_group(b, b.rotation_m, w, "rotation codes (modal group 7: M03 M05)");
+      case 80:
+      case 90:
+        return set_group(b, b.flushing_m, w, "flushing codes (modal group 8: M08 M09)");
+      default:
+        error(b, &w, "unknown M code " + word_text(w));
+        return false;
+    }
+  }
+
+  bool sort_words(const std::vector<Word>& words, Block& b) {
+    bool ok = true;
+    b.first = &words.front();
+    for (std::size_t i = 0; i < words.size(); ++i) {
+      const Word& w = words[i];
+      switch (w.letter) {
+        case 'N':
+          if (i != 0) {
+            error(b, &w, "'N' (block number) must be the first word of the block");
+            ok = false;
+          } else if (w.value < 0.0 || !is_whole(w.value)) {
+            error(b, &w, "block number " + word_text(w) + " must be a whole number >= 0");
+            ok = false;
+          }
+          break;
+        case 'G':
+          ok = sort_g(b, w) && ok;
+          break;
+        case 'M':
+          ok = sort_m(b, w) && ok;
+          break;
+        case 'X':
+        case 'Y':
+        case 'Z':
+        case 'I':
+        case 'J':
+        case 'F':
+        case 'E':
+        case 'P':
+        case 'R': {
+          const Word*& slot = b.value[static_cast<std::size_t>(w.letter - 'A')];
+          if (slot != nullptr) {
+            error(b, &w,
+                  std::string("'") + w.letter + "' given twice in one block (first at column " +
+                      std::to_string(slot->col) + ")");
+            ok = false;
+          } else {
+            slot = &w;
+          }
+          break;
+        }
+        case 'K':
+          error(b, &w,
+                "unknown word " + word_text(w) +
+                    ": arcs are in the XY plane only (G17), their centre is given by I and J");
+          ok = false;
+          break;
+        default:
+          error(b, &w,
+                "unknown word " + word_text(w) + ": this dialect has no '" + w.letter + "' words");
+          ok = false;
+          break;
+      }
+    }
+    if (!ok) return false;
+    // G04 and G160 run on their own: no motion code, axis or centre words beside them.
+    if (b.nonmodal_g != nullptr) {
+      for (const Word* w : {b.motion_g, b['X'], b['Y'], b['Z'], b['I'], b['J']}) {
+        if (w != nullptr) {
+          error(b, w, word_text(*w) + " cannot share a block with " + word_text(*b.nonmodal_g));
+          ok = false;
+        }
+      }
+    }
+    return ok;
+  }
+
+ private:
+  void error(const Block& b, const Word* at, std::string message) {
+    errors_.push_back({b.line, at != nullptr ? at->col : 1, std::move(message)});
+  }
+
+  std::vector<GcodeError>& errors_;
+};
+
+}  // namespace
+
+bool sort_block(const std::vector<Word>& words, int line, Block& b,
+                std::vector<GcodeError>& errors) {
+  b.line = line;
+  return Sorter(errors).sort_words(words, b);
+}
+
+}  // namespace edm::hmi::detail
