@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "edm/blocks/register.hpp"
+#include "edm/bridge/server.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/log.hpp"
@@ -204,9 +205,20 @@ int main(int argc, char** argv) {
   }
   const int bridge_port =
       opt.bridge_port.value_or(rt->config().bridge.loc.line != 0 ? rt->config().bridge.port : 0);
+  std::unique_ptr<edm::bridge::Server> bridge;
   if (bridge_port != 0) {
-    spdlog::warn("bridge: not yet available in this build (port {} requested); running without",
-                 bridge_port);
+    edm::bridge::ServerOptions bo = edm::bridge::options_from_config(rt->config().bridge);
+    bo.port = static_cast<std::uint16_t>(bridge_port);
+    bridge = std::make_unique<edm::bridge::Server>(*rt, bo);
+    try {
+      bridge->start();
+    } catch (const edm::bridge::BridgeError& e) {
+      spdlog::error("{}", e.what());
+      bridge.reset();
+      rt.reset();
+      edm::rt::shutdown_logging();
+      return kExitBadInput;
+    }
   }
 
   struct sigaction sa {};
@@ -239,6 +251,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     code = kExitFailure;
+  }
+  if (bridge) {
+    bridge->stop();  // before the runtime goes: the server reads its machine, job and registry
+    bridge.reset();
   }
   rt.reset();
   edm::rt::shutdown_logging();

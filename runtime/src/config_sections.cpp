@@ -395,8 +395,9 @@ void Parser::parse_trace(const Value& v, TraceSpec& out) {
 
 void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(
-      v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions", "max_line_bytes"});
+  auto m =
+      r_.map(v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions",
+                 "max_line_bytes", "read_timeout", "queue_limit", "stall_timeout", "status_vars"});
   if (!m) {
     return;
   }
@@ -412,6 +413,25 @@ void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   }
   int_in(*m, "max_sessions", 1, 64, out.max_sessions);
   int_in(*m, "max_line_bytes", 1024, kMaxLineBytes, out.max_line_bytes);
+  for (auto [key, dest] : {std::pair{"read_timeout", &out.read_timeout},
+                           std::pair{"stall_timeout", &out.stall_timeout}}) {
+    if (const Field* f = m->find(key)) {
+      if (auto d = r_.duration(f->value)) {
+        if (*d < std::chrono::milliseconds(100) || *d > std::chrono::hours(24)) {
+          r_.error(f->value, std::string(key) + " must be between 100ms and 24h");
+        } else {
+          *dest = *d;
+        }
+      }
+    }
+  }
+  int_in(*m, "queue_limit", 16, 65536, out.queue_limit);
+  if (const Field* f = m->find("status_vars")) {
+    out.status_vars = parse_variable_names(f->value);
+    if (out.status_vars.size() > 16) {
+      r_.error(f->value, "at most 16 status variables");
+    }
+  }
 }
 
 void Parser::parse_retain(const Value& v, RetainSpec& out) {

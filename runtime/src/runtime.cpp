@@ -47,6 +47,9 @@ void Runtime::drain_alarms() {
       spdlog::warn("alarm {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
                    to_string(a.code), a.source, t_s, a.text, a.value);
     }
+    for (const auto& listener : alarm_listeners_) {
+      listener(a);
+    }
   }
 }
 

@@ -81,6 +81,9 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   if (trace_ != nullptr) {
     trace_->sample(trace_channel_, release, cycle);
   }
+  for (CycleObserver* o : observers_) {
+    o->on_cycle_end(ctx);
+  }
 
   const TimePoint end = clock.now();
   const Duration exec = end - start;

@@ -263,3 +263,34 @@ TEST(Hostile, null_sections_say_how_to_write_empty) {
 
 }  // namespace
 }  // namespace edm::rt
+
+namespace edm::rt {
+namespace {
+
+// The bridge keys added with the server (issue 5): parsed with units, ranges checked with
+// file:line:col.
+TEST(BridgeKeys, timeouts_queue_and_status_vars_parse) {
+  const Config cfg =
+      parse_config_text(kHead + kTasks +
+                            "programs: [{name: p}]\n"
+                            "bridge: {read_timeout: 30s, stall_timeout: 750ms, queue_limit: 64,\n"
+                            "         status_vars: [io.z_mm, p.b.out]}\n",
+                        "t.yaml");
+  EXPECT_EQ(cfg.bridge.read_timeout, std::chrono::seconds(30));
+  EXPECT_EQ(cfg.bridge.stall_timeout, std::chrono::milliseconds(750));
+  EXPECT_EQ(cfg.bridge.queue_limit, 64u);
+  ASSERT_EQ(cfg.bridge.status_vars.size(), 2u);
+  EXPECT_EQ(cfg.bridge.status_vars[1].name, "p.b.out");
+}
+
+TEST(BridgeKeys, out_of_range_values_name_their_position) {
+  EXPECT_EQ(first_error(kHead + kTasks + "programs: [{name: p}]\nbridge: {queue_limit: 2}\n"),
+            "t.yaml:6:23: bridge.queue_limit: must be in 16..65536 (got 2)");
+  const std::string e =
+      first_error(kHead + kTasks + "programs: [{name: p}]\nbridge: {read_timeout: 1ms}\n");
+  EXPECT_EQ(e.rfind("t.yaml:6:24: ", 0), 0u) << e;
+  EXPECT_NE(e.find("read_timeout must be between 100ms and 24h"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace edm::rt

@@ -136,6 +136,10 @@ struct BridgeSpec {
   std::string viewer_token_file;  // viewer role
   int max_sessions{8};
   std::size_t max_line_bytes{1u << 20};
+  Duration read_timeout{std::chrono::seconds(60)};  // no request for this long: close
+  std::size_t queue_limit{256};  // queued messages per session before events are dropped
+  Duration stall_timeout{std::chrono::seconds(5)};  // dropping that long: disconnect
+  std::vector<NameRef> status_vars;  // key pins of the status snapshot (default: docs/protocol.md)
   SourceLoc loc;
 };
 

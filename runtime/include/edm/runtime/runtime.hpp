@@ -7,6 +7,7 @@
 // variables() and stats are safe to use from other non-RT threads.
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -74,6 +75,13 @@ class Runtime {
   [[nodiscard]] const Config& config() const noexcept { return config_; }
   /// The loaded part program and its progress (DESIGN §2: the runtime owns it).
   [[nodiscard]] JobStore& job() noexcept { return job_; }
+  /// Adds a consumer of every alarm (besides the log): called on the controlling thread, in
+  /// order, each time run() drains the machine's alarm queue (every ~20 ms on the real clock,
+  /// every 1024 cycles on the virtual one). The RT side only ever pushes into that lock-free
+  /// queue, so a slow listener delays the log, never a task. Non-RT; call before run().
+  void add_alarm_listener(std::function<void(const Alarm&)> listener) {
+    alarm_listeners_.push_back(std::move(listener));
+  }
   /// The config's conditions and soft limits, in the form part programs are checked against.
   [[nodiscard]] const machining::MachineTables& tables() const noexcept { return tables_; }
 
@@ -94,6 +102,7 @@ class Runtime {
   bool has_trace_{false};
   std::unique_ptr<RetainStore> retain_;
   std::string retain_warning_;
+  std::vector<std::function<void(const Alarm&)>> alarm_listeners_;
 };
 
 }  // namespace edm::rt

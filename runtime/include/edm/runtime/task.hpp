@@ -18,6 +18,7 @@
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
+#include "edm/runtime/cycle_observer.hpp"
 #include "edm/runtime/io_driver.hpp"
 #include "edm/runtime/machine.hpp"
 #include "edm/runtime/program.hpp"
@@ -50,6 +51,9 @@ class Task {
     trace_ = &t;
     trace_channel_ = channel;
   }
+  /// Adds an end-of-cycle observer (bridge status/trace tap). Non-RT, before the task runs; the
+  /// observer must outlive the task's run.
+  void add_observer(CycleObserver& o) { observers_.push_back(&o); }
   /// Stops sampling the trace (no --trace-out: nothing would drain the ring). Non-RT, before run.
   void detach_trace() noexcept { trace_ = nullptr; }
 
@@ -88,6 +92,7 @@ class Task {
   IoDriver* driver_{nullptr};
   TraceRecorder* trace_{nullptr};
   std::uint32_t trace_channel_{0};
+  std::vector<CycleObserver*> observers_;
   TaskStats stats_;
   Watchdog watchdog_;
   std::atomic<std::uint64_t> cycle_{0};

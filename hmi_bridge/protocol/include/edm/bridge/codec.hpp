@@ -1,0 +1,105 @@
+#pragma once
+// JSON encoding of the protocol's messages (docs/protocol.md): requests, replies, errors,
+// events, motion blocks, status, and the program checksum.
+//
+// Thread-safety: pure functions (thread-safe); Crc32 is a value type (thread-compatible).
+// Not RT-safe: everything here may allocate.
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "edm/bridge/protocol.hpp"
+#include "edm/machining/motion_block.hpp"
+
+namespace edm::bridge {
+
+using Json = nlohmann::json;
+
+// ---- motion blocks ------------------------------------------------------------------------
+// {"kind": "drill", "line": 12, "col": 1, "target": [x, y, z], "centre": [x, y, z], "turns": 0,
+//  "feed_mm_s": 0.5, "condition": 1, "z_travel_mm": 10.6, "final_radius_mm": 0, "dwell_s": 0,
+//  "on": false}. Only `kind` is required; absent fields take the MotionBlock defaults, and the
+// encoder leaves out fields equal to their default (a 100,000-block upload stays small).
+
+Json to_json(const machining::MotionBlock& b);
+/// Decodes one block; on failure returns false and says which field is wrong in `error`.
+/// Unknown fields, wrong types, non-finite numbers and out-of-range integers are errors.
+bool from_json(const Json& j, machining::MotionBlock& out, std::string& error);
+
+// ---- program checksum ---------------------------------------------------------------------
+// CRC-32 (IEEE 802.3, the zlib/PNG polynomial; Python: zlib.crc32) over each block's canonical
+// 98-byte little-endian record, in program order:
+//   u8 kind, i32 line, i32 col, f64 target.x/y/z, f64 centre.x/y/z, i32 turns, f64 feed_mm_s,
+//   i32 condition, f64 z_travel_mm, f64 final_radius_mm, f64 dwell_s, u8 on
+// (Python: struct.pack('<Bii6didi3dB', ...)). It covers the decoded values, so it catches a
+// lost, repeated or reordered chunk and any number the JSON round trip changed.
+inline constexpr std::size_t kBlockRecordBytes = 98;
+
+class Crc32 {
+ public:
+  void update(std::span<const std::uint8_t> bytes) noexcept;
+  void update(const machining::MotionBlock& b) noexcept;
+  [[nodiscard]] std::uint32_t value() const noexcept { return ~state_; }
+
+ private:
+  std::uint32_t state_{0xFFFFFFFFu};
+};
+
+std::uint32_t program_checksum(std::span<const machining::MotionBlock> blocks) noexcept;
+/// 8 lower-case hex digits.
+std::string format_checksum(std::uint32_t crc);
+/// Accepts the 8-hex-digit string form; false otherwise.
+bool parse_checksum(const Json& j, std::uint32_t& out) noexcept;
+
+// ---- requests, replies, events --------------------------------------------------------------
+
+/// {"id": id, "op": op, ...params}. params must be an object or null.
+Json make_request(std::int64_t id, std::string_view op, const Json& params = Json::object());
+/// {"id": id, "ok": true, ...body}. body must be an object or null; id null is left out.
+Json make_reply(const Json& id, const Json& body = Json::object());
+/// {"id": id, "ok": false, "error": {"code", "message"[, "details"]}}.
+Json make_error(const Json& id, ErrorCode code, std::string_view message,
+                const Json& details = nullptr);
+/// {"event": name, "seq": seq, ...body}.
+Json make_event(std::string_view name, std::uint64_t seq, const Json& body = Json::object());
+
+/// One line as the server sees it: a JSON object with a string `op` (id optional).
+struct ParsedRequest {
+  Json id;  // null when absent
+  std::string op;
+  Json msg;  // the whole object
+};
+/// Parses one line (without its newline). On failure returns nullopt and sets code/message:
+/// kBadJson for text that is not a JSON object, kBadRequest for a missing or non-string op or an
+/// id that is neither a number nor a string.
+std::optional<ParsedRequest> parse_request(std::string_view line, ErrorCode& code,
+                                           std::string& message, Json& id_if_known);
+
+/// Compact single-line text plus '\n'. Invalid UTF-8 in strings is replaced, never thrown.
+std::string to_line(const Json& j);
+
+// ---- status -------------------------------------------------------------------------------
+
+/// The `status` reply body and the `status` event body.
+struct StatusMessage {
+  std::string state;        // OFF, READY, RUNNING, HOLD, FAULT, ESTOP
+  int cause{0};             // alarm code of the last entry into a safe state (0 = none)
+  double t_s{0.0};          // release time of the cycle the snapshot was taken in (s)
+  std::uint64_t cycle{0};   // that cycle's number (of the I/O task)
+  std::string job_outcome;  // none, running, finished, aborted
+  std::uint64_t job_generation{0};
+  std::uint64_t job_block{0};  // index of the block being executed
+  std::uint64_t job_blocks{0};
+  std::int32_t job_line{0};                          // its G-code line
+  std::vector<std::pair<std::string, double>> vars;  // the configured key variables
+  std::uint64_t dropped{0};  // events this session has lost to a full queue (events only)
+};
+Json to_json(const StatusMessage& s);
+bool from_json(const Json& j, StatusMessage& out, std::string& error);
+
+}  // namespace edm::bridge

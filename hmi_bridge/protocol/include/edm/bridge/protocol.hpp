@@ -1,0 +1,60 @@
+#pragma once
+// The HMI bridge protocol (DESIGN §9, docs/protocol.md): JSON Lines over TCP. This header holds
+// what both ends share — version, limits, error codes, roles, the op table — with no dependency
+// on the runtime (the HMI process links it) and no I/O.
+//
+// Thread-safety: pure data and pure functions (thread-safe). Not for RT threads (the codec
+// allocates).
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace edm::bridge {
+
+inline constexpr int kProtocolVersion = 1;
+inline constexpr std::uint16_t kDefaultPort = 7730;
+/// Longest line either side accepts, newline excluded (DESIGN §9: 1 MiB).
+inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+/// Status subscription rates the server accepts (Hz).
+inline constexpr int kMinRateHz = 1;
+inline constexpr int kMaxRateHz = 100;
+/// Most blocks one program may have (the same bound check_program() enforces).
+inline constexpr std::size_t kMaxProgramBlocks = 1'000'000;
+
+/// Stable error codes (the `error.code` string of a failed reply).
+enum class ErrorCode : std::uint8_t {
+  kBadJson,       // the line is not a JSON object
+  kBadRequest,    // well-formed JSON, but a field is missing, of the wrong type or out of range
+  kUnknownOp,     // `op` names no operation
+  kUnauthorized,  // no hello yet, or a wrong token / protocol version
+  kForbidden,     // the session's role may not do this (viewer)
+  kInvalidState,  // the machine's state does not allow it (e.g. resume when idle)
+  kNotFound,      // no such variable / upload
+  kTooLarge,      // a line over the limit, or a program over kMaxProgramBlocks
+  kBusy,          // the resource is in use (job running, queue full, too many sessions)
+};
+inline constexpr int kErrorCodeCount = 9;
+
+std::string_view to_string(ErrorCode c) noexcept;
+bool error_code_from_string(std::string_view s, ErrorCode& out) noexcept;
+
+enum class Role : std::uint8_t { kViewer, kOperator };
+std::string_view to_string(Role r) noexcept;
+
+/// Every op and whether only an operator may run it.
+struct OpInfo {
+  std::string_view name;
+  bool operator_only;
+};
+std::span<const OpInfo> all_ops() noexcept;
+/// nullptr when the op is unknown.
+const OpInfo* find_op(std::string_view name) noexcept;
+
+/// Subscription topics.
+inline constexpr std::string_view kTopicStatus = "status";
+inline constexpr std::string_view kTopicAlarm = "alarm";
+inline constexpr std::string_view kTopicProgress = "progress";
+
+}  // namespace edm::bridge

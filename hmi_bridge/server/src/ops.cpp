@@ -1,0 +1,502 @@
+// The protocol's operations (docs/protocol.md), run on the server thread for one session.
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <variant>
+
+#include "edm/machining/program_check.hpp"
+#include "edm/runtime/stats_json.hpp"
+#include "server_impl.hpp"
+
+namespace edm::bridge {
+
+namespace {
+
+constexpr std::size_t kMaxIssuesReported = 100;
+
+struct Error {
+  ErrorCode code;
+  std::string message;
+  Json details{nullptr};
+};
+
+using Body = std::variant<Json, Error>;
+
+Body error(ErrorCode code, std::string message, Json details = nullptr) {
+  return Error{code, std::move(message), std::move(details)};
+}
+
+/// A required field of type T, or an error naming it.
+template <class Pred>
+const Json* field(const Json& msg, const char* key, Pred ok) {
+  auto it = msg.find(key);
+  if (it == msg.end() || !ok(*it)) {
+    return nullptr;
+  }
+  return &*it;
+}
+
+ErrorCode var_error(rt::VarResult r) {
+  switch (r) {
+    case rt::VarResult::kNotFound:
+      return ErrorCode::kNotFound;
+    case rt::VarResult::kBusy:
+      return ErrorCode::kBusy;
+    default:
+      return ErrorCode::kBadRequest;
+  }
+}
+
+Body op_hello(Session& s, const Json& msg) {
+  auto& srv = s.server();
+  const Json* proto = field(msg, "protocol", [](const Json& j) { return j.is_number_integer(); });
+  if (proto == nullptr || proto->get<std::int64_t>() != kProtocolVersion) {
+    return error(ErrorCode::kUnauthorized,
+                 "protocol version " + std::to_string(kProtocolVersion) + " required");
+  }
+  std::string token;
+  if (auto it = msg.find("token"); it != msg.end() && it->is_string()) {
+    token = it->get<std::string>();
+  }
+  const auto role = authenticate(srv.tokens, token, s.loopback());
+  if (!role) {
+    return error(ErrorCode::kUnauthorized, "bad token");
+  }
+  s.role_ = role;
+  return Json{{"role", std::string(to_string(*role))},
+              {"protocol", kProtocolVersion},
+              {"server", "edmplc"},
+              {"session", s.id()},
+              {"max_line_bytes", srv.opt.max_line_bytes},
+              {"read_timeout_ms", srv.opt.read_timeout.count()}};
+}
+
+Body op_subscribe(Session& s, const Json& msg) {
+  bool status = false;
+  bool alarm = false;
+  bool progress = false;
+  const Json* topics = field(msg, "topics", [](const Json& j) { return j.is_array(); });
+  if (topics == nullptr || topics->empty()) {
+    return error(ErrorCode::kBadRequest, "'topics' must be a non-empty array");
+  }
+  for (const auto& t : *topics) {
+    if (t == kTopicStatus) {
+      status = true;
+    } else if (t == kTopicAlarm) {
+      alarm = true;
+    } else if (t == kTopicProgress) {
+      progress = true;
+    } else {
+      return error(ErrorCode::kBadRequest,
+                   "unknown topic " + t.dump() + " (status, alarm, progress; traces: trace.start)");
+    }
+  }
+  int rate = s.rate_hz_ > 0 ? s.rate_hz_ : 10;
+  if (auto it = msg.find("rate_hz"); it != msg.end()) {
+    if (!it->is_number_integer() || it->get<std::int64_t>() < kMinRateHz ||
+        it->get<std::int64_t>() > kMaxRateHz) {
+      return error(ErrorCode::kBadRequest, "'rate_hz' must be an integer 1..100");
+    }
+    rate = it->get<int>();
+  }
+  s.sub_alarm_ = s.sub_alarm_ || alarm;
+  s.sub_progress_ = s.sub_progress_ || progress;
+  if (status) {
+    s.sub_status_ = true;
+    s.rate_hz_ = rate;
+    s.restart_status_timer();
+  }
+  Json subs = Json::array();
+  for (auto [on, name] : {std::pair{s.sub_status_, kTopicStatus},
+                          {s.sub_alarm_, kTopicAlarm},
+                          {s.sub_progress_, kTopicProgress}}) {
+    if (on) {
+      subs.push_back(std::string(name));
+    }
+  }
+  return Json{{"topics", std::move(subs)}, {"rate_hz", s.sub_status_ ? s.rate_hz_ : 0}};
+}
+
+Body op_unsubscribe(Session& s, const Json& msg) {
+  const Json* topics = field(msg, "topics", [](const Json& j) { return j.is_array(); });
+  const bool all = topics == nullptr;
+  auto drop = [&](std::string_view t) {
+    return all || std::find(topics->begin(), topics->end(), Json(std::string(t))) != topics->end();
+  };
+  if (drop(kTopicStatus)) {
+    s.sub_status_ = false;
+    s.restart_status_timer();
+  }
+  if (drop(kTopicAlarm)) {
+    s.sub_alarm_ = false;
+  }
+  if (drop(kTopicProgress)) {
+    s.sub_progress_ = false;
+  }
+  return Json::object();
+}
+
+Body op_program_begin(Session& s, const Json& msg) {
+  const Json* n = field(msg, "blocks", [](const Json& j) { return j.is_number_unsigned(); });
+  if (n == nullptr || n->get<std::uint64_t>() == 0) {
+    return error(ErrorCode::kBadRequest, "'blocks' must be the program's block count (> 0)");
+  }
+  if (n->get<std::uint64_t>() > kMaxProgramBlocks) {
+    return error(ErrorCode::kTooLarge,
+                 "a program has at most " + std::to_string(kMaxProgramBlocks) + " blocks");
+  }
+  static std::uint64_t next_upload = 1;
+  Upload u;
+  u.id = next_upload++;
+  u.expected = n->get<std::size_t>();
+  u.blocks.reserve(u.expected);
+  s.upload_ = std::move(u);
+  return Json{{"upload", s.upload_->id}, {"blocks", s.upload_->expected}};
+}
+
+Body op_program_chunk(Session& s, const Json& msg) {
+  if (!s.upload_) {
+    return error(ErrorCode::kNotFound, "no upload in progress (program.begin first)");
+  }
+  Upload& u = *s.upload_;
+  const Json* first = field(msg, "first", [](const Json& j) { return j.is_number_unsigned(); });
+  const Json* blocks = field(msg, "blocks", [](const Json& j) { return j.is_array(); });
+  if (first == nullptr || blocks == nullptr) {
+    return error(ErrorCode::kBadRequest,
+                 "'first' (index of the chunk's first block) and 'blocks' (array) are required");
+  }
+  if (first->get<std::uint64_t>() != u.blocks.size()) {
+    return error(ErrorCode::kBadRequest,
+                 "chunk out of order: expected first = " + std::to_string(u.blocks.size()),
+                 Json{{"expected_first", u.blocks.size()}});
+  }
+  if (u.blocks.size() + blocks->size() > u.expected) {
+    return error(ErrorCode::kBadRequest, "more blocks than announced in program.begin (" +
+                                             std::to_string(u.expected) + ")");
+  }
+  // Decode the whole chunk first: a bad chunk leaves the upload as it was (resend it).
+  std::vector<machining::MotionBlock> decoded(blocks->size());
+  std::string why;
+  for (std::size_t i = 0; i < blocks->size(); ++i) {
+    if (!from_json((*blocks)[i], decoded[i], why)) {
+      const std::size_t index = u.blocks.size() + i;
+      return error(ErrorCode::kBadRequest, "block " + std::to_string(index) + ": " + why,
+                   Json{{"block", index}});
+    }
+  }
+  for (const auto& b : decoded) {
+    u.crc.update(b);
+    u.blocks.push_back(b);
+  }
+  return Json{{"received", u.blocks.size()}};
+}
+
+Body op_program_commit(Session& s, const Json& msg) {
+  auto& srv = s.server();
+  if (!s.upload_) {
+    return error(ErrorCode::kNotFound, "no upload in progress (program.begin first)");
+  }
+  std::uint32_t want = 0;
+  auto it = msg.find("checksum");
+  if (it == msg.end() || !parse_checksum(*it, want)) {
+    return error(ErrorCode::kBadRequest, "'checksum' must be 8 hex digits (CRC-32, see protocol)");
+  }
+  Upload& u = *s.upload_;
+  if (u.blocks.size() != u.expected) {
+    return error(ErrorCode::kBadRequest, "incomplete program: " + std::to_string(u.blocks.size()) +
+                                             " of " + std::to_string(u.expected) +
+                                             " blocks received");
+  }
+  const std::uint32_t got = u.crc.value();
+  if (got != want) {
+    s.upload_.reset();
+    return error(ErrorCode::kBadRequest, "checksum mismatch; upload discarded",
+                 Json{{"expected", format_checksum(want)}, {"computed", format_checksum(got)}});
+  }
+  auto& rt = srv.rt;
+  const rt::MachineState state = rt.machine().state();
+  if (rt.job().active() || state == rt::MachineState::kRunning ||
+      state == rt::MachineState::kHold) {
+    return error(ErrorCode::kBusy, std::string("the machine is ") + std::string(to_string(state)) +
+                                       "; a program is swapped in only when idle");
+  }
+  // The program starts where the machine is now.
+  const machining::Vec3 start{rt.variables().read("io.x_mm").value_or(0.0),
+                              rt.variables().read("io.y_mm").value_or(0.0),
+                              rt.variables().read("io.z_mm").value_or(0.0)};
+  const auto issues = machining::check_program(u.blocks, rt.tables(), start);
+  if (!issues.empty()) {
+    Json list = Json::array();
+    for (std::size_t i = 0; i < issues.size() && i < kMaxIssuesReported; ++i) {
+      const auto& is = issues[i];
+      list.push_back(
+          {{"block", is.block}, {"line", is.line}, {"col", is.col}, {"message", is.message}});
+    }
+    const auto& f = issues.front();
+    std::string text =
+        "line " + std::to_string(f.line) + ":" + std::to_string(f.col) + ": " + f.message;
+    if (issues.size() > 1) {
+      text += " (and " + std::to_string(issues.size() - 1) + " more)";
+    }
+    return error(ErrorCode::kBadRequest, text,
+                 Json{{"issues", std::move(list)}, {"count", issues.size()}});
+  }
+  const std::size_t n = u.blocks.size();
+  if (rt.job().load(std::move(u.blocks)) != rt::LoadResult::kOk) {
+    s.upload_.reset();
+    return error(ErrorCode::kBusy, "a job became active; program not swapped");
+  }
+  s.upload_.reset();
+  srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
+  spdlog::info("bridge: session {} committed a program of {} blocks (crc32 {})", s.id(), n,
+               format_checksum(got));
+  return Json{{"blocks", n},
+              {"checksum", format_checksum(got)},
+              {"generation", rt.job().progress().generation}};
+}
+
+Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
+  auto& m = s.server().rt.machine();
+  const rt::MachineState before = m.state();
+  if (m.command(c) != rt::CommandResult::kOk) {
+    return error(ErrorCode::kInvalidState,
+                 std::string(op) + " is not allowed in " + std::string(to_string(before)));
+  }
+  return Json{{"state", std::string(to_string(m.state()))}};
+}
+
+Body op_var_list(Session& s, const Json& msg) {
+  std::string prefix;
+  if (auto it = msg.find("prefix"); it != msg.end()) {
+    if (!it->is_string()) {
+      return error(ErrorCode::kBadRequest, "'prefix' must be a string");
+    }
+    prefix = it->get<std::string>();
+  }
+  auto& reg = s.server().rt.variables();
+  const auto forced_list = reg.forced();
+  const std::set<std::string> forced(forced_list.begin(), forced_list.end());
+  Json vars = Json::array();
+  for (const auto& v : reg.all()) {
+    if (v.name.compare(0, prefix.size(), prefix) != 0) {
+      continue;
+    }
+    vars.push_back({{"name", v.name},
+                    {"kind", std::string(to_string(v.kind))},
+                    {"type", std::string(v.type_name())},
+                    {"unit", v.unit},
+                    {"task", v.owner != nullptr ? v.owner->name() : ""},
+                    {"forced", forced.count(v.name) > 0}});
+  }
+  return Json{{"vars", std::move(vars)}};
+}
+
+Body op_var_read(Session& s, const Json& msg) {
+  std::vector<std::string> names;
+  if (auto it = msg.find("names"); it != msg.end() && it->is_array() && !it->empty()) {
+    for (const auto& n : *it) {
+      if (!n.is_string()) {
+        return error(ErrorCode::kBadRequest, "'names' must be an array of strings");
+      }
+      names.push_back(n.get<std::string>());
+    }
+  } else if (auto n = msg.find("name"); n != msg.end() && n->is_string()) {
+    names.push_back(n->get<std::string>());
+  } else {
+    return error(ErrorCode::kBadRequest, "'name' (string) or 'names' (array) is required");
+  }
+  auto& reg = s.server().rt.variables();
+  Json values = Json::object();
+  for (const auto& name : names) {
+    const rt::Variable* v = reg.find(name);
+    if (v == nullptr) {
+      return error(ErrorCode::kNotFound, "no variable '" + name + "'", Json{{"name", name}});
+    }
+    const auto value = reg.read(name);
+    values[name] = value && std::isfinite(*value) ? Json(*value) : Json(nullptr);
+  }
+  return Json{{"values", std::move(values)}};
+}
+
+Body op_var_write(Session& s, const Json& msg, bool force) {
+  const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
+  const Json* value =
+      field(msg, "value", [](const Json& j) { return j.is_number() || j.is_boolean(); });
+  if (name == nullptr ||
+      (value == nullptr && !(msg.contains("value") && msg["value"].is_string() && !force))) {
+    return error(ErrorCode::kBadRequest,
+                 "'name' (string) and 'value' (number or boolean; durations: \"2ms\") required");
+  }
+  auto& reg = s.server().rt.variables();
+  const auto& n = name->get_ref<const std::string&>();
+  rt::VarStatus st;
+  if (value == nullptr) {  // a duration parameter as text
+    const auto d = rt::parse_duration(msg["value"].get<std::string>());
+    if (!d.value) {
+      return error(ErrorCode::kBadRequest, "'value': " + d.error);
+    }
+    st = reg.write(n, rt::ParamValue::of_duration(*d.value));
+  } else {
+    const double x = value->is_boolean() ? (value->get<bool>() ? 1.0 : 0.0) : value->get<double>();
+    st = force ? reg.force(n, x) : reg.write(n, x);
+  }
+  if (!st) {
+    return error(var_error(st.result), st.message.empty() ? "refused" : st.message);
+  }
+  return Json{{"name", n}};
+}
+
+Body op_var_unforce(Session& s, const Json& msg) {
+  const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
+  if (name == nullptr) {
+    return error(ErrorCode::kBadRequest, "'name' (string) required");
+  }
+  const auto st = s.server().rt.variables().unforce(name->get<std::string>());
+  if (!st) {
+    return error(var_error(st.result), st.message.empty() ? "refused" : st.message);
+  }
+  return Json{{"name", *name}};
+}
+
+Body op_tasks_stats(Session& s) {
+  auto& srv = s.server();
+  Json doc = Json::parse(rt::stats_to_json(srv.rt.stats_reports()));
+  const ServerStats st = srv.stats_snapshot();
+  doc["bridge"] = {{"sessions_open", st.sessions_open},
+                   {"sessions_accepted", st.sessions_accepted},
+                   {"sessions_refused", st.sessions_refused},
+                   {"requests", st.requests},
+                   {"errors", st.errors},
+                   {"events_sent", st.events_sent},
+                   {"events_dropped", st.events_dropped},
+                   {"slow_disconnects", st.slow_disconnects},
+                   {"timeouts", st.timeouts},
+                   {"programs_committed", st.programs_committed}};
+  return doc;
+}
+
+Body op_trace_start(Session& s, const Json& msg) {
+  const Json* vars = field(msg, "vars", [](const Json& j) { return j.is_array() && !j.empty(); });
+  if (vars == nullptr) {
+    return error(ErrorCode::kBadRequest, "'vars' must be a non-empty array of pin names");
+  }
+  auto& reg = s.server().rt.variables();
+  std::vector<std::string> names;
+  for (const auto& v : *vars) {
+    if (!v.is_string()) {
+      return error(ErrorCode::kBadRequest, "'vars' must be an array of strings");
+    }
+    const auto& n = v.get_ref<const std::string&>();
+    const rt::Variable* var = reg.find(n);
+    if (var == nullptr) {
+      return error(ErrorCode::kNotFound, "no variable '" + n + "'", Json{{"name", n}});
+    }
+    if (!var->is_pin() || var->owner == nullptr) {
+      return error(ErrorCode::kBadRequest, "'" + n + "' is a parameter; only pins are traced");
+    }
+    names.push_back(n);
+  }
+  s.trace_vars_ = names;
+  s.server().retrace();
+  return Json{{"vars", names}};
+}
+
+Body op_trace_stop(Session& s) {
+  s.trace_vars_.clear();
+  s.server().retrace();
+  return Json::object();
+}
+
+Body dispatch(Session& s, const std::string& op, const Json& msg) {
+  if (op == "ping") {
+    return Json{{"pong", true}};
+  }
+  if (op == "status") {
+    StatusMessage m = s.server().status_message();
+    return to_json(m);
+  }
+  if (op == "subscribe") {
+    return op_subscribe(s, msg);
+  }
+  if (op == "unsubscribe") {
+    return op_unsubscribe(s, msg);
+  }
+  if (op == "program.begin") {
+    return op_program_begin(s, msg);
+  }
+  if (op == "program.chunk") {
+    return op_program_chunk(s, msg);
+  }
+  if (op == "program.commit") {
+    return op_program_commit(s, msg);
+  }
+  if (op == "program.abort") {
+    s.upload_.reset();
+    return Json::object();
+  }
+  using C = rt::MachineCommand;
+  static const std::pair<const char*, C> kCommands[] = {
+      {"cycle.start", C::kStart}, {"cycle.hold", C::kHold}, {"cycle.resume", C::kResume},
+      {"cycle.stop", C::kStop},   {"estop", C::kEstop},     {"reset", C::kReset}};
+  for (const auto& [name, c] : kCommands) {
+    if (op == name) {
+      return op_machine(s, c, op);
+    }
+  }
+  if (op == "var.list") {
+    return op_var_list(s, msg);
+  }
+  if (op == "var.read") {
+    return op_var_read(s, msg);
+  }
+  if (op == "var.write") {
+    return op_var_write(s, msg, false);
+  }
+  if (op == "var.force") {
+    return op_var_write(s, msg, true);
+  }
+  if (op == "var.unforce") {
+    return op_var_unforce(s, msg);
+  }
+  if (op == "tasks.stats") {
+    return op_tasks_stats(s);
+  }
+  if (op == "trace.start") {
+    return op_trace_start(s, msg);
+  }
+  if (op == "trace.stop") {
+    return op_trace_stop(s);
+  }
+  return error(ErrorCode::kUnknownOp, "unknown op '" + op + "'");
+}
+
+}  // namespace
+
+OpResult run_op(Session& s, const ParsedRequest& req) {
+  OpResult r;
+  const OpInfo* info = find_op(req.op);
+  Body body;
+  if (info == nullptr) {
+    body = error(ErrorCode::kUnknownOp, "unknown op '" + req.op + "'");
+  } else if (req.op == "hello") {
+    body = op_hello(s, req.msg);
+    r.close_after = std::holds_alternative<Error>(body);  // a wrong token ends the session
+  } else if (!s.role_) {
+    body = error(ErrorCode::kUnauthorized, "hello first");
+  } else if (info->operator_only && *s.role_ != Role::kOperator) {
+    body = error(ErrorCode::kForbidden, "'" + req.op + "' needs the operator role");
+  } else {
+    body = dispatch(s, req.op, req.msg);
+  }
+  if (auto* e = std::get_if<Error>(&body)) {
+    r.reply = make_error(req.id, e->code, e->message, e->details);
+  } else {
+    r.reply = make_reply(req.id, std::get<Json>(body));
+  }
+  return r;
+}
+
+}  // namespace edm::bridge

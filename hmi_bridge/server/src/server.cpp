@@ -1,0 +1,403 @@
+// The bridge server's shared state: listener, session registry, broadcasts (alarms, progress,
+// trace), and start/stop.
+#include <spdlog/spdlog.h>
+
+#include <boost/asio/post.hpp>
+#include <cmath>
+#include <future>
+#include <set>
+
+#include "server_impl.hpp"
+
+namespace edm::bridge {
+
+namespace {
+
+constexpr auto kProgressPeriod = std::chrono::milliseconds(100);
+constexpr auto kTracePeriod = std::chrono::milliseconds(20);
+constexpr std::size_t kTraceSamplesPerEvent = 512;
+
+std::string_view outcome_name(rt::JobOutcome o) {
+  switch (o) {
+    case rt::JobOutcome::kNone:
+      return "none";
+    case rt::JobOutcome::kRunning:
+      return "running";
+    case rt::JobOutcome::kFinished:
+      return "finished";
+    case rt::JobOutcome::kAborted:
+      return "aborted";
+  }
+  return "none";
+}
+
+Json progress_json(const rt::JobProgress& p) {
+  return {{"outcome", std::string(outcome_name(p.outcome))},
+          {"generation", p.generation},
+          {"jobs_started", p.jobs_started},
+          {"block", p.block_index},
+          {"blocks", p.block_count},
+          {"line", p.line}};
+}
+
+bool same_progress(const rt::JobProgress& a, const rt::JobProgress& b) {
+  return a.outcome == b.outcome && a.generation == b.generation &&
+         a.jobs_started == b.jobs_started && a.block_index == b.block_index &&
+         a.block_count == b.block_count && a.line == b.line;
+}
+
+}  // namespace
+
+const std::vector<std::string>& default_status_vars() {
+  static const std::vector<std::string> kVars = {
+      "io.x_mm",         "io.y_mm",          "io.z_mm",       "io.depth_mm",
+      "io.electrode_mm", "io.gap_voltage_v", "io.ratio_short"};
+  return kVars;
+}
+
+ServerOptions options_from_config(const rt::BridgeSpec& spec) {
+  ServerOptions o;
+  o.bind = spec.bind;
+  o.port = static_cast<std::uint16_t>(spec.port);
+  o.token_file = spec.token_file;
+  o.viewer_token_file = spec.viewer_token_file;
+  o.max_sessions = spec.max_sessions;
+  o.max_line_bytes = spec.max_line_bytes;
+  o.read_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(spec.read_timeout);
+  o.queue_limit = spec.queue_limit;
+  o.stall_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(spec.stall_timeout);
+  for (const auto& v : spec.status_vars) {
+    o.status_vars.push_back(v.name);
+  }
+  return o;
+}
+
+Server::Impl::Impl(rt::Runtime& runtime, ServerOptions options)
+    : rt(runtime), opt(std::move(options)) {}
+
+void Server::Impl::start() {
+  tokens = load_tokens(opt.token_file, opt.viewer_token_file);
+  const bool loopback_bind = is_loopback_address(opt.bind);
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(opt.bind, ec);
+  if (ec) {
+    throw BridgeError("bridge.bind '" + opt.bind + "': not an IP address");
+  }
+  if (!loopback_bind && !tokens.any()) {
+    throw BridgeError("bridge.bind " + opt.bind +
+                      " is not a loopback address and no token_file is configured; refusing to "
+                      "serve the network without authentication");
+  }
+
+  // Status board on the I/O task (the one with the driver), else the first task.
+  std::vector<rt::PinRef> pins;
+  const bool explicit_vars = !opt.status_vars.empty();
+  for (const auto& name : explicit_vars ? opt.status_vars : default_status_vars()) {
+    const rt::Variable* v = rt.variables().find(name);
+    if (v == nullptr || !v->is_pin()) {
+      if (explicit_vars) {
+        throw BridgeError("bridge.status_vars: '" + name + "' is not a pin of this config");
+      }
+      continue;
+    }
+    if (pins.size() == kMaxStatusVars) {
+      throw BridgeError("bridge.status_vars: at most 16 variables");
+    }
+    pins.push_back(v->pin);
+    status_var_names.push_back(name);
+  }
+  board = std::make_unique<StatusBoard>(rt.machine(), rt.job(), pins);
+  rt::Task* io_task = nullptr;
+  for (const auto& t : rt.tasks()) {
+    if (t->driver() != nullptr) {
+      io_task = t.get();
+    }
+  }
+  if (io_task == nullptr && !rt.tasks().empty()) {
+    io_task = rt.tasks().front().get();
+  }
+  for (const auto& t : rt.tasks()) {
+    taps.push_back(std::make_unique<TraceTap>(t->name()));
+    tap_names.emplace_back();
+    t->add_observer(*taps.back());
+  }
+  if (io_task != nullptr) {
+    io_task->add_observer(*board);
+  }
+
+  const tcp::endpoint ep(address, opt.port);
+  acceptor.open(ep.protocol(), ec);
+  if (!ec) {
+    acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+    acceptor.bind(ep, ec);
+  }
+  if (!ec) {
+    acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  }
+  if (ec) {
+    throw BridgeError("bridge: cannot listen on " + opt.bind + ":" + std::to_string(opt.port) +
+                      ": " + ec.message());
+  }
+  bound_port = acceptor.local_endpoint().port();
+
+  alarm_link->target = this;
+  rt.add_alarm_listener([link = alarm_link](const rt::Alarm& a) {
+    std::lock_guard lock(link->mutex);
+    if (link->target != nullptr) {
+      Impl* self = link->target;
+      asio::post(self->ioc, [self, a] { self->on_alarm(a); });
+    }
+  });
+  work.emplace(ioc.get_executor());
+  do_accept();
+  progress_tick();
+  trace_tick();
+  thread = std::thread([this] { ioc.run(); });
+  started = true;
+  spdlog::info("bridge: listening on {}:{} ({}{})", opt.bind, bound_port,
+               tokens.any() ? "token authentication" : "loopback only, no token",
+               tokens.viewer_token.empty() ? "" : ", viewer token");
+}
+
+void Server::Impl::stop() {
+  if (!started.exchange(false)) {
+    return;
+  }
+  stopping.store(true, std::memory_order_release);
+  {
+    std::lock_guard lock(alarm_link->mutex);
+    alarm_link->target = nullptr;
+  }
+  std::promise<void> done;
+  asio::post(ioc, [this, &done] {
+    boost::system::error_code ec;
+    acceptor.close(ec);
+    progress_timer.cancel();
+    trace_timer.cancel();
+    std::vector<std::shared_ptr<Session>> all;
+    for (auto& [p, w] : sessions) {
+      if (auto s = w.lock()) {
+        all.push_back(std::move(s));
+      }
+    }
+    for (auto& s : all) {
+      s->async_close();
+    }
+    done.set_value();
+  });
+  done.get_future().wait();
+  work.reset();
+  // Handlers of closed sockets complete with operation_aborted and re-arm nothing; stop() is
+  // only the backstop should one still be pending.
+  asio::post(ioc, [this] { ioc.stop(); });
+  thread.join();
+  spdlog::info("bridge: stopped ({} requests, {} events sent, {} dropped)",
+               counters.requests.load(), counters.events_sent.load(),
+               counters.events_dropped.load());
+}
+
+void Server::Impl::do_accept() {
+  acceptor.async_accept(
+      asio::make_strand(ioc), [this](boost::system::error_code ec, tcp::socket socket) {
+        if (ec) {
+          if (ec != asio::error::operation_aborted) {
+            spdlog::warn("bridge: accept: {}", ec.message());
+            do_accept();
+          }
+          return;
+        }
+        auto s = std::make_shared<Session>(*this, std::move(socket), next_session_id++);
+        const bool full = sessions.size() >= static_cast<std::size_t>(opt.max_sessions);
+        if (full || (!tokens.any() && !s->loopback())) {
+          counters.sessions_refused.fetch_add(1, std::memory_order_relaxed);
+          s->start();
+          s->send_reply(
+              make_error(nullptr, full ? ErrorCode::kBusy : ErrorCode::kUnauthorized,
+                         full ? "too many sessions (max " + std::to_string(opt.max_sessions) + ")"
+                              : "only loopback clients are served without a token"));
+          s->close_after_flush();
+        } else {
+          counters.sessions_accepted.fetch_add(1, std::memory_order_relaxed);
+          counters.sessions_open.fetch_add(1, std::memory_order_relaxed);
+          sessions.emplace(s.get(), s);
+          s->start();
+        }
+        do_accept();
+      });
+}
+
+void Server::Impl::remove(Session* s) {
+  if (sessions.erase(s) > 0) {
+    counters.sessions_open.fetch_sub(1, std::memory_order_relaxed);
+  }
+  if (!s->trace_vars().empty()) {
+    retrace();
+  }
+}
+
+void Server::Impl::on_alarm(const rt::Alarm& a) {
+  Json body = {{"code", static_cast<int>(a.code)},
+               {"name", std::string(rt::to_string(a.code))},
+               {"severity", a.severity == rt::AlarmSeverity::kFault ? "fault" : "warning"},
+               {"t_s", rt::to_seconds(a.time)},
+               {"source", std::string(a.source)},
+               {"text", std::string(a.text)},
+               {"value", std::isfinite(a.value) ? Json(a.value) : Json(nullptr)}};
+  for (auto& [p, w] : sessions) {
+    if (auto s = w.lock(); s && s->wants(kTopicAlarm)) {
+      s->send_event("alarm", body);
+    }
+  }
+}
+
+void Server::Impl::progress_tick() {
+  const rt::JobProgress p = rt.job().progress();
+  if (!same_progress(p, last_progress)) {
+    last_progress = p;
+    const Json body = progress_json(p);
+    for (auto& [ptr, w] : sessions) {
+      if (auto s = w.lock(); s && s->wants(kTopicProgress)) {
+        s->send_event("progress", body);
+      }
+    }
+  }
+  progress_timer.expires_after(kProgressPeriod);
+  progress_timer.async_wait([this](boost::system::error_code ec) {
+    if (!ec) {
+      progress_tick();
+    }
+  });
+}
+
+void Server::Impl::retrace() {
+  // The union of every session's trace variables, split by owning task.
+  std::set<std::string> wanted;
+  for (auto& [p, w] : sessions) {
+    if (auto s = w.lock()) {
+      wanted.insert(s->trace_vars().begin(), s->trace_vars().end());
+    }
+  }
+  const auto& tasks = rt.tasks();
+  for (std::size_t i = 0; i < tasks.size() && i < taps.size(); ++i) {
+    std::vector<rt::PinRef> pins;
+    std::vector<std::string> names;
+    for (const auto& name : wanted) {
+      const rt::Variable* v = rt.variables().find(name);
+      if (v != nullptr && v->is_pin() && v->owner == tasks[i].get() &&
+          pins.size() < rt::kMaxTraceVarsPerTask) {
+        pins.push_back(v->pin);
+        names.push_back(name);
+      }
+    }
+    taps[i]->configure(pins);
+    tap_names[i] = std::move(names);
+  }
+}
+
+void Server::Impl::trace_tick() {
+  for (std::size_t i = 0; i < taps.size(); ++i) {
+    trace_scratch.clear();
+    while (taps[i]->drain(trace_scratch, kTraceSamplesPerEvent) > 0) {
+      const auto& names = tap_names[i];
+      for (auto& [p, w] : sessions) {
+        auto s = w.lock();
+        if (!s || s->trace_vars().empty()) {
+          continue;
+        }
+        std::vector<std::size_t> cols;
+        Json vars = Json::array();
+        for (std::size_t c = 0; c < names.size(); ++c) {
+          for (const auto& mine : s->trace_vars()) {
+            if (mine == names[c]) {
+              cols.push_back(c);
+              vars.push_back(names[c]);
+            }
+          }
+        }
+        if (cols.empty()) {
+          continue;
+        }
+        Json rows = Json::array();
+        for (const auto& smp : trace_scratch) {
+          Json row = Json::array({rt::to_seconds(smp.release), smp.cycle});
+          for (std::size_t c : cols) {
+            const double v = c < smp.n ? smp.v[c] : std::nan("");
+            row.push_back(std::isfinite(v) ? Json(v) : Json(nullptr));
+          }
+          rows.push_back(std::move(row));
+        }
+        s->send_event("trace", {{"task", taps[i]->task_name()},
+                                {"vars", std::move(vars)},
+                                {"samples", std::move(rows)},
+                                {"tap_dropped", taps[i]->dropped()}});
+      }
+      trace_scratch.clear();
+    }
+  }
+  trace_timer.expires_after(kTracePeriod);
+  trace_timer.async_wait([this](boost::system::error_code ec) {
+    if (!ec) {
+      trace_tick();
+    }
+  });
+}
+
+StatusMessage Server::Impl::status_message() {
+  StatusMessage m;
+  StatusSnapshot snap;
+  if (board && board->read(snap)) {
+    m.t_s = rt::to_seconds(snap.release);
+    m.cycle = snap.cycle;
+    m.state = std::string(rt::to_string(snap.state));
+    m.cause = static_cast<int>(snap.cause);
+    for (std::uint32_t i = 0; i < snap.n_vars && i < status_var_names.size(); ++i) {
+      m.vars.emplace_back(status_var_names[i], snap.vars[i]);
+    }
+  } else {
+    // No cycle has run yet (or no task): the state machine and registry directly.
+    snap.state = rt.machine().state();
+    snap.job = rt.job().progress();
+    m.state = std::string(rt::to_string(snap.state));
+    m.cause = static_cast<int>(rt.machine().last_cause());
+    for (const auto& name : status_var_names) {
+      m.vars.emplace_back(name, rt.variables().read(name).value_or(std::nan("")));
+    }
+  }
+  // Progress is read live (it is atomics already): the snapshot's copy may be a cycle old.
+  const rt::JobProgress p = rt.job().progress();
+  m.job_outcome = std::string(outcome_name(p.outcome));
+  m.job_generation = p.generation;
+  m.job_block = p.block_index;
+  m.job_blocks = p.block_count;
+  m.job_line = p.line;
+  return m;
+}
+
+Server::Server(rt::Runtime& runtime, ServerOptions options)
+    : impl_(std::make_unique<Impl>(runtime, std::move(options))) {}
+
+Server::~Server() { stop(); }
+
+void Server::start() { impl_->start(); }
+void Server::stop() { impl_->stop(); }
+std::uint16_t Server::port() const noexcept { return impl_->bound_port; }
+
+ServerStats Server::stats() const noexcept { return impl_->stats_snapshot(); }
+
+ServerStats Server::Impl::stats_snapshot() const noexcept {
+  const Counters& c = counters;
+  ServerStats s;
+  s.sessions_open = c.sessions_open.load();
+  s.sessions_accepted = c.sessions_accepted.load();
+  s.sessions_refused = c.sessions_refused.load();
+  s.requests = c.requests.load();
+  s.errors = c.errors.load();
+  s.events_sent = c.events_sent.load();
+  s.events_dropped = c.events_dropped.load();
+  s.slow_disconnects = c.slow_disconnects.load();
+  s.timeouts = c.timeouts.load();
+  s.programs_committed = c.programs_committed.load();
+  return s;
+}
+
+}  // namespace edm::bridge

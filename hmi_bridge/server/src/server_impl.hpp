@@ -1,0 +1,188 @@
+#pragma once
+// Internals of the bridge server: the shared state (Server::Impl) and the Session.
+// Everything here runs on the server's single io thread; each session's handlers are also
+// serialised by its strand. Counters are atomics so stats() may be read from any thread.
+
+#include <array>
+#include <atomic>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "edm/bridge/codec.hpp"
+#include "edm/bridge/server.hpp"
+#include "edm/bridge/status_board.hpp"
+#include "edm/bridge/trace_tap.hpp"
+#include "edm/runtime/runtime.hpp"
+
+namespace edm::bridge {
+
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+using SteadyClock = std::chrono::steady_clock;
+
+class Session;
+
+struct Counters {
+  std::atomic<std::uint64_t> sessions_open{0};
+  std::atomic<std::uint64_t> sessions_accepted{0};
+  std::atomic<std::uint64_t> sessions_refused{0};
+  std::atomic<std::uint64_t> requests{0};
+  std::atomic<std::uint64_t> errors{0};
+  std::atomic<std::uint64_t> events_sent{0};
+  std::atomic<std::uint64_t> events_dropped{0};
+  std::atomic<std::uint64_t> slow_disconnects{0};
+  std::atomic<std::uint64_t> timeouts{0};
+  std::atomic<std::uint64_t> programs_committed{0};
+};
+
+/// A reply to send, or nothing (the request produced no reply), plus what to do after it.
+struct OpResult {
+  Json reply;
+  bool close_after{false};
+};
+
+struct Server::Impl {
+  Impl(rt::Runtime& runtime, ServerOptions options);
+
+  void start();
+  void stop();
+  void do_accept();
+  void on_alarm(const rt::Alarm& a);
+  void progress_tick();
+  void trace_tick();
+  void remove(Session* s);
+  /// Recomputes each task's tap from the union of the sessions' trace variables.
+  void retrace();
+  /// Fills a status message (from the board when it has published, else directly).
+  StatusMessage status_message();
+  [[nodiscard]] ServerStats stats_snapshot() const noexcept;
+
+  rt::Runtime& rt;
+  ServerOptions opt;
+  TokenSet tokens;
+  std::vector<std::string> status_var_names;
+  std::unique_ptr<StatusBoard> board;
+  std::vector<std::unique_ptr<TraceTap>> taps;      // one per task, same order as rt.tasks()
+  std::vector<std::vector<std::string>> tap_names;  // the variables each tap samples, in order
+  /// The alarm listener outlives the server inside the runtime: it reaches the server only
+  /// through this, which stop() clears.
+  struct AlarmLink {
+    std::mutex mutex;
+    Impl* target{nullptr};
+  };
+  std::shared_ptr<AlarmLink> alarm_link{std::make_shared<AlarmLink>()};
+  std::uint16_t bound_port{0};
+  std::uint64_t next_session_id{1};
+
+  asio::io_context ioc{1};
+  std::optional<asio::executor_work_guard<asio::io_context::executor_type>> work;
+  tcp::acceptor acceptor{ioc};
+  asio::steady_timer progress_timer{ioc};
+  asio::steady_timer trace_timer{ioc};
+  rt::JobProgress last_progress{};
+  std::unordered_map<Session*, std::weak_ptr<Session>> sessions;
+  std::thread thread;
+  std::atomic<bool> started{false};
+  std::atomic<bool> stopping{false};
+  Counters counters;
+  std::vector<rt::TraceSample> trace_scratch;
+};
+
+/// Program upload state of one session (program.begin/chunk/commit).
+struct Upload {
+  std::uint64_t id{0};
+  std::size_t expected{0};
+  std::vector<machining::MotionBlock> blocks;
+  Crc32 crc;
+};
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(Server::Impl& server, tcp::socket socket, std::uint64_t id);
+
+  void start();
+  /// Closes the socket and cancels the timers; the session goes away when its handlers finish.
+  void close();
+  /// close() on the session's strand (from outside it).
+  void async_close();
+  /// Closes once the queued messages are written.
+  void close_after_flush();
+  /// Sends a reply (never dropped; a client that floods requests without reading is paused).
+  void send_reply(const Json& reply);
+  /// Queues an event if the queue has room; else drops it (counted) and disconnects a reader
+  /// that stays stalled past stall_timeout. Assigns seq only to events actually queued, so a
+  /// subscriber sees seq without gaps (and `dropped` in status events says what it missed).
+  void send_event(std::string_view name, Json body);
+
+  [[nodiscard]] bool wants(std::string_view topic) const;
+  [[nodiscard]] const std::vector<std::string>& trace_vars() const { return trace_vars_; }
+  [[nodiscard]] std::uint64_t id() const { return id_; }
+
+ private:
+  friend struct Ops;
+  void do_read();
+  void on_read(boost::system::error_code ec, std::size_t n);
+  void handle_line(std::string_view line);
+  void arm_read_timer();
+  void enqueue(std::shared_ptr<const std::string> msg);
+  void do_write();
+  void on_write(boost::system::error_code ec, std::size_t n);
+  void start_status_timer();
+  void on_status_tick(boost::system::error_code ec, std::uint64_t gen);
+
+  Server::Impl& server_;
+  tcp::socket socket_;
+  asio::strand<asio::io_context::executor_type> strand_;
+  const std::uint64_t id_;
+  bool loopback_{false};
+  std::string peer_;
+
+  std::array<char, 64 * 1024> rx_{};
+  std::string line_;
+  bool discarding_{false};  // skipping the rest of a too-long line
+  bool reading_{false};
+  bool read_paused_{false};
+  asio::steady_timer read_timer_;
+
+  std::deque<std::shared_ptr<const std::string>> queue_;
+  bool writing_{false};
+  bool close_after_flush_{false};
+  bool closed_{false};
+  std::uint64_t seq_{0};
+  std::uint64_t dropped_{0};
+  std::optional<SteadyClock::time_point> stalled_since_;
+  std::uint64_t status_gen_{0};
+
+ public:  // state the ops (ops.cpp) read and change
+  std::optional<Role> role_;
+  bool sub_status_{false};
+  bool sub_alarm_{false};
+  bool sub_progress_{false};
+  int rate_hz_{0};
+  SteadyClock::time_point next_status_{};
+  asio::steady_timer status_timer_;
+  std::optional<Upload> upload_;
+  std::vector<std::string> trace_vars_;
+
+  [[nodiscard]] Server::Impl& server() { return server_; }
+  [[nodiscard]] bool loopback() const { return loopback_; }
+  [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
+  void restart_status_timer() { start_status_timer(); }
+};
+
+/// Runs one request for a session (ops.cpp).
+OpResult run_op(Session& s, const ParsedRequest& req);
+
+}  // namespace edm::bridge
