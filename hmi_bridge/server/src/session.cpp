@@ -73,8 +73,33 @@ void Session::async_close() {
 void Session::close_after_flush() {
   close_after_flush_ = true;
   if (!writing_ && queue_.empty()) {
-    close();
+    linger_close();
   }
+}
+
+// Half-close after the last reply: send FIN, then drain what the client still sends until it
+// closes too (or kLinger passes). Closing with unread input would send an RST, and the client's
+// TCP stack may then drop the reply it has not read yet (a refused hello would read as a plain
+// disconnect instead of `busy` / `unauthorized`).
+void Session::linger_close() {
+  if (closed_ || lingering_) {
+    return;
+  }
+  lingering_ = true;
+  boost::system::error_code ec;
+  socket_.shutdown(tcp::socket::shutdown_send, ec);
+  if (ec) {
+    close();
+    return;
+  }
+  constexpr std::chrono::milliseconds kLinger{1000};
+  read_timer_.expires_after(kLinger);
+  read_timer_.async_wait([self = shared_from_this()](boost::system::error_code e) {
+    if (!e) {
+      self->close();
+    }
+  });
+  do_read();
 }
 
 bool Session::wants(std::string_view topic) const {
@@ -107,7 +132,7 @@ void Session::do_read() {
   if (closed_ || reading_) {
     return;
   }
-  if (queue_.size() >= server_.opt.queue_limit) {
+  if (queue_.size() >= server_.opt.queue_limit && !lingering_) {
     read_paused_ = true;  // the client is not reading its replies: stop reading its requests
     return;
   }
@@ -125,6 +150,10 @@ void Session::on_read(boost::system::error_code ec, std::size_t n) {
   if (ec) {
     fail(ec, "read", id_);
     close();
+    return;
+  }
+  if (lingering_) {  // closing: what the client still sends is read and dropped
+    do_read();
     return;
   }
   const std::size_t limit = server_.opt.max_line_bytes;
@@ -162,6 +191,9 @@ void Session::on_read(boost::system::error_code ec, std::size_t n) {
 }
 
 void Session::handle_line(std::string_view line) {
+  if (close_after_flush_) {
+    return;  // the session is ending: later requests get no reply
+  }
   if (!line.empty() && line.back() == '\r') {
     line.remove_suffix(1);
   }
@@ -260,7 +292,7 @@ void Session::on_write(boost::system::error_code ec, std::size_t /*n*/) {
     stalled_since_.reset();
   }
   if (queue_.empty() && close_after_flush_) {
-    close();
+    linger_close();
     return;
   }
   if (read_paused_ && queue_.size() < server_.opt.queue_limit / 2 + 1) {
