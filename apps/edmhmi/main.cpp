@@ -1,134 +1,105 @@
-// edmhmi — the HMI process's command line (DESIGN §4). Implemented: `check`, which interprets a
-// part program offline against a machine's conditions and soft limits (docs/gcode.md). The bridge
-// subcommands (run, status, watch, ...) come with the bridge client (issue 5).
-// Exit codes: 0 ok, 1 runtime failure (and subcommands not yet available), 2 bad input.
+// edmhmi — the HMI process's command line (DESIGN §4, docs/hmi.md). One file per command group:
+// cmd_check.cpp (offline interpretation), cmd_run.cpp (upload, start, follow, report),
+// cmd_status.cpp (status, stats), cmd_machine.cpp (hold, resume, stop, estop, reset),
+// cmd_watch.cpp (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
 
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
-#include <fstream>
-#include <iterator>
-#include <sstream>
-#include <string>
-#include <string_view>
-#include <vector>
 
-#include "edm/hmi/gcode.hpp"
-#include "edm/machining/machine_config.hpp"
-#include "edm/machining/machine_tables.hpp"
+#include "cli.hpp"
+
+namespace edmhmi {
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
-constexpr std::size_t kMaxPartBytes = 64u << 20;  // a part program larger than this is refused
-
 constexpr const char* kUsage =
     "usage: edmhmi [--host H] [--port P] [--token-file F] COMMAND ...\n"
+    "  connection: --host (else $EDM_HOST, 127.0.0.1), --port (else $EDM_PORT, 7730),\n"
+    "              --token-file (else $EDM_TOKEN_FILE, else the token in $EDM_TOKEN)\n"
     "commands:\n"
-    "  check [--machine CONFIG] PART.nc  interpret PART.nc offline against CONFIG's conditions\n"
-    "                                    and soft limits (default "
-    "config/machines/drill-sim.yaml);\n"
-    "                                    errors as PART.nc:line:col: message, exit 2\n"
-    "  run PART.nc | status | watch VAR... | trace VAR... --out FILE.csv | stats | hold |\n"
-    "  resume | stop | estop | reset     talk to edmplc over the bridge (not yet available)\n";
+    "  check [--machine CONFIG] PART.nc   interpret offline against CONFIG (default\n"
+    "                                     config/machines/drill-sim.yaml); nothing is sent\n"
+    "  run [--detach] [--quiet] PART.nc   upload, start, show progress, print the job report;\n"
+    "                                     exit 1 when the job does not finish or an alarm came\n"
+    "  status                             machine state, job, key variables, last job's figures\n"
+    "  watch [--rate HZ] [--count N] VAR...     print variables until Ctrl-C (or N samples)\n"
+    "  trace VAR... --out FILE.csv [--duration S]  record every cycle of VAR... to CSV\n"
+    "  stats                              task statistics and bridge counters\n"
+    "  hold | resume | stop | estop | reset   machine commands\n";
 
-int usage(const std::string& message) {
-  std::fprintf(stderr, "edmhmi: %s\n%s", message.c_str(), kUsage);
-  return kExitBadInput;
-}
+std::atomic<bool> g_interrupted{false};
 
-bool is_bridge_command(std::string_view c) {
-  for (std::string_view k :
-       {"run", "status", "watch", "trace", "stats", "hold", "resume", "stop", "estop", "reset"}) {
-    if (c == k) return true;
-  }
-  return false;
-}
-
-int check(const std::vector<std::string_view>& args) {
-  std::string machine = EDM_DEFAULT_MACHINE;
-  std::string part;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--machine") {
-      if (i + 1 >= args.size()) return usage("--machine needs a config file");
-      machine = std::string(args[++i]);
-    } else if (args[i].starts_with("--")) {
-      return usage("check: unknown option '" + std::string(args[i]) + "'");
-    } else if (part.empty()) {
-      part = std::string(args[i]);
-    } else {
-      return usage("check takes one part program");
-    }
-  }
-  if (part.empty()) return usage("check needs a part program (PART.nc)");
-
-  edm::machining::MachineTables tables;
-  try {
-    tables = edm::machining::read_machine_tables(machine);
-  } catch (const edm::machining::MachineConfigError& e) {
-    for (const std::string& m : e.messages()) std::fprintf(stderr, "%s\n", m.c_str());
-    return kExitBadInput;
-  }
-  std::ifstream in(part, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "%s: cannot open the part program\n", part.c_str());
-    return kExitBadInput;
-  }
-  std::string text;
-  text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad() || text.size() > kMaxPartBytes) {
-    std::fprintf(stderr, "%s: unreadable or larger than %zu bytes\n", part.c_str(), kMaxPartBytes);
-    return kExitBadInput;
-  }
-  const edm::hmi::GcodeResult r = edm::hmi::interpret_gcode(text, part, tables);
-  if (!r.ok()) {
-    for (const std::string& m : r.messages()) std::fprintf(stderr, "%s\n", m.c_str());
-    return kExitBadInput;
-  }
-  std::printf(
-      "%s: ok: %zu blocks, %d drilling blocks, %.3f mm drilled, estimated electrode wear %.3f mm "
-      "(machine %s)\n",
-      part.c_str(), r.blocks.size(), r.drill_blocks, r.drill_depth_mm, r.electrode_wear_mm,
-      machine.c_str());
-  return kExitOk;
-}
+extern "C" void on_signal(int /*sig*/) { g_interrupted.store(true); }
 
 int run(int argc, char** argv) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
+  const Args args(argv + 1, argv + argc);
+  edm::hmi::ConnectionFlags flags;
   std::size_t i = 0;
-  // Bridge connection options; kept for the bridge subcommands.
   while (i < args.size() && args[i].starts_with("--")) {
     if (args[i] == "--help" || args[i] == "-h") {
       std::fputs(kUsage, stdout);
       return kExitOk;
     }
-    if (args[i] != "--host" && args[i] != "--port" && args[i] != "--token-file") {
-      return usage("unknown option '" + std::string(args[i]) + "'");
-    }
+    std::string* target = args[i] == "--host"         ? &flags.host
+                          : args[i] == "--port"       ? &flags.port
+                          : args[i] == "--token-file" ? &flags.token_file
+                                                      : nullptr;
+    if (target == nullptr) return usage("unknown option '" + std::string(args[i]) + "'");
     if (i + 1 >= args.size()) return usage(std::string(args[i]) + " needs a value");
+    *target = std::string(args[i + 1]);
     i += 2;
   }
   if (i >= args.size()) return usage("missing command");
   const std::string_view command = args[i];
-  const std::vector<std::string_view> rest(args.begin() + static_cast<std::ptrdiff_t>(i) + 1,
-                                           args.end());
-  if (command == "check") return check(rest);
-  if (is_bridge_command(command)) {
-    std::fprintf(stderr, "edmhmi: %s: not yet available (issue 5: bridge client)\n",
-                 std::string(command).c_str());
-    return kExitFailure;
+  const Args rest(args.begin() + static_cast<std::ptrdiff_t>(i) + 1, args.end());
+  if (command == "check") return cmd_check(rest);
+
+  edm::hmi::ConnectionSettings settings;
+  try {
+    settings = edm::hmi::resolve_connection(
+        flags, [](const char* n) -> const char* { return std::getenv(n); });
+  } catch (const edm::hmi::SettingsError& e) {
+    std::fprintf(stderr, "edmhmi: %s\n", e.what());
+    return kExitBadInput;
+  }
+  install_signal_handlers();
+  if (command == "run") return cmd_run(rest, settings);
+  if (command == "status") return cmd_status(rest, settings);
+  if (command == "stats") return cmd_stats(rest, settings);
+  if (command == "watch") return cmd_watch(rest, settings);
+  if (command == "trace") return cmd_trace(rest, settings);
+  for (std::string_view c : {"hold", "resume", "stop", "estop", "reset"}) {
+    if (command == c) return cmd_machine(command, rest, settings);
   }
   return usage("unknown command '" + std::string(command) + "'");
 }
 
 }  // namespace
 
+std::atomic<bool>& interrupted() { return g_interrupted; }
+
+void install_signal_handlers() {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+int usage(const std::string& message) {
+  std::fprintf(stderr, "edmhmi: %s\n%s", message.c_str(), kUsage);
+  return kExitBadInput;
+}
+
+}  // namespace edmhmi
+
 int main(int argc, char** argv) {
   try {
-    return run(argc, argv);
+    return edmhmi::run(argc, argv);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "edmhmi: %s\n", e.what());
-    return kExitFailure;
+    return edmhmi::kExitFailure;
   }
 }

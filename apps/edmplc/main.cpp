@@ -31,14 +31,16 @@ constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
 
 constexpr std::string_view kUsage =
-    "usage: edmplc --config FILE [--clock real|virtual] [--run-for DURATION]\n"
+    "usage: edmplc --config FILE [--clock real|virtual [--speed F]] [--run-for DURATION]\n"
     "              [--stats-out FILE.json] [--trace-out FILE.csv] [--seed N]\n"
     "              [--bridge-port P] [--check] [--list-vars] [--log-level LEVEL]\n"
     "  --check       validate the config and exit (0 ok, 2 invalid: file:line:col: message)\n"
     "  --list-vars   print every variable (name, kind, type, unit, task) and exit\n"
     "  --run-for     stop after this much (real or virtual) time, e.g. 10s; default: until\n"
     "                SIGINT/SIGTERM\n"
-    "  --clock       real (default: SCHED_FIFO threads) or virtual (deterministic, fast)\n";
+    "  --clock       real (default: SCHED_FIFO threads) or virtual (deterministic, fast)\n"
+    "  --speed F     with --clock virtual: pace virtual time to F x wall time (accelerated\n"
+    "                but deterministic; an HMI can follow the job); default: unpaced\n";
 
 std::atomic<bool> g_stop{false};
 
@@ -47,6 +49,7 @@ extern "C" void on_signal(int /*sig*/) { g_stop.store(true); }
 struct Options {
   std::string config;
   edm::rt::ClockKind clock{edm::rt::ClockKind::kReal};
+  double speed{0.0};  // --speed: paced virtual clock
   std::optional<edm::rt::Duration> run_for;
   std::string stats_out;
   std::string trace_out;
@@ -101,6 +104,13 @@ Options parse_args(int argc, char** argv) {
       } else {
         bad_usage("--clock takes real or virtual, not '" + v + "'");
       }
+    } else if (a == "--speed") {
+      const std::string v = value(i, a);
+      char* end = nullptr;
+      o.speed = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !(o.speed > 0.0) || o.speed > 1e6) {
+        bad_usage("--speed takes a factor > 0 (virtual seconds per wall second), not '" + v + "'");
+      }
     } else if (a == "--run-for") {
       const std::string v = value(i, a);
       auto d = edm::rt::parse_duration(v);
@@ -143,6 +153,9 @@ Options parse_args(int argc, char** argv) {
   }
   if (o.config.empty()) {
     bad_usage("--config FILE is required");
+  }
+  if (o.speed > 0.0 && o.clock != edm::rt::ClockKind::kVirtual) {
+    bad_usage("--speed needs --clock virtual (the real clock runs at 1x)");
   }
   return o;
 }
@@ -228,6 +241,7 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
 
   edm::rt::RunOptions ro;
+  ro.speed = opt.speed;
   ro.clock = opt.clock;
   ro.run_for = opt.run_for;
   ro.stop = &g_stop;

@@ -420,6 +420,7 @@ class Interpreter {
         machining::wear_precompensate(lz, c != nullptr ? c->wear_ratio : 0.0);
     mb.z_travel_mm = wp.travel_mm;
     result_.blocks.push_back(mb);
+    pos_ = start;  // the runtime retracts out of the hole and returns to the block's start
     result_.drill_depth_mm += lz;
     result_.electrode_wear_mm += wp.delta_mm;
     ++result_.drill_blocks;

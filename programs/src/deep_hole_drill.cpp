@@ -101,6 +101,7 @@ void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
   v.output("state", state_);
   v.output("depth_reached_mm", depth_reached_mm_, "mm");
   v.output("touch_z_mm", touch_z_mm_, "mm");
+  v.output("wear_mm", wear_out_mm_, "mm");
   v.output("done", done_);
   v.output("breakthrough", breakthrough_);
 }
@@ -186,6 +187,7 @@ void DeepHoleDrill::activate_self() noexcept {
   gen_on_.set(false);
   depth_reached_mm_.set(0.0);
   touch_z_mm_.set(0.0);
+  wear_out_mm_.set(0.0);
   done_.set(false);
   set_state(State::kIdle);
 }
@@ -204,6 +206,7 @@ void DeepHoleDrill::begin_cycle() noexcept {
   done_.set(false);
   breakthrough_.set(false);
   depth_reached_mm_.set(0.0);
+  wear_out_mm_.set(0.0);
   set_state(State::kApproach);
 }
 
@@ -285,6 +288,7 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
     const double wear_mm = comp && wear_mm_ != nullptr ? wear_mm_->get() : 0.0;
     const double depth = (touch_z_mm_.get() - z) - wear_mm;
     depth_reached_mm_.set(depth);
+    wear_out_mm_.set(wear_mm);
     dark_cycles_ = td_count_.get() > 0 ? 0 : dark_cycles_ + 1;
     if (depth >= target_depth_mm_) {
       begin_retract(touch_z_mm_.get() + params_.clearance_mm);

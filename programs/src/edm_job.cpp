@@ -1,5 +1,7 @@
 #include "edm/programs/edm_job.hpp"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "edm/runtime/machine.hpp"
@@ -49,6 +51,9 @@ void EdmJob::visit_own_pins(rt::PinVisitor& v) {
   v.input("td_count", td_count_);
   v.input("n_open", n_open_);
   v.input("n_short", n_short_);
+  v.input("n_normal", n_normal_);
+  v.input("n_transient_arc", n_transient_arc_);
+  v.input("n_stable_arc", n_stable_arc_);
   v.input("x_mm", x_mm_, "mm");
   v.input("y_mm", y_mm_, "mm");
   v.input("z_mm", z_mm_, "mm");
@@ -67,6 +72,12 @@ void EdmJob::visit_own_pins(rt::PinVisitor& v) {
   v.output("block_index", block_index_);
   v.output("line", line_);
   v.output("jobs_finished", jobs_finished_);
+  v.output("job_time_s", job_time_s_, "s");
+  v.output("job_pulses", job_pulses_);
+  v.output("job_shorts", job_shorts_);
+  v.output("job_arcs", job_arcs_);
+  v.output("job_depth_mm", job_depth_mm_, "mm");
+  v.output("job_wear_mm", job_wear_mm_, "mm");
 }
 
 std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) {
@@ -114,6 +125,8 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
   drill_vz_ = child_output<double>(errs, drill_, "drill", "vz_cmd_mm_s");
   drill_gen_ = child_output<bool>(errs, drill_, "drill", "gen_on");
   drill_state_ = child_output<std::int64_t>(errs, drill_, "drill", "state");
+  drill_depth_ = child_output<double>(errs, drill_, "drill", "depth_reached_mm");
+  drill_wear_ = child_output<double>(errs, drill_, "drill", "wear_mm");
   finish_vx_ = child_output<double>(errs, finish_, "finish", "vx_cmd_mm_s");
   finish_vy_ = child_output<double>(errs, finish_, "finish", "vy_cmd_mm_s");
   finish_gen_ = child_output<bool>(errs, finish_, "finish", "gen_on");
@@ -222,6 +235,7 @@ void EdmJob::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
 
 void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   if (job_ != nullptr) job_->rt_finish(outcome);
+  drill_returning_ = false;
   if (outcome == rt::JobOutcome::kFinished) jobs_finished_.set(jobs_finished_.get() + 1);
   state_value_ = State::kIdle;
   state_.set(0);
@@ -230,6 +244,25 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   c_finish_start_.set(false);
   gen_arm_.set(false);
   gen_on_.set(false);
+}
+
+void EdmJob::begin_job_figures(const rt::CycleContext& ctx) noexcept {
+  job_start_ = ctx.release;
+  wear_before_block_ = 0.0;
+  job_time_s_.set(0.0);
+  job_pulses_.set(0);
+  job_shorts_.set(0);
+  job_arcs_.set(0);
+  job_depth_mm_.set(0.0);
+  job_wear_mm_.set(0.0);
+}
+
+void EdmJob::count_job_figures(const rt::CycleContext& ctx) noexcept {
+  job_time_s_.set(std::chrono::duration<double>(ctx.release - job_start_).count());
+  const std::int64_t arcs = n_transient_arc_.get() + n_stable_arc_.get();
+  job_pulses_.set(job_pulses_.get() + n_open_.get() + n_normal_.get() + arcs + n_short_.get());
+  job_shorts_.set(job_shorts_.get() + n_short_.get());
+  job_arcs_.set(job_arcs_.get() + arcs);
 }
 
 void EdmJob::select_condition(int e) noexcept {
@@ -362,8 +395,15 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
       return step_ == Step::kBusy && arc_done_->get() && !c_arc_start_.get() && in_position();
     }
     case MotionKind::kDrill: {
+      if (drill_returning_) return run_block(drill_return_, ctx, hold, status);
       hold_position();
       if (step_ == Step::kEnter) {
+        drill_return_ = MotionBlock{};
+        drill_return_.kind = MotionKind::kRapid;
+        drill_return_.line = b.line;
+        drill_return_.col = b.col;
+        drill_return_.target = {x, y, z};
+        wear_before_block_ = job_wear_mm_.get();
         c_depth_.set(-b.target.z);
         c_through_.set(false);
         c_drill_start_.set(true);
@@ -371,10 +411,16 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
         return false;
       }
       c_drill_start_.set(false);
+      job_depth_mm_.set(std::max(job_depth_mm_.get(), drill_depth_->get()));
+      job_wear_mm_.set(wear_before_block_ + drill_wear_->get());
       const bool done =
           drill_state_->get() == static_cast<std::int64_t>(DeepHoleDrill::State::kDone);
-      if (done) hold_z_ = z;
-      return done;
+      if (done) {  // retracted out of the hole: back to where the block began, as a rapid
+        hold_z_ = z;
+        drill_returning_ = true;
+        step_ = Step::kEnter;
+      }
+      return false;
     }
     case MotionKind::kOrbitFinish: {
       hold_position();
@@ -434,6 +480,7 @@ rt::BlockStatus EdmJob::update(const rt::CycleContext& ctx) noexcept {
     if (ms == rt::MachineState::kRunning && job_->rt_begin()) {
       state_value_ = State::kRun;
       state_.set(1);
+      begin_job_figures(ctx);
       step_ = Step::kEnter;
       condition_ = nullptr;
       gen_arm_.set(false);
@@ -445,6 +492,7 @@ rt::BlockStatus EdmJob::update(const rt::CycleContext& ctx) noexcept {
   c_loop_enable_.set(!rt::is_safe_state(ms));
   bool block_done = false;
   if (state_value_ == State::kRun) {
+    count_job_figures(ctx);
     const MotionBlock* b = job_->rt_current();
     if (b == nullptr || b->kind == MotionKind::kEnd) {
       finish_job(rt::JobOutcome::kFinished);
@@ -462,6 +510,7 @@ rt::BlockStatus EdmJob::update(const rt::CycleContext& ctx) noexcept {
       if (block_done) {
         job_->rt_advance();
         step_ = Step::kEnter;
+        drill_returning_ = false;
       }
     }
   } else {

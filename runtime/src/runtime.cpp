@@ -86,9 +86,14 @@ RunSummary Runtime::run(const RunOptions& options) {
     // Virtual time has no deadline: drain the trace between cycles so nothing is dropped and
     // the CSV is identical from run to run.
     std::uint64_t n = 0;
+    const TimePoint wall_start = RealClock{}.now();
     auto between = [&] {
       if (trace_file.is_open() && has_trace_) {
         trace_.drain(trace_file);
+      }
+      if (options.speed > 0.0 && (n & 63) == 0) {  // paced: virtual t = speed × wall t
+        const auto wall = std::chrono::duration<double>(clock.now()) / options.speed;
+        RealClock::sleep_until(wall_start + std::chrono::duration_cast<Duration>(wall));
       }
       if ((++n & 1023) == 0) {
         drain_alarms();

@@ -91,6 +91,7 @@ class RuntimeBuilder {
     wire();
     register_variables();
     make_trace();
+    check_bridge_vars();
     diag_.throw_if_any();
     finish();
     make_retain();
@@ -376,6 +377,22 @@ class RuntimeBuilder {
       Task* owner = program_task_.count(prog->name()) ? program_task_[prog->name()] : nullptr;
       for (const Program::Entry& e : prog->blocks()) {
         register_params(e.full_name, *e.block, owner);
+      }
+    }
+  }
+
+  // The bridge resolves its status variables when it starts; checking them here gives their
+  // file:line:col (and makes `edmplc --check` catch them).
+  void check_bridge_vars() {
+    for (const NameRef& n : cfg_.bridge.status_vars) {
+      const Variable* v = rt_->variables_.find(n.name);
+      if (v == nullptr && !rt_->driver_ && n.name.rfind("io.", 0) == 0) {
+        continue;  // the unknown driver was reported already
+      }
+      if (v == nullptr) {
+        diag_.error(n.loc, "bridge.status_vars: unknown variable '" + n.name + "'");
+      } else if (!v->is_pin()) {
+        diag_.error(n.loc, "bridge.status_vars: '" + n.name + "' is a parameter; only pins");
       }
     }
   }

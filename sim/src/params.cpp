@@ -64,6 +64,9 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("electrode_length_mm", electrode_length_mm, "mm", "electrode length at start");
   v.param("work_thickness_mm", work_thickness_mm, "mm", "through at this depth; 0 = blind");
   v.param("start_gap_um", start_gap_um, "um", "tip above the work surface at start");
+  v.param("initial_depth_mm", initial_depth_mm, "mm",
+          "tube/block: a hole this deep is already there under the electrode; the tip starts "
+          "start_gap_um above its bottom");
   v.param("debris_kappa", debris_kappa, "1", "kappa: c += kappa V / V_gap");
   v.param("debris_flush_k", debris_flush_k, "1", "k in the flushing term exp(-k c)");
   v.param("flush_tau0_ms", flush_tau0_ms, "ms", "tau_f0: flushing time constant at the surface");
@@ -228,6 +231,7 @@ std::vector<rt::ParamError> SimParams::validate() const {
                       {"removal_scale_positive", removal_scale_positive},
                       {"work_thickness_mm", work_thickness_mm},
                       {"start_gap_um", start_gap_um},
+                      {"initial_depth_mm", initial_depth_mm},
                       {"debris_kappa", debris_kappa},
                       {"debris_flush_k", debris_flush_k},
                       {"flush_drop_depth_mm", flush_drop_depth_mm},

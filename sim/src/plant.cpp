@@ -68,7 +68,11 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   AxisLimits z = xy;
   z.v_pos_max_mm_s = p.v_jump_mm_s;
   axes_ = {Axis(xy), Axis(xy), Axis(z)};
-  axes_[2].reset(p.start_gap_um * 1e-3);
+  if (tool_ != Tool::kWire && p.initial_depth_mm > 0.0) {
+    hole_bottom_mm_ = -p.initial_depth_mm;
+    hole_started_ = true;
+  }
+  axes_[2].reset(p.start_gap_um * 1e-3 + hole_bottom_mm_);
   jump_low_z_mm_ = axes_[2].position_mm();
   axis_step_ns_ = std::max<std::int64_t>(1, to_ns(p.axis_step_us));
   rab_ = RabWindow(to_ns(p.rab_window_ms * 1e3));
@@ -100,7 +104,8 @@ double Plant::front_gap_um(double z_mm) const noexcept {
 }
 
 double Plant::wall_gap_um(std::size_t j) const noexcept {
-  const double off = axes_[0].position_mm() * wall_cos_[j] + axes_[1].position_mm() * wall_sin_[j];
+  const double off = (axes_[0].position_mm() - hole_cx_mm_) * wall_cos_[j] +
+                     (axes_[1].position_mm() - hole_cy_mm_) * wall_sin_[j];
   return (wall_r_mm_[j] - params_.tool_od_mm / 2.0 - off) * 1e3;
 }
 
@@ -150,6 +155,7 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
   axis_time_ns_ = t_ns;
   axes_[0].step(cmd_.vx_mm_s, dt);
   axes_[1].step(cmd_.vy_mm_s, dt);
+  track_hole();
   if (hold_) {
     axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
   } else {
@@ -231,6 +237,7 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
     if (s >= p.wire_hole_from_mm && s < p.wire_hole_to_mm) s = p.wire_hole_to_mm;  // no material
     hole_bottom_mm_ = -s;
   } else {
+    hole_started_ = true;
     if (site < 0) {
       hole_bottom_mm_ -= volume_mm3 / area_front_mm2_;
     } else {
@@ -267,7 +274,8 @@ void Plant::start_pulse(std::int64_t t_ns) noexcept {
   double gap = gap_front;
   double median = model_.td_median_us(gap_front, c);
   int site = -1;
-  if (tool_ == Tool::kTube && p.wall_sparks) {
+  // The wall competes only where there is one: with the tip below the work surface.
+  if (tool_ == Tool::kTube && p.wall_sparks && tool_z_mm(t_ns) + wear_length_mm_ < 0.0) {
     const double kw = p.weibull_k;
     std::array<double, kWallBins> w{};
     const double w_front = std::isfinite(median) ? area_front_mm2_ * std::pow(median, -kw) : 0.0;
@@ -408,10 +416,29 @@ void Plant::hold_gap(double gap_um) noexcept {
   publish();
 }
 
+void Plant::track_hole() noexcept {
+  if (tool_ != Tool::kTube) return;
+  const double x = axes_[0].position_mm(), y = axes_[1].position_mm();
+  if (!hole_started_) {  // nothing eroded yet
+    hole_cx_mm_ = x;
+    hole_cy_mm_ = y;
+    return;
+  }
+  const double tip_z = axes_[2].position_mm() + wear_length_mm_;
+  if (tip_z > 0.0 && std::hypot(x - hole_cx_mm_, y - hole_cy_mm_) > params_.hole_d_mm) {
+    hole_bottom_mm_ = 0.0;
+    wall_r_mm_.fill(params_.hole_d_mm / 2.0);
+    hole_started_ = false;
+    hole_cx_mm_ = x;
+    hole_cy_mm_ = y;
+  }
+}
+
 void Plant::release_gap() noexcept { hold_ = false; }
 
 void Plant::set_depth_mm(double h) noexcept {
   hole_bottom_mm_ = -h;
+  hole_started_ = hole_started_ || h > 0.0;
   if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
   publish();
 }

@@ -46,8 +46,18 @@ TEST(GcodeDrill, UsesTheArmedConditionsWearRatio) {
   ASSERT_EQ(d.size(), 2u);
   EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(4.0, 0.05), 1e-9);
   EXPECT_NEAR(d[1].z_travel_mm, precompensated_travel(6.0, 0.05), 1e-9);
-  EXPECT_DOUBLE_EQ(d[1].target.z, -10.0);
+  // A drilling block ends back at its start point (the runtime retracts out of the hole and
+  // returns there), so the incremental second block starts at Z0 again.
+  EXPECT_DOUBLE_EQ(d[1].target.z, -6.0);
   EXPECT_EQ(d[1].condition, 2);
+}
+
+TEST(GcodeDrill, EndsWhereItBegan) {
+  const auto b = blocks_of("G00 X3 Y4 Z0.5\nE1\nG01 Z-5 F60\nE0\nG91 G00 Z1\nX1");
+  const auto r = of_kind(b, MotionKind::kRapid);
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r[1].target, (Vec3{3, 4, 1.5}));  // from Z0.5, not from the hole bottom at Z-5
+  EXPECT_EQ(r[2].target, (Vec3{4, 4, 1.5}));
 }
 
 TEST(GcodeDrill, NotADrillWhenDisarmedMovingUpOrSideways) {
@@ -98,15 +108,15 @@ TEST(GcodeSoftLimits, EndPointsOutsideTheAxesAreRefusedAtTheirWord) {
 }
 
 TEST(GcodeOrbit, G160FinishesAboutTheCurrentPoint) {
-  const auto b = blocks_of("G00 X-20 Y10 Z0.5\nE1\nG01 Z-15 F60\nE2\nG160 R0.55 F30");
+  const auto b = blocks_of("G00 X-20 Y10 Z0.5\nE1\nG01 Z-15 F60\nG00 Z-14.8\nE2\nG160 R0.55 F30");
   const auto o = of_kind(b, MotionKind::kOrbitFinish);
   ASSERT_EQ(o.size(), 1u);
-  EXPECT_EQ(o[0].centre, (Vec3{-20, 10, -15}));
-  EXPECT_EQ(o[0].target, (Vec3{-20, 10, -15}));  // back at the centre afterwards
+  EXPECT_EQ(o[0].centre, (Vec3{-20, 10, -14.8}));
+  EXPECT_EQ(o[0].target, (Vec3{-20, 10, -14.8}));  // back at the centre afterwards
   EXPECT_DOUBLE_EQ(o[0].final_radius_mm, 0.55);
   EXPECT_DOUBLE_EQ(o[0].feed_mm_s, 0.5);
   EXPECT_EQ(o[0].condition, 2);
-  EXPECT_EQ(o[0].line, 5);
+  EXPECT_EQ(o[0].line, 6);
   EXPECT_EQ(o[0].col, 1);
   // E in the same block arms before the cycle runs.
   EXPECT_EQ(of_kind(blocks_of("G160 R1 E2 F30"), MotionKind::kOrbitFinish).size(), 1u);

@@ -33,7 +33,7 @@ TEST(EdmhmiCheck, GoodProgramPrintsASummaryAndExitsZero) {
   const Outcome r = edmhmi({"check", kParts + "blind-hole.nc"});
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("blind-hole.nc: ok: 12 blocks, 1 drilling blocks, 20.500 mm drilled, "
-                          "estimated electrode wear 12.737 mm"),
+                          "estimated electrode wear 12.700 mm"),
             std::string::npos)
       << r.output;
 }
@@ -57,7 +57,7 @@ TEST(EdmhmiCheck, MachineOptionSelectsTheConditionTable) {
   const Outcome r = edmhmi({"check", "--machine", sink, kParts + "drill-then-finish.nc"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(
-      r.output.find("drill-then-finish.nc:12:1: unknown condition 'E2' (this machine has E1)"),
+      r.output.find("drill-then-finish.nc:13:1: unknown condition 'E2' (this machine has E1)"),
       std::string::npos)
       << r.output;
   const Outcome bad =
@@ -72,12 +72,15 @@ TEST(EdmhmiCheck, MissingPartFileIsBadInput) {
   EXPECT_NE(r.output.find("/nonexistent/part.nc: cannot open"), std::string::npos) << r.output;
 }
 
-TEST(EdmhmiCommands, BridgeCommandsAreNotYetAvailable) {
-  for (const char* c : {"status", "run", "estop"}) {
-    const Outcome r = edmhmi({"--host", "127.0.0.1", c});
-    EXPECT_EQ(r.code, 1) << c;
-    EXPECT_NE(r.output.find("not yet available (issue 5: bridge client)"), std::string::npos)
-        << r.output;
+TEST(EdmhmiCommands, BridgeCommandsWithoutEdmplcFailWithExitOne) {
+  // Port 1 on loopback: nothing listens there, the connection is refused at once.
+  for (const std::vector<std::string>& c :
+       {std::vector<std::string>{"status"}, {"run", kParts + "blind-hole.nc"}, {"estop"}}) {
+    std::vector<std::string> args = {"--host", "127.0.0.1", "--port", "1"};
+    args.insert(args.end(), c.begin(), c.end());
+    const Outcome r = edmhmi(args);
+    EXPECT_EQ(r.code, 1) << c[0];
+    EXPECT_NE(r.output.find("edmhmi: edmplc at 127.0.0.1:1:"), std::string::npos) << r.output;
   }
 }
 

@@ -62,7 +62,7 @@ TEST(GcodeExamples, ThroughHoleGoesPastTheFarSide) {
   EXPECT_LT(d[0].target.z, -10.0);
 }
 
-TEST(GcodeExamples, DrillThenFinishSwitchesToPositiveAndOrbitsTo055) {
+TEST(GcodeExamples, DrillThenFinishSwitchesToPositiveAndOrbitsTo060) {
   const GcodeResult r = interpret_part("drill-then-finish.nc");
   ASSERT_TRUE(r.ok()) << joined(r);
   const auto d = of_kind(r.blocks, MotionKind::kDrill);
@@ -71,8 +71,9 @@ TEST(GcodeExamples, DrillThenFinishSwitchesToPositiveAndOrbitsTo055) {
   ASSERT_EQ(o.size(), 1u);
   EXPECT_EQ(d[0].condition, 1);
   EXPECT_EQ(o[0].condition, 2);
-  EXPECT_DOUBLE_EQ(o[0].final_radius_mm, 0.55);
-  EXPECT_EQ(o[0].centre, d[0].target);  // orbit at the bottom of the drilled hole
+  EXPECT_DOUBLE_EQ(o[0].final_radius_mm, 0.60);
+  // The orbit runs in the drilled hole, 0.2 mm off its bottom, about the hole's axis.
+  EXPECT_EQ(o[0].centre, (machining::Vec3{d[0].target.x, d[0].target.y, d[0].target.z + 0.2}));
 }
 
 TEST(GcodeExamples, RowOfHolesHasFiveDrillsWithRapidsBetween) {

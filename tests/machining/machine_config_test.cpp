@@ -33,7 +33,7 @@ TEST(MachineConfig, ReadsTheShippedDrillMachine) {
   ASSERT_NE(e1, nullptr);
   EXPECT_EQ(e1->name, "drill-rough");
   EXPECT_EQ(e1->polarity, Polarity::kNegative);
-  EXPECT_EQ(e1->wear_ratio, 0.6213);  // the calibrated effective ratio (docs/blocks.md)
+  EXPECT_EQ(e1->wear_ratio, 0.6195);  // the calibrated effective ratio (docs/blocks.md)
   EXPECT_EQ(e1->tdr_us, 8.0);
   const Condition* e2 = t.condition(2);
   ASSERT_NE(e2, nullptr);

@@ -6,10 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <vector>
 
 #include "edm/blocks/register.hpp"
+#include "edm/hmi/gcode.hpp"
+#include "edm/machining/machine_config.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "edm/machining/program_check.hpp"
 #include "edm/programs/register.hpp"
@@ -81,14 +85,13 @@ struct JobResult {
   double short_fraction{0.0};
 };
 
-JobResult run_job(int seed, double depth, double final_radius) {
+JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::Vec3 start) {
   JobResult res;
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(seed);
   auto r = build_sim_machine(
       rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"), opts);
-  const auto program = drill_then_finish(depth, final_radius);
-  const auto issues = machining::check_program(program, r->tables(), {0, 0, 0.1});
+  const auto issues = machining::check_program(program, r->tables(), start);
   EXPECT_TRUE(issues.empty()) << issues[0].message;
   EXPECT_EQ(r->job().load(program), rt::LoadResult::kOk);
   r->machine().command(rt::MachineCommand::kPowerOn);
@@ -138,7 +141,7 @@ JobResult run_job(int seed, double depth, double final_radius) {
 class JobSeeds : public ::testing::TestWithParam<int> {};
 
 TEST_P(JobSeeds, DrillThenFinishFromTheJobStore) {
-  const JobResult j = run_job(GetParam(), 20.0, 0.6);
+  const JobResult j = run_job(GetParam(), drill_then_finish(20.0, 0.6), {0, 0, 0.1});
   std::printf(
       "[edm_job] seed %d finished %d in %.1f s: depth %.4f mm, wall r %.4f..%.4f (initial %.4f), "
       "z end %.3f, shorts %.2f %%\n",
@@ -153,6 +156,27 @@ TEST_P(JobSeeds, DrillThenFinishFromTheJobStore) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, JobSeeds, ::testing::Values(1, 2, 3));
+
+// The shipped example, through the HMI's interpreter (the program edmhmi run uploads): a 15 mm
+// hole at X-20 Y10 (the simulator drills where the electrode is), then the wall to R0.60.
+TEST(PartPrograms, DrillThenFinishExampleOnTheSimulatedMachine) {
+  const std::string cfg = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml";
+  std::ifstream in(std::string(EDM_SOURCE_DIR) + "/examples/parts/drill-then-finish.nc");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  hmi::GcodeOptions o;
+  o.start_mm = {0, 0, 0.1};  // where the simulated electrode starts
+  const auto g =
+      hmi::interpret_gcode(text, "drill-then-finish.nc", machining::read_machine_tables(cfg), o);
+  ASSERT_TRUE(g.ok()) << g.messages()[0];
+  const JobResult j = run_job(1, g.blocks, o.start_mm);
+  std::printf("[edm_job] example finished %d in %.1f s: depth %.4f mm, wall r %.4f..%.4f\n",
+              j.finished, j.time_s, j.depth_mm, j.r_min_mm, j.r_max_mm);
+  ASSERT_TRUE(j.finished);
+  EXPECT_NEAR(j.depth_mm, 15.0, 0.02);
+  EXPECT_NEAR(j.r_min_mm, 0.60, 0.01);  // the hole axis is fixed at the first spark, while XY
+                                        // may still settle by a few µm
+  EXPECT_NEAR(j.r_max_mm, 0.60, 0.012);
+}
 
 }  // namespace
 }  // namespace edm::test

@@ -162,6 +162,11 @@ TEST(BuildErrors, TraceAndRetainNamesMustExist) {
   rt::Diagnostic d = build_error(cfg + "trace: {variables: [p.a.out, p.a.nope]}\n");
   EXPECT_EQ(d.loc.line, 17);
   EXPECT_NE(d.message.find("trace: unknown variable 'p.a.nope'"), std::string::npos) << d.str();
+  d = build_error(cfg + "bridge: {port: 0, status_vars: [p.a.out, p.a.nope]}\n");
+  EXPECT_EQ(d.loc.line, 17);
+  EXPECT_EQ(d.loc.col, 42);
+  EXPECT_NE(d.message.find("bridge.status_vars: unknown variable 'p.a.nope'"), std::string::npos)
+      << d.str();
   d = build_error(cfg + "retain: {file: /tmp/x.retain, variables: [p.a.in]}\n");
   EXPECT_NE(d.message.find("is an input"), std::string::npos) << d.str();
 }

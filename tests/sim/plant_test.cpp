@@ -414,7 +414,8 @@ TEST(SimPlant, orbit_offset_erodes_the_near_wall) {
   auto params = kDrill;
   params.wall_sparks = true;
   Plant p(params, 12);
-  p.hold_gap(45.0);  // a slow front, so the wall competes
+  p.set_depth_mm(2.0);  // the tip in the hole: the wall exists there
+  p.hold_gap(45.0);     // a slow front, so the wall competes
   auto cmd = generator_on();
   cmd.vx_mm_s = 1.0;
   p.set_commands(cmd);
@@ -428,6 +429,67 @@ TEST(SimPlant, orbit_offset_erodes_the_near_wall) {
   EXPECT_GT(near, 0.005);
   EXPECT_LT(far, 0.2 * near);  // (centred, in the first ms, all bins took some sparks)
   EXPECT_GT(p.state().wall_radius_mm, r0);
+}
+
+// The hole is drilled where the electrode is: the same drilling at (−20, 10) as at the origin
+// gives the same pulses (the draws are indexed by pulse number), and a retract above the surface
+// followed by a move of more than a hole diameter starts a fresh hole. The wall sparks only with
+// the tip below the surface.
+TEST(SimPlant, the_hole_is_where_the_electrode_drills) {
+  auto params = kDrill;
+  params.wall_sparks = true;
+  auto drill_at = [&](double x, double y) {
+    Plant p(params, 15);
+    PlantCommands move;
+    move.vx_mm_s = x;  // 1 s at these speeds, generator off
+    move.vy_mm_s = y;
+    p.set_commands(move);
+    run_ms(p, 1000);
+    p.set_commands(PlantCommands{});
+    run_ms(p, 200);
+    p.set_depth_mm(2.0);  // a hole begun here (the tip inside it, so its wall competes)
+    p.hold_gap(45.0);
+    p.set_commands(generator_on());
+    const auto s = run_ms(p, 300);
+    return std::make_pair(s, p.state().wall_radius_mm);
+  };
+  const auto [at_origin, r_origin] = drill_at(0.0, 0.0);
+  const auto [offset, r_offset] = drill_at(-20.0, 10.0);
+  ASSERT_GT(total(at_origin), 1000);
+  EXPECT_GT(r_origin, params.hole_d_mm / 2.0);  // the wall took sparks
+  EXPECT_LT(of(offset, PulseClass::kShort), total(offset) / 100);
+  EXPECT_NEAR(static_cast<double>(total(offset)), static_cast<double>(total(at_origin)),
+              0.01 * static_cast<double>(total(at_origin)));
+  EXPECT_NEAR(r_offset, r_origin, 1e-3);
+
+  Plant p(params, 16);
+  p.set_depth_mm(2.0);
+  PlantCommands cmd;
+  cmd.vx_mm_s = 3.0;  // 0.3 mm sideways, less than a hole diameter: still the same hole
+  p.set_commands(cmd);
+  run_ms(p, 100);
+  p.set_commands(PlantCommands{});
+  run_ms(p, 50);
+  EXPECT_DOUBLE_EQ(p.state().depth_mm, 2.0);
+  cmd.vx_mm_s = 0.0;
+  cmd.vz_mm_s = 10.0;  // up and out (tip above the surface) ...
+  p.set_commands(cmd);
+  run_ms(p, 500);
+  cmd.vz_mm_s = 0.0;
+  cmd.vx_mm_s = 20.0;  // ... then 2 mm sideways: a fresh hole
+  p.set_commands(cmd);
+  run_ms(p, 100);
+  p.set_commands(PlantCommands{});
+  run_ms(p, 50);
+  EXPECT_DOUBLE_EQ(p.state().depth_mm, 0.0);
+  EXPECT_DOUBLE_EQ(p.state().wall_radius_mm, params.hole_d_mm / 2.0);
+
+  Plant above(params, 17);  // a fresh plate, the tip 45 µm above it: only the front sparks
+  above.hold_gap(45.0);
+  above.set_commands(generator_on());
+  const auto s = run_ms(above, 300);
+  EXPECT_GT(total(s), 1000);
+  EXPECT_DOUBLE_EQ(above.state().wall_radius_mm, params.hole_d_mm / 2.0);
 }
 
 TEST(SimPlant, a_jump_flushes_debris) {

@@ -7,6 +7,7 @@
 #include <set>
 #include <variant>
 
+#include "edm/bridge/machine_info.hpp"
 #include "edm/machining/program_check.hpp"
 #include "edm/runtime/stats_json.hpp"
 #include "server_impl.hpp"
@@ -469,6 +470,10 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
   }
   if (op == "trace.stop") {
     return op_trace_stop(s);
+  }
+  if (op == "machine.info") {
+    const rt::Runtime& rt = s.server().rt;
+    return to_json(rt.tables(), rt.config().machine.name);
   }
   return error(ErrorCode::kUnknownOp, "unknown op '" + op + "'");
 }

@@ -210,12 +210,12 @@ void Server::Impl::do_accept() {
         const bool full = sessions.size() >= static_cast<std::size_t>(opt.max_sessions);
         if (full || (!tokens.any() && !s->loopback())) {
           counters.sessions_refused.fetch_add(1, std::memory_order_relaxed);
+          // The refusal answers the client's first request (its hello), with that request's
+          // id, so a client can tell it from a dropped connection; then the session closes.
+          s->refuse(full ? ErrorCode::kBusy : ErrorCode::kUnauthorized,
+                    full ? "too many sessions (max " + std::to_string(opt.max_sessions) + ")"
+                         : "only loopback clients are served without a token");
           s->start();
-          s->send_reply(
-              make_error(nullptr, full ? ErrorCode::kBusy : ErrorCode::kUnauthorized,
-                         full ? "too many sessions (max " + std::to_string(opt.max_sessions) + ")"
-                              : "only loopback clients are served without a token"));
-          s->close_after_flush();
         } else {
           counters.sessions_accepted.fetch_add(1, std::memory_order_relaxed);
           counters.sessions_open.fetch_add(1, std::memory_order_relaxed);

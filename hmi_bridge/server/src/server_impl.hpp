@@ -120,6 +120,8 @@ class Session : public std::enable_shared_from_this<Session> {
   /// Closes once the queued messages are written.
   void close_after_flush();
   void linger_close();
+  /// Before start(): the session only answers its first request with this error, then closes.
+  void refuse(ErrorCode code, std::string message);
   /// Sends a reply (never dropped; a client that floods requests without reading is paused).
   void send_reply(const Json& reply);
   /// Queues an event if the queue has room; else drops it (counted) and disconnects a reader
@@ -160,7 +162,9 @@ class Session : public std::enable_shared_from_this<Session> {
   std::deque<std::shared_ptr<const std::string>> queue_;
   bool writing_{false};
   bool close_after_flush_{false};
-  bool lingering_{false};  // half-closed, draining the client's input until it closes
+  bool lingering_{false};
+  std::optional<std::pair<ErrorCode, std::string>>
+      refusal_;  // half-closed, draining the client's input until it closes
   bool closed_{false};
   std::uint64_t seq_{0};
   std::uint64_t dropped_{0};

@@ -70,6 +70,10 @@ void Session::async_close() {
   asio::dispatch(strand_, [self = shared_from_this()] { self->close(); });
 }
 
+void Session::refuse(ErrorCode code, std::string message) {
+  refusal_.emplace(code, std::move(message));
+}
+
 void Session::close_after_flush() {
   close_after_flush_ = true;
   if (!writing_ && queue_.empty()) {
@@ -207,6 +211,11 @@ void Session::handle_line(std::string_view line) {
   Json id;
   auto req = parse_request(line, code, message, id);
   OpResult r;
+  if (refusal_) {
+    send_reply(make_error(id, refusal_->first, refusal_->second));
+    close_after_flush();
+    return;
+  }
   if (!req) {
     r.reply = make_error(id, code, message);
   } else {

@@ -17,6 +17,7 @@
 //   2 DRILL     td → gap → wear → vz_cmd_mm_s (wear compensation only if enable_wear_comp).
 //               Hole depth estimate (the electrode front is z − accumulated wear):
 //                 depth_reached_mm = (touch_z_mm − z_mm) − (enable_wear_comp ? wear.wear_mm : 0)
+//                 (output wear_mm: that estimated electrode wear of this cycle)
 //               When it reaches the target → RETRACT. With `through` set, breakthrough_cycles
 //               consecutive cycles without an ignited pulse (td_count = 0) once depth ≥
 //               breakthrough_min_mm mean the front has left the work: breakthrough = true →
@@ -124,7 +125,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<double> vz_cmd_mm_s_;
   rt::Output<bool> gen_on_;
   rt::Output<std::int64_t> state_;
-  rt::Output<double> depth_reached_mm_, touch_z_mm_;
+  rt::Output<double> depth_reached_mm_, touch_z_mm_, wear_out_mm_;
   rt::Output<bool> done_;
   rt::Output<bool> breakthrough_;
 

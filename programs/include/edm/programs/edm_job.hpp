@@ -29,7 +29,9 @@
 //   arc_cw / arc_ccw  arc interpolates in XY (centre, end, turns), Z held; then in position.
 //   drill      drill.depth_mm = −target.z (Z0 is the work surface; the depth is measured from
 //              the touch point), through = false, wear ratio and Tdr of the active condition; XY
-//              held by px/py; done when the drill child is DONE (after its retract).
+//              held by px/py; when the drill child is DONE (after its retract) a rapid takes the
+//              electrode back to where the block began, so a drilling block ends at its start
+//              point (the G-code interpreter's current point after it, docs/gcode.md).
 //   orbit_finish  finish.final_offset_mm = final_radius_mm − orbit_radius_offset_mm (the
 //              electrode radius plus the finishing side gap, calibrated: docs/blocks.md); Z held.
 //   end        finishes the job.
@@ -39,6 +41,12 @@
 // Outputs for the I/O image: vx/vy/vz_cmd_mm_s, gen_arm, gen_on, polarity_positive,
 // on_time_us, off_time_us, servo_ref_v, flushing_on, rotation_on; progress: state, block_index,
 // line, jobs_finished.
+// Job figures (reset when a job begins, frozen when it ends; the HMI's job report reads them, so
+// they survive the HMI): job_time_s (machine time in the job), job_pulses / job_shorts / job_arcs
+// (the I/O counts n_open + n_normal + n_transient_arc + n_stable_arc + n_short, n_short, and
+// n_transient_arc + n_stable_arc summed over the job's cycles; unwired count inputs read 0),
+// job_depth_mm (deepest depth_reached_mm of the job's drilling blocks), job_wear_mm (estimated
+// electrode wear, eq. 8, summed over the drilling blocks).
 // RT-safety: update() and enter_safe_state() never allocate, lock or throw. Needs the runtime's
 // BlockSetup (machine, job, tables): configure() reports an error without them.
 
@@ -88,6 +96,8 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   enum class Step : std::uint8_t { kEnter, kLoad, kGo, kBusy, kSettle };
 
   void finish_job(rt::JobOutcome outcome) noexcept;
+  void begin_job_figures(const rt::CycleContext& ctx) noexcept;
+  void count_job_figures(const rt::CycleContext& ctx) noexcept;
   void select_condition(int e) noexcept;
   /// Executes the current block one cycle; true when it is complete.
   bool run_block(const machining::MotionBlock& b, const rt::CycleContext& ctx, bool hold,
@@ -111,11 +121,14 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
 
   // Own pins.
   rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_;
+  rt::Input<std::int64_t> n_normal_, n_transient_arc_, n_stable_arc_;
   rt::Input<double> x_mm_, y_mm_, z_mm_;
   rt::Output<double> vx_, vy_, vz_;
   rt::Output<bool> gen_arm_, gen_on_, polarity_positive_, flushing_on_, rotation_on_;
   rt::Output<double> on_time_us_, off_time_us_, servo_ref_v_;
   rt::Output<std::int64_t> state_, block_index_, line_, jobs_finished_;
+  rt::Output<double> job_time_s_, job_depth_mm_, job_wear_mm_;
+  rt::Output<std::int64_t> job_pulses_, job_shorts_, job_arcs_;
 
   // Cells the children's inputs are wired to.
   rt::Output<std::int64_t> c_td_sum_ns_, c_td_count_, c_n_open_, c_n_short_;
@@ -133,6 +146,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   const rt::Output<double>*drill_vz_{}, *finish_vx_{}, *finish_vy_{};
   const rt::Output<bool>*drill_gen_{}, *finish_gen_{}, *finish_pos_{};
   const rt::Output<std::int64_t>*drill_state_{}, *finish_state_{};
+  const rt::Output<double>*drill_depth_{}, *drill_wear_{};
   const rt::Output<double>*lin_rx_{}, *lin_ry_{}, *lin_rz_{}, *lin_vx_{}, *lin_vy_{}, *lin_vz_{};
   const rt::Output<bool>* lin_done_{};
   const rt::Output<double>*arc_rx_{}, *arc_ry_{}, *arc_vx_{}, *arc_vy_{};
@@ -148,6 +162,10 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   const machining::Condition* condition_{nullptr};
   bool polarity_positive_value_{false};
   bool limit_alarm_raised_{false};
+  rt::TimePoint job_start_{};
+  double wear_before_block_{0.0};  // job_wear_mm when the current drilling block began
+  bool drill_returning_{false};    // the drill is done; rapid back to the block's start
+  machining::MotionBlock drill_return_{};
 };
 
 }  // namespace edm::programs

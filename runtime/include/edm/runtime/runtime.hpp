@@ -39,6 +39,9 @@ struct RunOptions {
   std::optional<Duration> run_for;         // nullopt: until *stop
   const std::atomic<bool>* stop{nullptr};  // set by a signal handler
   std::string trace_out;                   // CSV path; empty: no trace file
+  /// Virtual clock only: > 0 paces virtual time to `speed` × wall time (an accelerated but
+  /// still deterministic machine, e.g. for an HMI to follow a job); 0 runs as fast as possible.
+  double speed{0.0};
 };
 
 struct RunSummary {

@@ -86,6 +86,7 @@ struct SimParams {
   double electrode_length_mm{300.0};  // tube/block length sticking out; consumed by wear
   double work_thickness_mm{0.0};      // tube/block: through at this depth; 0 = blind (no limit)
   double start_gap_um{100.0};         // tip above the work surface at start
+  double initial_depth_mm{0.0};       // a hole already there (tip start_gap_um above its bottom)
 
   // --- Debris and flushing (§6.2 step 7) ---
   double debris_kappa{0.75};        // κ: c += κ V / V_gap; calibrated [bk], see simulator.md

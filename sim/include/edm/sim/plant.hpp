@@ -112,6 +112,10 @@ class Plant {
   [[nodiscard]] double flush_effective() const noexcept;
   void account(std::int64_t until_ns) noexcept;
   void step_axes(std::int64_t t_ns) noexcept;
+  /// Tube: before any erosion the hole's axis follows the electrode's XY; once the tip is
+  /// back above the surface and more than a hole diameter away, a fresh hole begins there (the
+  /// simulator models one hole at a time, so a row of holes can be drilled).
+  void track_hole() noexcept;
   void start_pulse(std::int64_t t_ns) noexcept;
   void enter_phase(Phase ph, std::int64_t t_ns, std::int64_t dur_ns) noexcept;
   void on_phase_end(std::int64_t t_ns) noexcept;
@@ -136,6 +140,10 @@ class Plant {
   double wear_length_mm_{0.0};  // electrode consumed: the tip is at z + wear_length
   std::array<double, kWallBins> wall_r_mm_{};
   std::array<double, kWallBins> wall_cos_{}, wall_sin_{};
+  // The hole's axis (tube): it follows the electrode until material has been removed at the
+  // front, so a hole is drilled where the program puts the electrode; see track_hole().
+  double hole_cx_mm_{0.0}, hole_cy_mm_{0.0};
+  bool hole_started_{false};  // material removed since the hole began
   ThicknessProfile profile_{};
 
   // Axes.

@@ -1,0 +1,53 @@
+// The pieces every edmhmi command shares (cli.hpp).
+#include "cli.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+namespace edmhmi {
+
+bool connect(edm::bridge::Client& client, const edm::hmi::ConnectionSettings& s,
+             bool auto_reconnect) {
+  edm::bridge::ClientOptions o;
+  o.host = s.host;
+  o.port = s.port;
+  o.token = s.token;
+  o.auto_reconnect = auto_reconnect;
+  try {
+    client.connect(o);
+    return true;
+  } catch (const edm::bridge::ClientError& e) {
+    std::fprintf(stderr, "edmhmi: edmplc at %s:%u: %s\n", s.host.c_str(), unsigned{s.port},
+                 e.what());
+    if (e.code() == edm::bridge::ErrorCode::kUnauthorized) {
+      std::fprintf(stderr, "edmhmi: token from %s\n",
+                   s.token_source.empty() ? "nowhere (none given)" : s.token_source.c_str());
+    }
+    return false;
+  }
+}
+
+int report_error(std::string_view op, const edm::bridge::Reply& r) {
+  const std::string code = r.code ? std::string(edm::bridge::to_string(*r.code)) : "transport";
+  std::fprintf(stderr, "edmhmi: %s: %s: %s\n", std::string(op).c_str(), code.c_str(),
+               r.message.c_str());
+  return r.code == edm::bridge::ErrorCode::kBadRequest ? kExitBadInput : kExitFailure;
+}
+
+bool read_text_file(const std::string& path, std::string& out) {
+  constexpr std::size_t kMaxBytes = 64u << 20;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "%s: cannot open\n", path.c_str());
+    return false;
+  }
+  out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad() || out.size() > kMaxBytes) {
+    std::fprintf(stderr, "%s: unreadable or larger than %zu bytes\n", path.c_str(), kMaxBytes);
+    return false;
+  }
+  return true;
+}
+
+}  // namespace edmhmi

@@ -1,0 +1,49 @@
+// edmhmi check [--machine CONFIG] PART.nc — offline interpretation (docs/gcode.md).
+#include <cstdio>
+
+#include "cli.hpp"
+#include "edm/hmi/gcode.hpp"
+#include "edm/machining/machine_config.hpp"
+
+namespace edmhmi {
+
+int cmd_check(const Args& args) {
+  std::string machine = EDM_DEFAULT_MACHINE;
+  std::string part;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--machine") {
+      if (i + 1 >= args.size()) return usage("--machine needs a config file");
+      machine = std::string(args[++i]);
+    } else if (args[i].starts_with("--")) {
+      return usage("check: unknown option '" + std::string(args[i]) + "'");
+    } else if (part.empty()) {
+      part = std::string(args[i]);
+    } else {
+      return usage("check takes one part program");
+    }
+  }
+  if (part.empty()) return usage("check needs a part program (PART.nc)");
+
+  edm::machining::MachineTables tables;
+  try {
+    tables = edm::machining::read_machine_tables(machine);
+  } catch (const edm::machining::MachineConfigError& e) {
+    for (const std::string& m : e.messages()) std::fprintf(stderr, "%s\n", m.c_str());
+    return kExitBadInput;
+  }
+  std::string text;
+  if (!read_text_file(part, text)) return kExitBadInput;
+  const edm::hmi::GcodeResult r = edm::hmi::interpret_gcode(text, part, tables);
+  if (!r.ok()) {
+    for (const std::string& m : r.messages()) std::fprintf(stderr, "%s\n", m.c_str());
+    return kExitBadInput;
+  }
+  std::printf(
+      "%s: ok: %zu blocks, %d drilling blocks, %.3f mm drilled, estimated electrode wear %.3f mm "
+      "(machine %s)\n",
+      part.c_str(), r.blocks.size(), r.drill_blocks, r.drill_depth_mm, r.electrode_wear_mm,
+      machine.c_str());
+  return kExitOk;
+}
+
+}  // namespace edmhmi

@@ -1,0 +1,24 @@
+// edmhmi hold | resume | stop | estop | reset — the machine commands (docs/runtime.md has the
+// state machine; a command in the wrong state is refused with invalid_state, exit 1).
+#include <cstdio>
+
+#include "cli.hpp"
+
+namespace edmhmi {
+
+int cmd_machine(std::string_view command, const Args& args,
+                const edm::hmi::ConnectionSettings& settings) {
+  if (!args.empty()) return usage(std::string(command) + " takes no arguments");
+  const std::string op = command == "hold"     ? "cycle.hold"
+                         : command == "resume" ? "cycle.resume"
+                         : command == "stop"   ? "cycle.stop"
+                                               : std::string(command);  // estop, reset
+  edm::bridge::Client client;
+  if (!connect(client, settings)) return kExitFailure;
+  const edm::bridge::Reply r = client.request(op);
+  if (!r) return report_error(op, r);
+  std::printf("%s: machine %s\n", op.c_str(), r.body.value("state", std::string("?")).c_str());
+  return kExitOk;
+}
+
+}  // namespace edmhmi

@@ -1,0 +1,70 @@
+#include "edm/hmi/connection.hpp"
+
+#include <charconv>
+#include <fstream>
+
+namespace edm::hmi {
+
+namespace {
+
+std::string trim(std::string s) {
+  const auto first = s.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return {};
+  const auto last = s.find_last_not_of(" \t\r\n");
+  return s.substr(first, last - first + 1);
+}
+
+const char* env_or_null(EnvLookup env, const char* name) {
+  if (env == nullptr) return nullptr;
+  const char* v = env(name);
+  return v != nullptr && *v != '\0' ? v : nullptr;
+}
+
+}  // namespace
+
+std::uint16_t parse_port(std::string_view text, std::string_view what) {
+  unsigned value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc{} || end != text.data() + text.size() || value < 1 || value > 65535) {
+    throw SettingsError(std::string(what) + ": '" + std::string(text) +
+                        "' is not a port number (1..65535)");
+  }
+  return static_cast<std::uint16_t>(value);
+}
+
+std::string read_token_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SettingsError("token file '" + path + "': cannot be read");
+  std::string line;
+  std::getline(in, line);
+  line = trim(line);
+  if (line.empty()) throw SettingsError("token file '" + path + "': empty first line");
+  return line;
+}
+
+ConnectionSettings resolve_connection(const ConnectionFlags& flags, EnvLookup env) {
+  ConnectionSettings s;
+  if (!flags.host.empty()) {
+    s.host = flags.host;
+  } else if (const char* h = env_or_null(env, "EDM_HOST")) {
+    s.host = h;
+  }
+  if (!flags.port.empty()) {
+    s.port = parse_port(flags.port, "--port");
+  } else if (const char* p = env_or_null(env, "EDM_PORT")) {
+    s.port = parse_port(p, "$EDM_PORT");
+  }
+  if (!flags.token_file.empty()) {
+    s.token = read_token_file(flags.token_file);
+    s.token_source = "--token-file " + flags.token_file;
+  } else if (const char* f = env_or_null(env, "EDM_TOKEN_FILE")) {
+    s.token = read_token_file(f);
+    s.token_source = std::string("$EDM_TOKEN_FILE ") + f;
+  } else if (const char* t = env_or_null(env, "EDM_TOKEN")) {
+    s.token = trim(t);
+    s.token_source = "$EDM_TOKEN";
+  }
+  return s;
+}
+
+}  // namespace edm::hmi
