@@ -12,8 +12,8 @@
 #include <utility>
 
 #include "edm/hmi/gcode.hpp"
+#include "edm/machining/program_check.hpp"
 #include "edm/machining/wear_precomp.hpp"
-#include "gcode_arc.hpp"
 #include "gcode_block.hpp"
 #include "gcode_lexer.hpp"
 
@@ -38,8 +38,6 @@ std::vector<std::string> GcodeResult::messages() const {
 
 namespace {
 
-using detail::arc_bounding_box;
-using detail::ArcBox;
 using detail::Block;
 using detail::code10;
 using detail::is_whole;
@@ -82,6 +80,7 @@ class Interpreter {
     if (!stop_ && !ended_) {
       error(std::max(line_no, 1), 1, "program has no end: finish it with M02 or M30");
     }
+    if (!stop_) check_blocks();
     std::stable_sort(result_.errors.begin(), result_.errors.end(),
                      [](const GcodeError& a, const GcodeError& b) {
                        return a.line != b.line ? a.line < b.line : a.col < b.col;
@@ -166,18 +165,31 @@ class Interpreter {
     return mb;
   }
 
-  /// Reports each coordinate of p outside its axis's soft limits, at the axis word of the block
-  /// when `what` is empty (an end point), else at `at` (an arc's or orbit's extent).
-  void check_limits(const Block& b, const Vec3& p, const Word* at, const std::string& what) {
-    const std::array<std::pair<char, double>, 3> coords{{{'X', p.x}, {'Y', p.y}, {'Z', p.z}}};
-    for (const auto& [axis, v] : coords) {
-      const machining::AxisLimits* lim = tables_.axis(axis);
-      if (lim == nullptr || (v >= lim->min_mm - kEps && v <= lim->max_mm + kEps)) continue;
-      const Word* w = what.empty() && b[axis] != nullptr ? b[axis] : at;
-      error(b, w,
-            what + std::string(1, axis) + " " + mm(v) + " mm is beyond the " + axis +
-                " soft limit (" + mm(lim->min_mm) + ".." + mm(lim->max_mm) + " mm)");
+  /// The soft limits (end points, arc and orbit extents, drilling travel) are checked by
+  /// machining::check_program, the check the runtime runs at program.commit, so the HMI and the
+  /// runtime refuse the same programs with the same words. An end point beyond a limit is
+  /// reported at its axis word, anything else at the word that made the block. Issues other than
+  /// soft limits mean the two disagree; they are reported only for a program that is otherwise
+  /// clean (after a refused line the blocks no longer follow the modelled position).
+  void check_blocks() {
+    machining::ProgramCheckOptions o;
+    o.arc_tolerance_mm = opt_.arc_tolerance_mm;
+    const bool clean = result_.errors.empty();
+    for (const machining::ProgramIssue& is :
+         machining::check_program(result_.blocks, tables_, opt_.start_mm, o)) {
+      if (!is.soft_limit && !clean) continue;
+      int col = is.col;
+      if (is.axis != 0 && static_cast<std::size_t>(is.line) < axis_cols_.size()) {
+        const int axis_col = axis_cols_[static_cast<std::size_t>(is.line)][axis_index(is.axis)];
+        if (axis_col > 0) col = axis_col;
+      }
+      error(is.line, col, is.message);
+      if (stop_) return;
     }
+  }
+
+  static std::size_t axis_index(char axis) noexcept {
+    return static_cast<std::size_t>(axis == 'X' ? 0 : axis == 'Y' ? 1 : 2);
   }
 
   bool need_feed(const Block& b, const Word* at, const char* what) {
@@ -360,9 +372,6 @@ class Interpreter {
     mb.final_radius_mm = r;
     if (need_feed(b, b.nonmodal_g, "G160")) mb.feed_mm_s = feed_mm_min_ / 60.0;
     result_.blocks.push_back(mb);
-    const std::string what = "G160 orbit of radius " + mm(r) + " mm: ";
-    check_limits(b, {pos_.x - r, pos_.y - r, pos_.z}, b.nonmodal_g, what);
-    check_limits(b, {pos_.x + r, pos_.y + r, pos_.z}, b.nonmodal_g, what);
   }
 
   void do_motion(const Block& b) {
@@ -376,11 +385,11 @@ class Interpreter {
     const Vec3 target{coord('X', start.x), coord('Y', start.y), coord('Z', start.z)};
     const Word* at = b.motion_g != nullptr ? b.motion_g : b.first_axis();
     if (at == nullptr) at = b['I'] != nullptr ? b['I'] : b['J'];
+    remember_axis_words(b);
     switch (mode_) {
       case Motion::kRapid: {
         pos_ = target;
         result_.blocks.push_back(make(MotionKind::kRapid, b, at));
-        check_limits(b, target, at, "");
         break;
       }
       case Motion::kLinear:
@@ -400,7 +409,6 @@ class Interpreter {
     const bool drill = armed_ >= 1 && target.z < start.z - kEps;
     MotionBlock mb = make(drill ? MotionKind::kDrill : MotionKind::kLinear, b, at);
     if (need_feed(b, at, "G01")) mb.feed_mm_s = feed_mm_min_ / 60.0;
-    check_limits(b, target, at, "");
     if (!drill) {
       result_.blocks.push_back(mb);
       return;
@@ -424,15 +432,6 @@ class Interpreter {
     result_.drill_depth_mm += lz;
     result_.electrode_wear_mm += wp.delta_mm;
     ++result_.drill_blocks;
-    // The Z axis itself travels lz' (the tip arrives at the nominal bottom as the electrode wears).
-    const machining::AxisLimits* zl = tables_.axis('Z');
-    const double axis_end = start.z - wp.travel_mm;
-    if (zl != nullptr && target.z >= zl->min_mm - kEps && axis_end < zl->min_mm - kEps) {
-      error(b, b['Z'] != nullptr ? b['Z'] : at,
-            "drilling with wear pre-compensation moves Z to " + mm(axis_end) + " mm (nominal " +
-                mm(target.z) + " - wear " + mm(wp.delta_mm) + " mm), beyond the Z soft limit (" +
-                mm(zl->min_mm) + ".." + mm(zl->max_mm) + " mm)");
-    }
   }
 
   void do_arc(const Block& b, const Word* at, const Vec3& start, Vec3 target) {
@@ -472,18 +471,22 @@ class Interpreter {
     mb.turns = b['P'] != nullptr ? static_cast<std::int32_t>(b['P']->value) : 0;
     if (need_feed(b, at, name)) mb.feed_mm_s = feed_mm_min_ / 60.0;
     result_.blocks.push_back(mb);
-    const ArcBox box =
-        arc_bounding_box(start.x - centre.x, start.y - centre.y, target.x - centre.x,
-                         target.y - centre.y, mode_ == Motion::kArcCw, full || mb.turns > 0);
-    const std::string what = std::string(name) + " arc: ";
-    check_limits(b, {centre.x + box.min_x, centre.y + box.min_y, start.z}, at, what);
-    check_limits(b, {centre.x + box.max_x, centre.y + box.max_y, start.z}, at, what);
+  }
+
+  /// Where this line's X, Y and Z words are (columns, 0 = absent), for soft-limit messages.
+  void remember_axis_words(const Block& b) {
+    const auto line = static_cast<std::size_t>(b.line);
+    if (axis_cols_.size() <= line) axis_cols_.resize(std::max(line + 1, 2 * axis_cols_.size()));
+    for (char axis : {'X', 'Y', 'Z'}) {
+      axis_cols_[line][axis_index(axis)] = b[axis] != nullptr ? b[axis]->col : 0;
+    }
   }
 
   std::string_view text_;
   const MachineTables& tables_;
   const GcodeOptions& opt_;
   GcodeResult result_;
+  std::vector<std::array<int, 3>> axis_cols_;  // by line: columns of X, Y, Z words
 
   Vec3 pos_{};
   Motion mode_{Motion::kNone};

@@ -14,4 +14,12 @@ const AxisLimits* MachineTables::axis(char name) const noexcept {
   return nullptr;
 }
 
+MachineTables make_tables(const std::vector<LocatedAxis>& axes,
+                          const std::vector<LocatedCondition>& conditions) {
+  MachineTables t;
+  t.axes.assign(axes.begin(), axes.end());
+  t.conditions.assign(conditions.begin(), conditions.end());
+  return t;
+}
+
 }  // namespace edm::machining

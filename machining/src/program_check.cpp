@@ -2,20 +2,75 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
 namespace edm::machining {
 namespace {
 
+constexpr double kLimitSlackMm = 1e-9;  // rounding slack: a point this close to a limit is in
+
 bool finite(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-std::string fmt_mm(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", v);
+std::string mm(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
   return buf;
+}
+
+/// The angle swept (rad, in (0, 2π]) going from angle a0 to a1 counter-clockwise; equal angles
+/// sweep the full circle.
+double ccw_sweep(double a0, double a1) noexcept {
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  double s = std::fmod(a1 - a0, kTwoPi);
+  if (s <= 0.0) s += kTwoPi;
+  return s;
+}
+
+/// Bounding box of an XY arc relative to its centre (mm).
+struct ArcBox {
+  double min_x{0.0};
+  double max_x{0.0};
+  double min_y{0.0};
+  double max_y{0.0};
+};
+
+/// The box of the arc from (sx, sy) to (ex, ey) (both relative to the centre) swept clockwise or
+/// counter-clockwise; `full` sweeps the whole circle (extra turns). The radius is the start
+/// radius (the end radius agrees within the arc tolerance).
+ArcBox arc_bounding_box(double sx, double sy, double ex, double ey, bool clockwise,
+                        bool full) noexcept {
+  const double r = std::hypot(sx, sy);
+  ArcBox box{std::min(sx, ex), std::max(sx, ex), std::min(sy, ey), std::max(sy, ey)};
+  const double a0 = std::atan2(sy, sx);
+  const double a1 = std::atan2(ey, ex);
+  // Going clockwise from a0 to a1 sweeps the same points as counter-clockwise from a1 to a0.
+  const double from = clockwise ? a1 : a0;
+  const double sweep = full ? 2.0 * std::numbers::pi : ccw_sweep(from, clockwise ? a0 : a1);
+  for (int k = 0; k < 4; ++k) {
+    const double a = k * std::numbers::pi / 2.0;
+    // An axis direction a lies on the arc when it is reached from `from` within the sweep.
+    if (full || ccw_sweep(from, a) <= sweep) {
+      switch (k) {
+        case 0:
+          box.max_x = std::max(box.max_x, r);
+          break;
+        case 1:
+          box.max_y = std::max(box.max_y, r);
+          break;
+        case 2:
+          box.min_x = std::min(box.min_x, -r);
+          break;
+        default:
+          box.min_y = std::min(box.min_y, -r);
+          break;
+      }
+    }
+  }
+  return box;
 }
 
 class Checker {
@@ -28,23 +83,38 @@ class Checker {
     out_.push_back({i, b.line, b.col, std::move(message)});
   }
 
-  void check_point(std::size_t i, const MotionBlock& b, const Vec3& p, const char* what) {
-    check_axis(i, b, 'X', p.x, what);
-    check_axis(i, b, 'Y', p.y, what);
-    check_axis(i, b, 'Z', p.z, what);
+  /// The limits of `axis` when v is beyond them, else nullptr.
+  [[nodiscard]] const AxisLimits* beyond(char axis, double v) const {
+    const AxisLimits* a = tables_.axis(axis);
+    if (a == nullptr || (v >= a->min_mm - kLimitSlackMm && v <= a->max_mm + kLimitSlackMm)) {
+      return nullptr;
+    }
+    return a;
   }
 
-  void check_axis(std::size_t i, const MotionBlock& b, char axis, double v, const char* what) {
-    const AxisLimits* a = tables_.axis(axis);
-    if (a == nullptr) return;
-    if (v < a->min_mm || v > a->max_mm) {
-      issue(i, b,
-            std::string(what) + " " + axis + " " + fmt_mm(v) + " mm is outside the soft limits [" +
-                fmt_mm(a->min_mm) + ", " + fmt_mm(a->max_mm) + "]");
+  /// Each coordinate of p beyond its axis's limits; `extent` names an arc's or orbit's extent
+  /// ("G02 arc: "), empty for an end point (then the issue names its axis).
+  void check_point(std::size_t i, const MotionBlock& b, const Vec3& p, const std::string& extent,
+                   bool with_z = true) {
+    check_axis(i, b, 'X', p.x, extent);
+    check_axis(i, b, 'Y', p.y, extent);
+    if (with_z) check_axis(i, b, 'Z', p.z, extent);
+  }
+
+  void check_axis(std::size_t i, const MotionBlock& b, char axis, double v,
+                  const std::string& extent) {
+    if (const AxisLimits* a = beyond(axis, v)) {
+      limit_issue(i, b, extent.empty() ? axis : '\0',
+                  extent + axis + " " + mm(v) + " mm is beyond the " + axis + " soft limit (" +
+                      mm(a->min_mm) + ".." + mm(a->max_mm) + " mm)");
     }
   }
 
-  // The arc's extreme points: the axis-aligned bounding box of the swept angle.
+  void limit_issue(std::size_t i, const MotionBlock& b, char axis, std::string message) {
+    out_.push_back({i, b.line, b.col, std::move(message), true, axis});
+  }
+
+  /// Arc consistency, then the arc's extent over its swept angle (which holds its end point).
   void check_arc(std::size_t i, const MotionBlock& b, const Vec3& from) {
     const double r0 = std::hypot(from.x - b.centre.x, from.y - b.centre.y);
     const double r1 = std::hypot(b.target.x - b.centre.x, b.target.y - b.centre.y);
@@ -54,25 +124,31 @@ class Checker {
     }
     if (std::abs(r0 - r1) > std::max(options_.arc_tolerance_mm, 1e-4 * r0)) {
       issue(i, b,
-            "arc start radius " + fmt_mm(r0) + " mm and end radius " + fmt_mm(r1) +
+            "arc start radius " + mm(r0) + " mm and end radius " + mm(r1) +
                 " mm differ by more than the tolerance");
     }
-    const double pi = std::numbers::pi;
-    const double a0 = std::atan2(from.y - b.centre.y, from.x - b.centre.x);
-    const double a1 = std::atan2(b.target.y - b.centre.y, b.target.x - b.centre.x);
-    const bool ccw = b.kind == MotionKind::kArcCcw;
-    double sweep = ccw ? a1 - a0 : a0 - a1;
-    while (sweep <= 1e-12) sweep += 2.0 * pi;  // an arc to its own start is a full circle
-    if (b.turns > 0) sweep = 2.0 * pi;         // more turns visit every angle
-    for (int q = 0; q < 4; ++q) {
-      const double ang = q * pi / 2.0;  // the four axis directions
-      double d = ccw ? ang - a0 : a0 - ang;
-      d = std::fmod(std::fmod(d, 2.0 * pi) + 2.0 * pi, 2.0 * pi);
-      if (d <= sweep) {
-        const Vec3 p{b.centre.x + r0 * std::cos(ang), b.centre.y + r0 * std::sin(ang), b.target.z};
-        check_point(i, b, p, "arc extreme");
-      }
+    const bool cw = b.kind == MotionKind::kArcCw;
+    const ArcBox box =
+        arc_bounding_box(from.x - b.centre.x, from.y - b.centre.y, b.target.x - b.centre.x,
+                         b.target.y - b.centre.y, cw, b.turns > 0);
+    const std::string extent = std::string(cw ? "G02" : "G03") + " arc: ";
+    check_point(i, b, {b.centre.x + box.min_x, b.centre.y + box.min_y, b.target.z}, extent);
+    check_point(i, b, {b.centre.x + box.max_x, b.centre.y + box.max_y, b.target.z}, extent, false);
+  }
+
+  /// The Z axis of a drilling block travels the wear-compensated z_travel_mm (eq. 9-11), past
+  /// the nominal bottom; reported when the bottom itself is inside (else the end point says it).
+  void check_drill_travel(std::size_t i, const MotionBlock& b, const Vec3& from) {
+    const AxisLimits* z = tables_.axis('Z');
+    const double axis_end = from.z - b.z_travel_mm;
+    if (z == nullptr || beyond('Z', b.target.z) != nullptr || beyond('Z', axis_end) == nullptr) {
+      return;
     }
+    const double wear = b.z_travel_mm - (from.z - b.target.z);
+    limit_issue(i, b, 'Z',
+                "drilling with wear pre-compensation moves Z to " + mm(axis_end) + " mm (nominal " +
+                    mm(b.target.z) + " - wear " + mm(wear) + " mm), beyond the Z soft limit (" +
+                    mm(z->min_mm) + ".." + mm(z->max_mm) + " mm)");
   }
 
  private:
@@ -120,13 +196,12 @@ std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
     switch (b.kind) {
       case MotionKind::kRapid:
       case MotionKind::kLinear:
-        c.check_point(i, b, b.target, "end point");
+        c.check_point(i, b, b.target, "");
         pos = b.target;
         break;
       case MotionKind::kArcCw:
       case MotionKind::kArcCcw:
         if (b.turns < 0) c.issue(i, b, "negative number of turns");
-        c.check_point(i, b, b.target, "end point");
         c.check_arc(i, b, pos);
         pos = b.target;
         break;
@@ -137,24 +212,23 @@ std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
         }
         if (!(b.z_travel_mm > 0.0)) c.issue(i, b, "a drilling block needs a positive Z travel");
         if (b.condition < 1) c.issue(i, b, "drilling needs an armed machining condition (E1..)");
-        c.check_point(i, b, b.target, "hole bottom");
-        {
-          const Vec3 travel_end{pos.x, pos.y, pos.z - b.z_travel_mm};
-          c.check_point(i, b, travel_end, "wear-compensated Z travel end");
-        }
+        c.check_point(i, b, b.target, "");
+        c.check_drill_travel(i, b, pos);
         pos = b.target;
         break;
       case MotionKind::kOrbitFinish:
         if (!(b.final_radius_mm > 0.0)) c.issue(i, b, "orbit finishing needs a final radius > 0");
         if (b.condition < 1) c.issue(i, b, "orbit finishing needs an armed machining condition");
-        c.check_point(i, b, Vec3{pos.x + b.final_radius_mm, pos.y + b.final_radius_mm, pos.z},
-                      "orbit extreme");
-        c.check_point(i, b, Vec3{pos.x - b.final_radius_mm, pos.y - b.final_radius_mm, pos.z},
-                      "orbit extreme");
+        if (b.final_radius_mm > 0.0) {
+          const double r = b.final_radius_mm;
+          const std::string extent = "G160 orbit of radius " + mm(r) + " mm: ";
+          c.check_point(i, b, Vec3{pos.x - r, pos.y - r, pos.z}, extent, false);
+          c.check_point(i, b, Vec3{pos.x + r, pos.y + r, pos.z}, extent, false);
+        }
         break;
       case MotionKind::kDwell:
         if (b.dwell_s < 0.0 || b.dwell_s > options.max_dwell_s) {
-          c.issue(i, b, "dwell must be within [0, " + fmt_mm(options.max_dwell_s) + "] s");
+          c.issue(i, b, "dwell must be within [0, " + mm(options.max_dwell_s) + "] s");
         }
         break;
       case MotionKind::kCondition:

@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "config_parser_impl.hpp"
+#include "edm/machining/machine_sections.hpp"
 
 namespace edm::rt {
 
@@ -50,21 +51,7 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
     parse_machine(f->value, cfg.machine);
   }
   if (const Field* f = m->find("conditions")) {
-    if (auto items = r_.list(f->value)) {
-      UniqueNames e_numbers;
-      for (const Value& item : *items) {
-        ConditionSpec c;
-        const SourceLoc e_loc = parse_condition(item, c);
-        if (c.e >= 1) {
-          if (const SourceLoc* first = e_numbers.add(std::to_string(c.e), e_loc)) {
-            r_.error(e_loc, item.path + ".E",
-                     "duplicate condition E" + std::to_string(c.e) + " (first at line " +
-                         line_of(*first) + ")");
-          }
-        }
-        cfg.conditions.push_back(std::move(c));
-      }
-    }
+    cfg.conditions = machining::read_conditions(r_, f->value);
   }
   task_names_complete_ = task_programs_complete_ = false;
   if (const Field* f = r_.require(*m, "tasks")) {
@@ -274,29 +261,7 @@ Config parse_config_file(const std::string& path) {
 }
 
 machining::MachineTables to_machine_tables(const Config& cfg) {
-  machining::MachineTables t;
-  for (const ConditionSpec& c : cfg.conditions) {
-    t.conditions.push_back({.e = c.e,
-                            .name = c.name,
-                            .polarity = c.polarity == Polarity::kPositive
-                                            ? machining::Polarity::kPositive
-                                            : machining::Polarity::kNegative,
-                            .open_voltage_v = c.open_voltage_v,
-                            .peak_current_a = c.peak_current_a,
-                            .on_time_us = c.on_time_us,
-                            .off_time_us = c.off_time_us,
-                            .tdr_us = c.tdr_us,
-                            .servo_ref_v = c.servo_ref_v,
-                            .wear_ratio = c.wear_ratio});
-  }
-  for (const AxisSpec& a : cfg.machine.axes) {
-    t.axes.push_back({.name = a.name.empty() ? '?' : a.name[0],
-                      .min_mm = a.min_mm,
-                      .max_mm = a.max_mm,
-                      .v_max_mm_s = a.v_max_mm_s,
-                      .a_max_mm_s2 = a.a_max_mm_s2});
-  }
-  return t;
+  return machining::make_tables(cfg.machine.axes, cfg.conditions);
 }
 
 }  // namespace edm::rt

@@ -49,9 +49,6 @@ class Parser {
  private:
   void parse_machine(const Value& v, MachineSpec& out);
   void parse_io(const Value& v, IoSpec& out);
-  // Both return where the entry's identity (axis name, E number) was written, for duplicates.
-  SourceLoc parse_axis(const Value& v, AxisSpec& out);
-  SourceLoc parse_condition(const Value& v, ConditionSpec& out);
   void parse_task(const Value& v, TaskSpec& out);
   void parse_watchdog(const Value& v, WatchdogSpec& out);
   void parse_program(const Value& v, ProgramSpec& out);
@@ -66,7 +63,6 @@ class Parser {
 
   // Optional-field helpers: read `key` if present and store it on success.
   std::optional<std::string> identifier(const Value& v, const char* what);
-  void positive(const MapView& m, std::string_view key, double& out);
   template <class Int>
   void int_in(const MapView& m, std::string_view key, std::int64_t min, std::int64_t max,
               Int& out) {

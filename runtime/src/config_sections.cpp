@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "config_parser_impl.hpp"
+#include "edm/machining/machine_sections.hpp"
 
 namespace edm::rt::config_detail {
 
@@ -14,18 +15,6 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
     return std::nullopt;
   }
   return s;
-}
-
-void Parser::positive(const MapView& m, std::string_view key, double& out) {
-  if (const Field* f = m.find(key)) {
-    if (auto x = r_.real(f->value)) {
-      if (*x <= 0.0) {
-        r_.error(f->value, "must be > 0 (got " + f->value.node.Scalar() + ")");
-      } else {
-        out = *x;
-      }
-    }
-  }
 }
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
@@ -43,20 +32,7 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
     parse_io(f->value, out.io);
   }
   if (const Field* f = m->find("axes")) {
-    if (auto items = r_.list(f->value)) {
-      UniqueNames names;
-      for (const Value& item : *items) {
-        AxisSpec a;
-        const SourceLoc name_loc = parse_axis(item, a);
-        if (!a.name.empty()) {
-          if (const SourceLoc* first = names.add(a.name, name_loc)) {
-            r_.error(name_loc, item.path + ".name",
-                     "duplicate axis '" + a.name + "' (first at line " + line_of(*first) + ")");
-          }
-        }
-        out.axes.push_back(std::move(a));
-      }
-    }
+    out.axes = machining::read_axes(r_, f->value);
   }
 }
 
@@ -81,75 +57,6 @@ void Parser::parse_io(const Value& v, IoSpec& out) {
   if (const Field* f = m->find("params")) {
     parse_params(f->value, out.params);
   }
-}
-
-SourceLoc Parser::parse_axis(const Value& v, AxisSpec& out) {
-  out.loc = v.loc;
-  SourceLoc name_loc = v.loc;
-  auto m = r_.map(v, {"name", "min_mm", "max_mm", "v_max_mm_s", "a_max_mm_s2"});
-  if (!m) {
-    return name_loc;
-  }
-  if (const Field* f = r_.require(*m, "name")) {
-    name_loc = f->value.loc;
-    out.name = r_.choice(f->value, {"X", "Y", "Z"}).value_or("");
-  }
-  std::optional<double> min_mm;
-  std::optional<double> max_mm;
-  if (const Field* f = r_.require(*m, "min_mm")) {
-    min_mm = r_.real(f->value);
-  }
-  const Field* max_field = r_.require(*m, "max_mm");
-  if (max_field != nullptr) {
-    max_mm = r_.real(max_field->value);
-  }
-  if (min_mm && max_mm && *max_mm <= *min_mm) {
-    r_.error(max_field->value, "must be > min_mm (got max_mm " + max_field->value.node.Scalar() +
-                                   " <= min_mm " + m->find("min_mm")->value.node.Scalar() + ")");
-  }
-  out.min_mm = min_mm.value_or(out.min_mm);
-  out.max_mm = max_mm.value_or(out.max_mm);
-  positive(*m, "v_max_mm_s", out.v_max_mm_s);
-  positive(*m, "a_max_mm_s2", out.a_max_mm_s2);
-  return name_loc;
-}
-
-SourceLoc Parser::parse_condition(const Value& v, ConditionSpec& out) {
-  out.loc = v.loc;
-  SourceLoc e_loc = v.loc;
-  auto m = r_.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
-                      "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio"});
-  if (!m) {
-    return e_loc;
-  }
-  if (const Field* f = r_.require(*m, "E")) {
-    e_loc = f->value.loc;
-    out.e = static_cast<int>(r_.integer(f->value, 1, kMaxInt).value_or(0));
-  }
-  if (const Field* f = m->find("name")) {
-    out.name = r_.string(f->value).value_or("");
-  }
-  if (const Field* f = m->find("polarity")) {
-    if (auto s = r_.choice(f->value, {"negative", "positive"})) {
-      out.polarity = *s == "positive" ? Polarity::kPositive : Polarity::kNegative;
-    }
-  }
-  positive(*m, "open_voltage_v", out.open_voltage_v);
-  positive(*m, "peak_current_a", out.peak_current_a);
-  positive(*m, "on_time_us", out.on_time_us);
-  positive(*m, "off_time_us", out.off_time_us);
-  positive(*m, "tdr_us", out.tdr_us);
-  positive(*m, "servo_ref_v", out.servo_ref_v);
-  if (const Field* f = m->find("wear_ratio")) {
-    if (auto x = r_.real(f->value)) {
-      if (*x < 0.0 || *x > 10.0) {
-        r_.error(f->value, "must be in 0..10 (got " + f->value.node.Scalar() + ")");
-      } else {
-        out.wear_ratio = *x;
-      }
-    }
-  }
-  return e_loc;
 }
 
 void Parser::parse_task(const Value& v, TaskSpec& out) {

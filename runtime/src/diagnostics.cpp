@@ -4,23 +4,6 @@
 
 namespace edm::rt {
 
-std::string Diagnostic::str() const {
-  std::string out = loc.file;
-  if (loc.line > 0) {
-    if (!out.empty()) {
-      out += ':';
-    }
-    out += std::to_string(loc.line);
-    if (loc.col > 0) {
-      out += ':' + std::to_string(loc.col);
-    }
-  }
-  if (out.empty()) {
-    return message;
-  }
-  return out + ": " + message;
-}
-
 namespace {
 
 // runtime_error needs its message before diags_ exists, so build it from the argument.

@@ -70,13 +70,13 @@ TEST_F(FullConfigTest, machine_io_and_axes) {
 
   ASSERT_EQ(cfg_.machine.axes.size(), 2u);
   const AxisSpec& x = cfg_.machine.axes[0];
-  EXPECT_EQ(x.name, "X");
+  EXPECT_EQ(x.name, 'X');
   EXPECT_DOUBLE_EQ(x.min_mm, -100.0);
   EXPECT_DOUBLE_EQ(x.max_mm, 100.0);
   EXPECT_DOUBLE_EQ(x.v_max_mm_s, 20.0);
   EXPECT_DOUBLE_EQ(x.a_max_mm_s2, 800.0);
   const AxisSpec& z = cfg_.machine.axes[1];
-  EXPECT_EQ(z.name, "Z");
+  EXPECT_EQ(z.name, 'Z');
   EXPECT_DOUBLE_EQ(z.min_mm, -50.0);
   EXPECT_DOUBLE_EQ(z.max_mm, 5.5);
   EXPECT_DOUBLE_EQ(z.v_max_mm_s, 10.0);

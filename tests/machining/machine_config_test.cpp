@@ -70,15 +70,17 @@ TEST(MachineConfig, MalformedAxes) {
       "    - {name: X, min_mm: 0, max_mm: 1, speed: 3}\n"
       "    - {name: Y, min_mm: '0', max_mm: 1, v_max_mm_s: 0}\n"
       "    - {name: Z}\n");
-  ASSERT_EQ(e.size(), 7u);
+  // The runtime's wording (one section reader): an axis with bad limits still claims its name.
+  ASSERT_EQ(e.size(), 8u);
   EXPECT_EQ(e[0], "m.yaml:3:14: machine.axes[0].name: must be one of X, Y, Z (got 'Q')");
   EXPECT_EQ(e[1],
             "m.yaml:4:36: machine.axes[1].max_mm: must be > min_mm (got max_mm 1 <= min_mm 5)");
-  EXPECT_EQ(e[2].substr(0, 54), "m.yaml:5:39: machine.axes[2]: unknown key 'speed' (all");
-  EXPECT_EQ(e[3], "m.yaml:6:25: machine.axes[3].min_mm: expected a number, got '0'");
-  EXPECT_EQ(e[4], "m.yaml:6:53: machine.axes[3].v_max_mm_s: must be > 0 (got 0)");
-  EXPECT_EQ(e[5], "m.yaml:7:7: machine.axes[4]: missing required key 'min_mm'");
-  EXPECT_EQ(e[6], "m.yaml:7:7: machine.axes[4]: missing required key 'max_mm'");
+  EXPECT_EQ(e[2], "m.yaml:5:14: machine.axes[2].name: duplicate axis 'X' (first at line 4)");
+  EXPECT_EQ(e[3].substr(0, 54), "m.yaml:5:39: machine.axes[2]: unknown key 'speed' (all");
+  EXPECT_EQ(e[4], "m.yaml:6:25: machine.axes[3].min_mm: expected a number, got the string '0'");
+  EXPECT_EQ(e[5], "m.yaml:6:53: machine.axes[3].v_max_mm_s: must be > 0 (got 0)");
+  EXPECT_EQ(e[6], "m.yaml:7:7: machine.axes[4]: missing required key 'min_mm'");
+  EXPECT_EQ(e[7], "m.yaml:7:7: machine.axes[4]: missing required key 'max_mm'");
 }
 
 TEST(MachineConfig, MalformedConditions) {
@@ -94,8 +96,8 @@ TEST(MachineConfig, MalformedConditions) {
   EXPECT_EQ(e[1],
             "m.yaml:4:22: conditions[1].polarity: must be one of negative, positive (got 'plus')");
   EXPECT_EQ(e[2], "m.yaml:4:40: conditions[1].wear_ratio: must be in 0..10 (got 11)");
-  EXPECT_EQ(e[3], "m.yaml:5:9: conditions[2].E: duplicate condition E1");
-  EXPECT_EQ(e[4], "m.yaml:6:29: conditions[3]: duplicate key 'E'");
+  EXPECT_EQ(e[3], "m.yaml:5:9: conditions[2].E: duplicate condition E1 (first at line 4)");
+  EXPECT_EQ(e[4], "m.yaml:6:29: conditions[3]: duplicate key 'E' (first at line 6)");
 }
 
 TEST(MachineConfig, SyntaxAndShapeErrors) {

@@ -58,7 +58,9 @@ TEST(ProgramCheck, SoftLimitsNameTheLine) {
   const auto issues = check({at(MotionKind::kRapid, 11, 0, 0, 7)});
   ASSERT_EQ(issues.size(), 1u);
   EXPECT_EQ(issues[0].line, 7);
-  EXPECT_NE(issues[0].message.find("outside the soft limits"), std::string::npos);
+  EXPECT_TRUE(issues[0].soft_limit);
+  EXPECT_EQ(issues[0].axis, 'X');  // an end point: a G-code reader points at the X word
+  EXPECT_EQ(issues[0].message, "X 11.000 mm is beyond the X soft limit (-10.000..10.000 mm)");
 }
 
 TEST(ProgramCheck, ArcExtremesAreCheckedNotOnlyTheEndPoints) {
@@ -75,9 +77,13 @@ TEST(ProgramCheck, ArcExtremesAreCheckedNotOnlyTheEndPoints) {
   EXPECT_TRUE(check({at(MotionKind::kRapid, 0, 5, 0, 1), b}).empty());
   b.kind = MotionKind::kArcCcw;
   const auto issues = check({at(MotionKind::kRapid, 0, 5, 0, 1), b});
-  ASSERT_EQ(issues.size(), 5u);  // (−10.9, ±12): X and Y each; (−22.9, 0): X
+  // Each axis's extreme once: X −22.9 (min), Y −12 (min), Y +12 (max).
+  ASSERT_EQ(issues.size(), 3u);
   EXPECT_EQ(issues[0].line, 2);
-  EXPECT_NE(issues[0].message.find("arc extreme"), std::string::npos);
+  EXPECT_TRUE(issues[0].soft_limit);
+  EXPECT_EQ(issues[0].axis, 0);  // an extent: named at the motion word
+  EXPECT_EQ(issues[0].message.rfind("G03 arc: X -22.909 mm is beyond the X soft limit", 0), 0u)
+      << issues[0].message;
 }
 
 TEST(ProgramCheck, InconsistentArcAndZeroRadius) {

@@ -1,8 +1,9 @@
 #pragma once
 // Reads the two sections of a machine config (DESIGN §8) that the HMI needs to check a part
-// program offline: `machine.axes` (soft limits) and `conditions` (the E-number table). Same keys,
-// types, ranges and defaults as the runtime's loader (runtime/src/config_sections.cpp); the other
-// sections (tasks, programs, ...) are the runtime's business and are not looked at.
+// program offline: `machine.axes` (soft limits) and `conditions` (the E-number table), through the
+// same section reader as the runtime's loader (machine_sections.hpp), so keys, types, ranges,
+// defaults and messages are the runtime's; the other sections (tasks, programs, ...) are the
+// runtime's business and are not looked at.
 //
 // Non-RT (allocates, reads files). Thread-safety: the functions are reentrant.
 

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "edm/machining/diagnostics.hpp"
+
 namespace edm::machining {
 
 enum class Polarity : std::uint8_t { kNegative, kPositive };
@@ -44,5 +46,19 @@ struct MachineTables {
   /// The limits of axis 'X' / 'Y' / 'Z', or nullptr.
   [[nodiscard]] const AxisLimits* axis(char name) const noexcept;
 };
+
+/// An axis as read from a config, with where its entry was written.
+struct LocatedAxis : AxisLimits {
+  SourceLoc loc;
+};
+
+/// A condition as read from a config, with where its entry was written.
+struct LocatedCondition : Condition {
+  SourceLoc loc;
+};
+
+/// The tables of what a config's `machine.axes` and `conditions` sections held.
+MachineTables make_tables(const std::vector<LocatedAxis>& axes,
+                          const std::vector<LocatedCondition>& conditions);
 
 }  // namespace edm::machining

@@ -19,6 +19,10 @@ struct ProgramIssue {
   int line{0};           // the block's G-code line (0 = unknown)
   int col{0};
   std::string message;
+  bool soft_limit{false};  // a point of the block (end, arc or orbit extent, drill travel) is
+                           // beyond a soft limit
+  char axis{0};  // 'X'/'Y'/'Z' when an end point (or drill travel) is beyond that axis's limit,
+                 // so a G-code reader can point at the axis word; 0 for extents and other issues
 };
 
 struct ProgramCheckOptions {
@@ -32,6 +36,9 @@ struct ProgramCheckOptions {
 /// has no positive travel, an orbit without a positive final radius, negative or huge dwells, an
 /// arc before any known position, blocks after the end block, an empty or oversized program.
 /// `start` is where the machine is when the program starts (the first block's start point).
+/// Soft-limit messages read "X 150.000 mm is beyond the X soft limit (-100.000..100.000 mm)",
+/// prefixed "G02 arc: " / "G160 orbit of radius R mm: " for extents (docs/gcode.md); each arc
+/// reports each axis's extreme once, over its swept angle.
 std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
                                         const MachineTables& tables, const Vec3& start,
                                         const ProgramCheckOptions& options = {});

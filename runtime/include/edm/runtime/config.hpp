@@ -90,14 +90,8 @@ struct IoSpec {
   SourceLoc driver_loc;
 };
 
-struct AxisSpec {
-  std::string name;  // X, Y or Z
-  double min_mm{0.0};
-  double max_mm{0.0};          // > min_mm
-  double v_max_mm_s{10.0};     // > 0
-  double a_max_mm_s2{1000.0};  // > 0
-  SourceLoc loc;
-};
+/// An axis (soft limits, dynamics) as read by machining's shared section reader.
+using AxisSpec = machining::LocatedAxis;
 
 struct MachineSpec {
   std::string name;
@@ -106,22 +100,9 @@ struct MachineSpec {
   SourceLoc loc;
 };
 
-enum class Polarity : std::uint8_t { kNegative, kPositive };
-
-/// A machining condition (selected by E number).
-struct ConditionSpec {
-  int e{0};  // >= 1, unique
-  std::string name;
-  Polarity polarity{Polarity::kNegative};
-  double open_voltage_v{120.0};
-  double peak_current_a{10.0};
-  double on_time_us{20.0};
-  double off_time_us{40.0};
-  double tdr_us{8.0};        // reference ignition delay for the gap controller
-  double servo_ref_v{40.0};  // reference mean gap voltage for voltage-based servos
-  double wear_ratio{0.0};    // electrode volume / workpiece volume, 0..10
-  SourceLoc loc;
-};
+using machining::Polarity;
+/// A machining condition (selected by E number) as read by machining's shared section reader.
+using ConditionSpec = machining::LocatedCondition;
 
 struct TraceSpec {
   std::vector<NameRef> variables;

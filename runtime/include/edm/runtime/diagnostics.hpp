@@ -1,27 +1,19 @@
 #pragma once
-// Located error messages for configuration files: "file:line:col: message".
+// Located error messages for configuration files: "file:line:col: message". The location and
+// message types are machining's (edm/machining/diagnostics.hpp), shared with the HMI's reader of
+// machine configs; this header adds the runtime's exception and a sink that throws it.
 // Non-RT; thread-compatible.
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "edm/machining/diagnostics.hpp"
+
 namespace edm::rt {
 
-/// A position in a source file; line and col are 1-based (0 = unknown).
-struct SourceLoc {
-  std::string file;
-  int line{0};
-  int col{0};
-};
-
-struct Diagnostic {
-  SourceLoc loc;
-  std::string message;
-  /// "file:line:col: message" (the parts that are known).
-  [[nodiscard]] std::string str() const;
-};
+using machining::Diagnostic;
+using machining::SourceLoc;
 
 /// Thrown by the config parser and the runtime builder (never on an RT path). Holds every
 /// problem found, in file order where possible; what() is the first one.
@@ -35,26 +27,14 @@ class ConfigError : public std::runtime_error {
 };
 
 /// Collects diagnostics; throw_if_any() throws a ConfigError with all of them.
-class DiagnosticSink {
+class DiagnosticSink : public machining::DiagnosticSink {
  public:
-  void error(const SourceLoc& loc, std::string message) {
-    diags_.push_back({loc, std::move(message)});
-  }
-  [[nodiscard]] bool empty() const noexcept { return diags_.empty(); }
-  [[nodiscard]] const std::vector<Diagnostic>& diagnostics() const noexcept { return diags_; }
   /// Throws every diagnostic, in file order (line, then column; stable for equal places).
   void throw_if_any() const {
-    if (!diags_.empty()) {
-      std::vector<Diagnostic> sorted = diags_;
-      std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic& a, const Diagnostic& b) {
-        return a.loc.line != b.loc.line ? a.loc.line < b.loc.line : a.loc.col < b.loc.col;
-      });
-      throw ConfigError(std::move(sorted));
+    if (!empty()) {
+      throw ConfigError(sorted());
     }
   }
-
- private:
-  std::vector<Diagnostic> diags_;
 };
 
 }  // namespace edm::rt

@@ -1,0 +1,169 @@
+// machine.axes and conditions of a machine config: the one reader both the runtime and the HMI
+// use. See machine_sections.hpp.
+
+#include "edm/machining/machine_sections.hpp"
+
+#include <climits>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <utility>
+
+namespace edm::machining {
+
+namespace {
+
+using yaml::Field;
+using yaml::MapView;
+using yaml::Value;
+
+/// First place each name (axis letter, E number) was written.
+class FirstSeen {
+ public:
+  /// The line of the first occurrence if `name` was seen before, else nullopt.
+  std::optional<int> add(const std::string& name, const SourceLoc& loc) {
+    const auto [it, inserted] = first_line_.emplace(name, loc.line);
+    return inserted ? std::nullopt : std::optional<int>(it->second);
+  }
+
+ private:
+  std::unordered_map<std::string, int> first_line_;
+};
+
+void positive(yaml::Reader& r, const MapView& m, std::string_view key, double& out) {
+  if (const Field* f = m.find(key)) {
+    if (auto x = r.real(f->value)) {
+      if (*x <= 0.0) {
+        r.error(f->value, "must be > 0 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out = *x;
+      }
+    }
+  }
+}
+
+/// One axis; returns its name (nullopt when unreadable) and where the name was written.
+std::optional<char> read_axis(yaml::Reader& r, const Value& v, LocatedAxis& out,
+                              SourceLoc& name_loc) {
+  out.loc = v.loc;
+  name_loc = v.loc;
+  auto m = r.map(v, {"name", "min_mm", "max_mm", "v_max_mm_s", "a_max_mm_s2"});
+  if (!m) {
+    return std::nullopt;
+  }
+  std::optional<char> name;
+  if (const Field* f = r.require(*m, "name")) {
+    name_loc = f->value.loc;
+    if (auto s = r.choice(f->value, {"X", "Y", "Z"})) {
+      name = (*s)[0];
+      out.name = *name;
+    }
+  }
+  std::optional<double> min_mm;
+  std::optional<double> max_mm;
+  if (const Field* f = r.require(*m, "min_mm")) {
+    min_mm = r.real(f->value);
+  }
+  const Field* max_field = r.require(*m, "max_mm");
+  if (max_field != nullptr) {
+    max_mm = r.real(max_field->value);
+  }
+  if (min_mm && max_mm && *max_mm <= *min_mm) {
+    r.error(max_field->value, "must be > min_mm (got max_mm " + max_field->value.node.Scalar() +
+                                  " <= min_mm " + m->find("min_mm")->value.node.Scalar() + ")");
+  }
+  out.min_mm = min_mm.value_or(out.min_mm);
+  out.max_mm = max_mm.value_or(out.max_mm);
+  positive(r, *m, "v_max_mm_s", out.v_max_mm_s);
+  positive(r, *m, "a_max_mm_s2", out.a_max_mm_s2);
+  return name;
+}
+
+/// One condition; returns where its E number was written.
+SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out) {
+  out.loc = v.loc;
+  SourceLoc e_loc = v.loc;
+  auto m = r.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
+                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio"});
+  if (!m) {
+    return e_loc;
+  }
+  if (const Field* f = r.require(*m, "E")) {
+    e_loc = f->value.loc;
+    out.e = static_cast<int>(r.integer(f->value, 1, INT_MAX).value_or(0));
+  }
+  if (const Field* f = m->find("name")) {
+    out.name = r.string(f->value).value_or("");
+  }
+  if (const Field* f = m->find("polarity")) {
+    if (auto s = r.choice(f->value, {"negative", "positive"})) {
+      out.polarity = *s == "positive" ? Polarity::kPositive : Polarity::kNegative;
+    }
+  }
+  positive(r, *m, "open_voltage_v", out.open_voltage_v);
+  positive(r, *m, "peak_current_a", out.peak_current_a);
+  positive(r, *m, "on_time_us", out.on_time_us);
+  positive(r, *m, "off_time_us", out.off_time_us);
+  positive(r, *m, "tdr_us", out.tdr_us);
+  positive(r, *m, "servo_ref_v", out.servo_ref_v);
+  if (const Field* f = m->find("wear_ratio")) {
+    if (auto x = r.real(f->value)) {
+      if (*x < 0.0 || *x > 10.0) {
+        r.error(f->value, "must be in 0..10 (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.wear_ratio = *x;
+      }
+    }
+  }
+  return e_loc;
+}
+
+}  // namespace
+
+std::vector<LocatedAxis> read_axes(yaml::Reader& r, const Value& axes) {
+  std::vector<LocatedAxis> out;
+  auto items = r.list(axes);
+  if (!items) {
+    return out;
+  }
+  FirstSeen names;
+  for (const Value& item : *items) {
+    LocatedAxis a;
+    SourceLoc name_loc;
+    if (const std::optional<char> name = read_axis(r, item, a, name_loc)) {
+      const std::string s(1, *name);
+      if (const std::optional<int> first = names.add(s, name_loc)) {
+        r.error(name_loc, item.path + ".name",
+                "duplicate axis '" + s + "' (first at line " + std::to_string(*first) + ")");
+      }
+    }
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+std::vector<LocatedCondition> read_conditions(yaml::Reader& r, const Value& conditions) {
+  std::vector<LocatedCondition> out;
+  auto items = r.list(conditions);
+  if (!items) {
+    return out;
+  }
+  FirstSeen e_numbers;
+  for (const Value& item : *items) {
+    LocatedCondition c;
+    const SourceLoc e_loc = read_condition(r, item, c);
+    if (c.e >= 1) {
+      if (const std::optional<int> first = e_numbers.add(std::to_string(c.e), e_loc)) {
+        r.error(e_loc, item.path + ".E",
+                "duplicate condition E" + std::to_string(c.e) + " (first at line " +
+                    std::to_string(*first) + ")");
+      }
+    }
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace edm::machining
