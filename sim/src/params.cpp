@@ -83,7 +83,7 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("a_max_mm_s2", a_max_mm_s2, "mm/s2", "acceleration limit");
   v.param("encoder_um", encoder_um, "um", "encoder quantum of reported positions");
   v.param("servo_gain_mm_s_per_v", servo_gain_mm_s_per_v, "mm/s/V",
-          "machine servo gain k: vz += -k (U_av - servo_ref_v) while servo_ref_v > 0");
+          "machine servo gain k: vz += -k (U_av - servo_ref_v) while servo_ref_v > 0; 0 = none");
   v.param("axis_step_us", axis_step_us, "us", "axis integration sub-step");
   v.param("wire_thickness_profile", wire_thickness_profile, "mm:mm", "cut length:thickness,...");
   v.param("wire_hole_from_mm", wire_hole_from_mm, "mm", "internal hole starts at this length");
@@ -306,6 +306,7 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.flush_gap_ref_um = 50.0;
     p.jump_dz_mm = 1.0;
     p.jump_eps = 0.7;
+    p.servo_gain_mm_s_per_v = 0.02;
     return p;
   }
   if (name == "wire") {

@@ -108,6 +108,15 @@ TEST(SimServoReference, the_sink_machine_follows_its_servo_reference_voltage_too
   EXPECT_NEAR(s.u_av_v, 60.0, 6.0);
 }
 
+TEST(SimServoReference, the_drill_preset_has_no_machine_servo) {
+  // drill-sim.yaml wires its condition's servo_ref_v to the pin; the drill's feed is the runtime's
+  // Td controller alone (seed 004), so k = 0 there and the pin moves nothing.
+  EXPECT_EQ(SimParams::preset("drill")->servo_gain_mm_s_per_v, 0.0);
+  const Settled s = run("drill", 40.0, 500);
+  EXPECT_EQ(s.depth_mm, 0.0);
+  EXPECT_NEAR(s.gap_um, 100.0, 0.5) << "the start gap";
+}
+
 TEST(SimServoReference, wire_arc_off_time_default_lies_in_seed_000_actuator_range) {
   const auto wire = *SimParams::preset("wire");
   EXPECT_GE(wire.default_arc_off_time_us, 9.0);

@@ -102,14 +102,15 @@ struct SimParams {
   bool wall_sparks{false};          // tube: the 64 wall bins compete with the front (orbit)
 
   // --- Axes (§3, §6.3) ---
-  double axis_wn_rad_s{200.0};         // ω_n of the position loop
-  double axis_zeta{0.55};              // ζ
-  double v_max_mm_s{30.0};             // feed limit (toward the work, and x/y)
-  double v_jump_mm_s{150.0};           // retract limit (away from the work)
-  double a_max_mm_s2{2000.0};          // acceleration limit of the reference
-  double encoder_um{0.1};              // q_z, position quantum of the reported positions
-  double servo_gain_mm_s_per_v{0.02};  // k of the machine's servo ε = k·(U_av − servo_ref_v)
-  double axis_step_us{25.0};           // fixed integration sub-step between pulses (<= 50)
+  double axis_wn_rad_s{200.0};  // ω_n of the position loop
+  double axis_zeta{0.55};       // ζ
+  double v_max_mm_s{30.0};      // feed limit (toward the work, and x/y)
+  double v_jump_mm_s{150.0};    // retract limit (away from the work)
+  double a_max_mm_s2{2000.0};   // acceleration limit of the reference
+  double encoder_um{0.1};       // q_z, position quantum of the reported positions
+  double servo_gain_mm_s_per_v{
+      0.0};                   // k of the machine's servo ε = k·(U_av − servo_ref_v); 0 = none
+  double axis_step_us{25.0};  // fixed integration sub-step between pulses (<= 50)
 
   // --- WEDM (§6.4) ---
   std::string wire_thickness_profile{"0:10"};  // "s:H,..." cut length mm : thickness mm steps
