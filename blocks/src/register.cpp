@@ -8,6 +8,7 @@
 #include "edm/blocks/gap_controller_p.hpp"
 #include "edm/blocks/grey_predictor_gm11.hpp"
 #include "edm/blocks/integrator.hpp"
+#include "edm/blocks/iterative_learning_control.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/linear_interpolator.hpp"
 #include "edm/blocks/low_pass.hpp"
@@ -15,7 +16,9 @@
 #include "edm/blocks/orbit_expander.hpp"
 #include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/position_loop.hpp"
+#include "edm/blocks/recursive_least_squares.hpp"
 #include "edm/blocks/self_tuning_fuzzy_pi.hpp"
+#include "edm/blocks/self_tuning_regulator.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/sine_source.hpp"
 #include "edm/blocks/td_detector.hpp"
@@ -53,6 +56,16 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<SelfTuningFuzzyPI>(
       "SelfTuningFuzzyPI",
       "seed 000 eq. 3-9: self-tuning fuzzy PI on Rab -> arc-off time, servo V");
+  // Seed 001: self-tuning regulator of die sinking (RLS with forgetting, minimum variance).
+  r.add<RecursiveLeastSquares>("RecursiveLeastSquares",
+                               "seed 001: RLS with forgetting factor and covariance bound");
+  r.add<SelfTuningRegulator>(
+      "SelfTuningRegulator",
+      "seed 001: minimum-variance STR, y_v -> servo reference V, y_t -> pulse-off time");
+  // Seed 002: iterative learning control over the machining cycle.
+  r.add<IterativeLearningControl>(
+      "IterativeLearningControl",
+      "seed 002: lifted-domain ILC, Q filter, l1/l2/l3 by pole placement, per jump/orbit cycle");
 }
 
 }  // namespace edm::blocks

@@ -85,6 +85,8 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("v_jump_mm_s", v_jump_mm_s, "mm/s", "retract speed limit (z away from the work)");
   v.param("a_max_mm_s2", a_max_mm_s2, "mm/s2", "acceleration limit");
   v.param("encoder_um", encoder_um, "um", "encoder quantum of reported positions");
+  v.param("servo_gain_mm_s_per_v", servo_gain_mm_s_per_v, "mm/s/V",
+          "machine servo gain k: vz += -k (U_av - servo_ref_v) while servo_ref_v > 0; 0 = none");
   v.param("axis_step_us", axis_step_us, "us", "axis integration sub-step");
   v.param("wire_thickness_profile", wire_thickness_profile, "mm:mm", "cut length:thickness,...");
   v.param("wire_hole_from_mm", wire_hole_from_mm, "mm", "internal hole starts at this length");
@@ -237,6 +239,7 @@ std::vector<rt::ParamError> SimParams::validate() const {
                       {"flush_drop_depth_mm", flush_drop_depth_mm},
                       {"flush_drop_factor", flush_drop_factor},
                       {"encoder_um", encoder_um},
+                      {"servo_gain_mm_s_per_v", servo_gain_mm_s_per_v},
                       {"wire_hole_from_mm", wire_hole_from_mm}}) {
     require_non_negative(e, n, v);
   }
@@ -307,6 +310,7 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.flush_gap_ref_um = 50.0;
     p.jump_dz_mm = 1.0;
     p.jump_eps = 0.7;
+    p.servo_gain_mm_s_per_v = 0.02;
     return p;
   }
   if (name == "wire") {
@@ -314,7 +318,7 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.peak_current_a = 60.0;
     p.default_on_time_us = 3.0;
     p.default_off_time_us = 80.0;
-    p.default_arc_off_time_us = 80.0;
+    p.default_arc_off_time_us = 30.0;  // inside seed 000's actuator range (Table 1: 9…50 µs)
     p.wait_time_us = 250.0;
     p.td_law = "quadratic";
     p.weibull_k = 1.0;
@@ -327,6 +331,7 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.flush_tau0_ms = 5.0;
     p.flush_gap_ref_um = 25.0;
     p.a_max_mm_s2 = 300.0;
+    p.servo_gain_mm_s_per_v = 0.05;
     p.wire_thickness_profile = "0:10,20:60,40:10";
     p.wire_hole_from_mm = 45.0;
     p.wire_hole_to_mm = 47.0;

@@ -159,7 +159,11 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
   if (hold_) {
     axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
   } else {
-    axes_[2].step(cmd_.vz_mm_s, dt);
+    double vz = cmd_.vz_mm_s;
+    if (cmd_.servo_ref_v > 0.0) {  // the machine's own servo: advance while U_av > reference
+      vz -= params_.servo_gain_mm_s_per_v * (state_.gap_voltage_filtered_v - cmd_.servo_ref_v);
+    }
+    axes_[2].step(vz, dt);
   }
   const double z = axes_[2].position_mm();
   const double gap = front_gap_um(z);

@@ -154,6 +154,7 @@ void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {
   c.on_time_us = on_time_us_.get();
   c.off_time_us = off_time_us_.get();
   c.arc_off_time_us = arc_off_time_us_.get();
+  c.servo_ref_v = safe ? 0.0 : servo_ref_v_.get();  // no machine servo in FAULT or ESTOP
   c.flushing_on = flushing_on_.get();
   c.flushing_strength = flushing_strength_.get();
   c.rotation_on = rotation_on_.get();

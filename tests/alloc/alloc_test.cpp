@@ -336,6 +336,49 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed003And000Blocks) {
   EXPECT_NE(r->variables().read("wire.pi.arc_off_time_us").value(), 20.0) << "the PI acted";
 }
 
+// Seed 001 and 002 blocks on the simulated sink machine: five-state ratios → SelfTuningRegulator
+// → servo reference voltage (the machine's own servo) and pulse-off time; a stand-alone
+// RecursiveLeastSquares; an IterativeLearningControl block learning over 100-sample cycles.
+constexpr const char* kSeed001And002 = R"yaml(version: 1
+machine:
+  name: alloc-001-002
+  io: {driver: sim, params: {preset: sink, seed: 6}}
+tasks:
+  - {name: servo, interval: 1ms, priority: 0, programs: [sink]}
+programs:
+  - name: sink
+    blocks:
+      - {name: str, type: SelfTuningRegulator, params: {delay_v: 1}}
+      - {name: rls, type: RecursiveLeastSquares, params: {n_params: 2, lambda: 0.97}}
+      - {name: ilc, type: IterativeLearningControl,
+         params: {n_samples: 100, p0: 0.5, k_delta: 0.01, q_pole: 0.2, auto_cycle: true,
+                  u_min: -0.5, u_max: 0.5}}
+    wires:
+      str.ratio_normal: io.ratio_normal
+      str.ratio_transient_arc: io.ratio_transient_arc
+      str.ratio_stable_arc: io.ratio_stable_arc
+      str.ratio_short: io.ratio_short
+      io.servo_ref_v: str.servo_ref_v
+      io.off_time_us: str.off_time_us
+      rls.y: str.y_v
+      rls.phi0: str.u_v
+      rls.phi1: 1.0
+      ilc.y: io.gap_voltage_v
+      ilc.y_ref: 45.0
+      io.gen_arm: true
+      io.gen_on: true
+trace:
+  variables: [io.ratio_normal, sink.str.servo_ref_v, sink.rls.theta0, sink.ilc.u]
+)yaml";
+
+TEST(Allocations, NoneInsideCyclesOfTheSeed001And002Blocks) {
+  auto r = build_sim_machine(rt::parse_config_text(kSeed001And002, "alloc-001-002.yaml"));
+  EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
+  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.001) << "the machine servo sank";
+  EXPECT_GE(r->variables().read("sink.ilc.cycles").value(), 29.0) << "the ILC learnt";
+  EXPECT_NE(r->variables().read("sink.rls.trace_p").value(), 2000.0) << "the RLS estimated";
+}
+
 TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
   // Approach, touch, drilling with wear compensation, on the simulated machine.
   auto r = build_shipped("drill-sim-program");

@@ -58,7 +58,7 @@ TEST(SimDriver, RealClockLatchAdvancesThePlantFromTheFirstLatchOnly) {
 }
 
 TEST(SimDriver, TheShippedMachinesPassCheck) {
-  for (const char* m : {"drill-sim", "sink-sim", "wire-sim"}) {
+  for (const char* m : {"drill-sim", "sink-sim", "wire-sim", "sink-str-sim"}) {
     Child c({EDM_EDMPLC_PATH, "--check", "--config",
              std::string(EDM_SOURCE_DIR) + "/config/machines/" + m + ".yaml"});
     EXPECT_EQ(c.wait(), 0) << m << ": " << c.output();

@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/1";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/2";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
@@ -109,7 +109,9 @@ struct SimParams {
   double v_jump_mm_s{150.0};    // retract limit (away from the work)
   double a_max_mm_s2{2000.0};   // acceleration limit of the reference
   double encoder_um{0.1};       // q_z, position quantum of the reported positions
-  double axis_step_us{25.0};    // fixed integration sub-step between pulses (<= 50)
+  double servo_gain_mm_s_per_v{
+      0.0};                   // k of the machine's servo ε = k·(U_av − servo_ref_v); 0 = none
+  double axis_step_us{25.0};  // fixed integration sub-step between pulses (<= 50)
 
   // --- WEDM (§6.4) ---
   std::string wire_thickness_profile{"0:10"};  // "s:H,..." cut length mm : thickness mm steps

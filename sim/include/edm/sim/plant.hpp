@@ -31,6 +31,10 @@ struct PlantCommands {
   double on_time_us{0.0};         // 0: preset default
   double off_time_us{0.0};        // 0: preset default
   double arc_off_time_us{0.0};    // off time after an abnormal pulse; 0: = off_time
+  // > 0: the machine's own gap-voltage servo (PLANT-MODEL §3, ε = k·(U_av − COMP)) adds
+  // −servo_gain·(U_av − servo_ref_v) to vz: it advances while U_av is above the reference.
+  // 0 (or servo_gain_mm_s_per_v = 0, the drill preset): no machine servo (vz alone).
+  double servo_ref_v{0.0};
   bool flushing_on{true};
   double flushing_strength{1.0};  // 0..1, multiplies the scenario's flushing factor F
   bool rotation_on{false};

@@ -18,8 +18,9 @@
 //   true_gap_um, true_debris            the plant's hidden state (for traces, not for control)
 // outputs from the runtime — latched at the end of each cycle:
 //   vx_cmd, vy_cmd, vz_cmd (mm/s, +z away from the work), gen_arm, gen_on, polarity_positive,
-//   on_time_us, off_time_us, arc_off_time_us (0 = preset), servo_ref_v, flushing_on,
-//   flushing_strength (0..1), rotation_on
+//   on_time_us, off_time_us, arc_off_time_us (0 = preset), servo_ref_v (V; > 0 switches on the
+//   machine's own gap-voltage servo, which adds −servo_gain_mm_s_per_v·(U_av − servo_ref_v) to
+//   vz_cmd; 0 = off), flushing_on, flushing_strength (0..1), rotation_on
 // Safe state: in FAULT and ESTOP the generator is off whatever the pins say; in ESTOP the axes
 // are also held at zero velocity (in FAULT the programs back Z off through vz_cmd).
 //

@@ -1,0 +1,106 @@
+#pragma once
+// IterativeLearningControl: the ILC of seed 002 (Furlan & Balemi, SUPSI) for cyclic machining in
+// which the start of each cycle depends on the material removed before (die sinking: one jump
+// cycle; orbiting: one revolution).
+//
+// Lifted domain over a cycle of N samples (vectors of length N, cycle index j):
+//   process    z_j = P·u_j,  δ_j = z_j − z_p,j,  y_j = kδ·δ_j + b + n_j,
+//              z_p,j+1 = z_A,j+1 + [0 1]·z_p,j      (the surface recedes by z_A per cycle)
+//   law        u_j+1 = Q·(u_j + L·e_j),   e_j = y_ref − y_j
+//              L·e = l1·(e − ē·1) + l2·ē·1 + l3·x_j·1,   ē = (1/N)·1ᵀ·e,   x_j+1 = x_j + ē_j
+//   Q          first-sample-anchored low-pass: (Q·v)_0 = v_0, (Q·v)_i = v_0 + Σ_{m=1..i}
+//              q_{i−m}·(v_m − v_0), with q_m = (1 − a)·a^m (first-order, pole a = q_pole), so
+//              q0 = 1 − a and Q·(c·1) = c·1. a = 0 gives Q = I.
+//   gains      (pole placement, eq. 1)  l1 = (q0 − λ3)/(kδ·q0·p0),  l2 = (2 − λ1 − λ2)/kδ,
+//              l3 = (1 − λ1)(1 − λ2)/kδ
+// λ1, λ2 are the poles of the cycle-mean (forward motion) dynamics: Q and P preserve constants,
+// so the cycle means follow x_j+1 = x_j − kδ·δ̄_j, δ̄_j+1 = l3·x_j + (1 − kδ·l2)·δ̄_j (the
+// paper's Φ restricted to constants), whose characteristic polynomial is (λ − λ1)(λ − λ2). λ3 sets
+// the within-cycle dynamics: it is the diagonal of PQ(P⁻¹ − kδ·l1·I) below the anchored first
+// sample (for P = Q = I the zero-mean part of a repeating error shape contracts by exactly λ3 per
+// cycle).
+//
+// Sampling convention: at each update the block stores the error of the sample it output last
+// update (y is the response to that output), then outputs u_j(k) for the current sample k. So p0
+// is the first sample of the axis' impulse response as the block sees it (one task period after
+// the command). A cycle ends at a rising edge of `cycle_start` (or every N samples when
+// auto_cycle is set); a cycle cut short repeats its last error over the missing samples, a cycle
+// longer than N holds u_j(N−1) and keeps overwriting e_j(N−1) (status kSaturated). Before the
+// first cycle edge (without auto_cycle) the output is u_initial and nothing is learnt.
+// Cost O(N) per cycle edge, O(1) otherwise. N sizes buffers allocated in configure().
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+
+#include <cstdint>
+#include <vector>
+
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct IterativeLearningControlParams {
+  static constexpr std::int64_t kMaxSamples = 65536;
+
+  std::int64_t n_samples{100};  // N, samples per cycle (2..65536), load time only
+  double p0{0.5};               // first impulse-response sample of the closed axis loop
+  double k_delta{1.0};          // kδ: output per unit of gap (y = kδ·δ + b), != 0
+  double q_pole{0.0};           // a of Q's first-order low-pass, [0, 1); q0 = 1 − a
+  double lambda1{0.5};          // forward-motion poles, (−1, 1)
+  double lambda2{0.5};
+  double lambda3{0.5};    // within-cycle pole, (−1, 1)
+  double u_initial{0.0};  // u before learning and in the first cycle [position unit]
+  double u_min{-1e9};     // clamp of u [position unit]
+  double u_max{1e9};
+  bool auto_cycle{false};  // the cycle ends every N samples without cycle_start
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("n_samples", n_samples, "samples", "samples per cycle N (2..65536), load time only");
+    v.param("p0", p0, "1", "first impulse-response sample of the axis loop (!= 0)");
+    v.param("k_delta", k_delta, "", "output per unit of gap, y = k_delta*gap + b (!= 0)");
+    v.param("q_pole", q_pole, "1", "pole a of the Q low-pass, 0 <= a < 1 (0: no filter)");
+    v.param("lambda1", lambda1, "1", "forward-motion pole 1, |lambda| < 1");
+    v.param("lambda2", lambda2, "1", "forward-motion pole 2, |lambda| < 1");
+    v.param("lambda3", lambda3, "1", "within-cycle pole, |lambda| < 1");
+    v.param("u_initial", u_initial, "", "output before learning, position unit");
+    v.param("u_min", u_min, "", "lower clamp of u");
+    v.param("u_max", u_max, "", "upper clamp of u");
+    v.param("auto_cycle", auto_cycle, "", "a cycle ends every n_samples without cycle_start");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearningControlParams> {
+ public:
+  struct Gains {
+    double l1{0.0}, l2{0.0}, l3{0.0};
+  };
+  /// Eq. (1) of the paper. Pure, RT-safe.
+  static Gains gains(const IterativeLearningControlParams& p) noexcept;
+
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. Allocates u and e (N samples each).
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. u = u_initial everywhere, x = 0, waiting for the first cycle edge.
+  void activate() noexcept override;
+  /// RT-safe.
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+  /// Non-RT. Refuses n_samples at run time.
+  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
+
+ private:
+  void learn() noexcept;
+
+  rt::Input<double> y_, y_ref_;
+  rt::Input<bool> cycle_start_, enable_{true};
+  rt::Output<double> u_out_, mean_error_, x_out_, l1_, l2_, l3_;
+  rt::Output<std::int64_t> sample_, cycles_;
+  std::vector<double> u_;
+  std::vector<double> e_;
+  std::int64_t idx_{-1};  // sample output last update; −1 before the first cycle
+  bool prev_edge_{false};
+  bool overrun_{false};
+  double x_{0.0};
+  double last_e_{0.0};
+  std::int64_t cycles_done_{0};
+};
+
+}  // namespace edm::blocks

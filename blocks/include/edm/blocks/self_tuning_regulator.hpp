@@ -1,0 +1,131 @@
+#pragma once
+// SelfTuningRegulator: the two decoupled minimum-variance self-tuning loops of seed 001 (Wang, Wu
+// & Liu, adaptive control of die-sinking EDM) on the five gap-state ratios.
+//
+// Controlled variables, from the pulse-width ratios φ (open d, spark e, transient arc e', stable
+// arc a, short s) and the period ratios Φ = K1·φ, K1 = ti/tp = ti/(ti + to):
+//   y_v = φe + 2φe' + 2φa + 2φs        (0: Us too large, open; 2: Us too small, shorting; ~1 good)
+//   y_t = Φe + 2Φe' + 2Φa              (~0: to too long; ~0.9 good)
+// Models (zero-order, the paper's §4.1), k the sample index:
+//   main       y_v(k+d+1) = β00·u_v(k) + β01·u_v(k−1) + β0c + ε_v     β00 = −1 fixed
+//   auxiliary  y_t(k+1)   = β10·u_t(k) + β1c + ε_t                     β10 = −1/ti fixed
+// β01, β0c (2 regressors) and β1c (1 regressor) are estimated by RLS with forgetting λ (0.97),
+// rls_core.hpp. Minimum-variance law (J = E[y − y_r]², the model solved for the u that puts the
+// prediction on the reference):
+//   u_v(k) = (y_rv − β01·u_v(k−1) − β0c) / β00,    u_t(k) = (y_rt − β1c) / β10
+// Reference decision (§3): gap good (φe' < transient_arc_limit and φa <= stable_arc_limit) →
+// y_rv, y_rt approach y_rv_good (0.95), y_rt_good (0.9) by ref_rise of the distance per sample;
+// a stable arc (φa > stable_arc_limit) → y_rv, y_rt fall by ref_step per sample (floors y_rv_min,
+// y_rt_min) until φa returns to 0; transient arcs above the limit without a stable arc → hold.
+// The inputs y_rv_ref / y_rt_ref override the decision while > 0.
+//
+// Choices where the paper is silent (docs/controllers.md):
+// - u_v is in the paper's normalised D/A units (β00 = −1 because u_v ≈ 1.6 at full scale, like
+//   y_v); the servo reference voltage is Us = us_per_unit_v·u_v [V]. u_t is the pulse-off time
+//   in µs, so β10 = −1/ti with ti in µs.
+// - φ comes from the simulator's five-state time ratios (ratio_*, the share of time spent in
+//   pulses of each class; the sim charges each pulse's off time to its class, so with equal off
+//   times this is the pulse-width ratio). Φ = K1·φ uses the off time commanded last sample.
+// - The regressor history before activate() is the initial u (the outputs held there).
+// - u_v and u_t are clamped to their ranges; the RLS sees the clamped values.
+// Status: kSaturated when a clamp cut a control value, kFault on a non-finite input (outputs held).
+// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "edm/blocks/rls_core.hpp"
+#include "edm/runtime/block.hpp"
+
+namespace edm::blocks {
+
+struct SelfTuningRegulatorParams {
+  static constexpr std::int64_t kMaxDelay = 4;
+
+  // Main loop: y_v → servo reference voltage.
+  std::int64_t delay_v{1};     // d_v in samples (paper: 1 at T = 50 ms, 0 at T = 100 ms)
+  double beta00{-1.0};         // fixed β00 (paper: −1)
+  double us_per_unit_v{40.0};  // Us [V] per unit of u_v
+  double u_v_min{0.25};        // range of u_v (normalised units)
+  double u_v_max{2.0};
+  double u_v_initial{1.0};
+  double beta01_init{0.0};  // RLS start values
+  double beta0c_init{2.0};  // y_v ≈ 1 at u_v = 1 with β01 = 0
+  // Auxiliary loop: y_t → pulse-off time.
+  double ti_us{100.0};    // pulse width ti [µs]: K1 = ti/(ti + to), β10 = −1/ti
+  double to_min_us{5.0};  // range of the pulse-off time [µs]
+  double to_max_us{500.0};
+  double to_initial_us{50.0};
+  double beta1c_init{1.0};
+  // Estimation.
+  double lambda{0.97};       // forgetting factor (paper: 0.97)
+  double p0{100.0};          // initial covariance
+  double trace_max{1000.0};  // covariance bound per estimator
+  // Reference decision.
+  double y_rv_good{0.95};
+  double y_rt_good{0.9};
+  double transient_arc_limit{0.1};  // φe' below this (and no stable arc): gap good
+  double stable_arc_limit{0.0};     // φa above this: a stable arc
+  double ref_rise{0.2};             // fraction of the distance to the good value per sample
+  double ref_step{0.05};            // decrease per sample while a stable arc lasts
+  double y_rv_min{0.3};
+  double y_rt_min{0.3};
+
+  void visit(rt::ParamVisitor& v) {
+    v.param("delay_v", delay_v, "samples", "prediction delay d_v of the main model (0..4)");
+    v.param("beta00", beta00, "1", "fixed beta00 of the main model (!= 0; paper -1)");
+    v.param("us_per_unit_v", us_per_unit_v, "V", "servo reference voltage per unit of u_v");
+    v.param("u_v_min", u_v_min, "1", "lowest u_v");
+    v.param("u_v_max", u_v_max, "1", "highest u_v");
+    v.param("u_v_initial", u_v_initial, "1", "u_v after activation");
+    v.param("beta01_init", beta01_init, "1", "initial estimate of beta01");
+    v.param("beta0c_init", beta0c_init, "1", "initial estimate of beta0c");
+    v.param("ti_us", ti_us, "us", "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti (> 0)");
+    v.param("to_min_us", to_min_us, "us", "shortest pulse-off time (> 0)");
+    v.param("to_max_us", to_max_us, "us", "longest pulse-off time");
+    v.param("to_initial_us", to_initial_us, "us", "pulse-off time after activation");
+    v.param("beta1c_init", beta1c_init, "1", "initial estimate of beta1c");
+    v.param("lambda", lambda, "1", "RLS forgetting factor in [0.5, 1]");
+    v.param("p0", p0, "1", "initial RLS covariance (> 0)");
+    v.param("trace_max", trace_max, "1", "bound of the RLS covariance trace (>= 2*p0)");
+    v.param("y_rv_good", y_rv_good, "1", "y_v reference in a good gap (paper 0.95)");
+    v.param("y_rt_good", y_rt_good, "1", "y_t reference in a good gap (paper 0.9)");
+    v.param("transient_arc_limit", transient_arc_limit, "1", "good gap: transient-arc ratio below");
+    v.param("stable_arc_limit", stable_arc_limit, "1", "stable arc: stable-arc ratio above this");
+    v.param("ref_rise", ref_rise, "1", "approach to the good references per sample, (0, 1]");
+    v.param("ref_step", ref_step, "1", "reference decrease per sample during a stable arc");
+    v.param("y_rv_min", y_rv_min, "1", "floor of the y_v reference");
+    v.param("y_rt_min", y_rt_min, "1", "floor of the y_t reference");
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const;
+};
+
+class SelfTuningRegulator final : public rt::BlockWithParams<SelfTuningRegulatorParams> {
+ public:
+  void visit_pins(rt::PinVisitor& v) override;
+  /// Non-RT. u_v, u_t at their initial values (also as regressor history), RLS reset.
+  void activate() noexcept override;
+  /// RT-safe. One sample of both loops.
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
+  /// Non-RT. Refuses delay_v at run time (it shapes the regressor history).
+  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
+
+ private:
+  void publish() noexcept;
+
+  rt::Input<double> ratio_normal_, ratio_transient_arc_, ratio_stable_arc_, ratio_short_;
+  rt::Input<double> y_rv_ref_, y_rt_ref_;
+  rt::Input<bool> enable_{true};
+  rt::Output<double> servo_ref_v_, off_time_us_, u_v_out_, y_v_out_, y_t_out_, y_rv_out_, y_rt_out_,
+      beta01_, beta0c_, beta1c_, k1_;
+  rt::Output<bool> saturated_;
+  RlsCore main_;
+  RlsCore aux_;
+  std::array<double, SelfTuningRegulatorParams::kMaxDelay + 2> hist_v_{};  // u_v(k−1−i)
+  double u_t_{0.0};
+  double y_rv_{0.0};
+  double y_rt_{0.0};
+};
+
+}  // namespace edm::blocks

@@ -1,0 +1,184 @@
+#include "edm/blocks/iterative_learning_control.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edm::blocks {
+namespace {
+
+constexpr std::size_t kSamplesIndex = 0;  // n_samples in IterativeLearningControlParams::visit()
+
+}  // namespace
+
+std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "n_samples", static_cast<double>(n_samples), 2.0,
+                    static_cast<double>(kMaxSamples));
+  const std::pair<const char*, double> all[] = {
+      {"p0", p0},           {"k_delta", k_delta}, {"q_pole", q_pole},       {"lambda1", lambda1},
+      {"lambda2", lambda2}, {"lambda3", lambda3}, {"u_initial", u_initial}, {"u_min", u_min},
+      {"u_max", u_max}};
+  for (const auto& [name, value] : all) {
+    rt::require_finite(errs, name, value);
+  }
+  if (!errs.empty()) {
+    return errs;
+  }
+  if (p0 == 0.0) {
+    errs.push_back({"p0", "must be != 0 (l1 divides by it)"});
+  }
+  if (k_delta == 0.0) {
+    errs.push_back({"k_delta", "must be != 0 (the gains divide by it)"});
+  }
+  rt::require_range(errs, "q_pole", q_pole, 0.0, 1.0 - 1e-9);
+  constexpr double kPole = 1.0 - 1e-9;
+  rt::require_range(errs, "lambda1", lambda1, -kPole, kPole);
+  rt::require_range(errs, "lambda2", lambda2, -kPole, kPole);
+  rt::require_range(errs, "lambda3", lambda3, -kPole, kPole);
+  rt::require_ordered(errs, "u_min", u_min, "u_max", u_max);
+  if (errs.empty()) {
+    rt::require_range(errs, "u_initial", u_initial, u_min, u_max);
+  }
+  return errs;
+}
+
+IterativeLearningControl::Gains IterativeLearningControl::gains(
+    const IterativeLearningControlParams& p) noexcept {
+  const double q0 = 1.0 - p.q_pole;
+  Gains g;
+  g.l1 = (q0 - p.lambda3) / (p.k_delta * q0 * p.p0);
+  g.l2 = (2.0 - p.lambda1 - p.lambda2) / p.k_delta;
+  g.l3 = (1.0 - p.lambda1) * (1.0 - p.lambda2) / p.k_delta;
+  return g;
+}
+
+void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
+  v.input("y", y_);
+  v.input("y_ref", y_ref_);
+  v.input("cycle_start", cycle_start_);
+  v.input("enable", enable_);
+  v.output("u", u_out_);
+  v.output("mean_error", mean_error_);
+  v.output("x", x_out_);
+  v.output("l1", l1_);
+  v.output("l2", l2_);
+  v.output("l3", l3_);
+  v.output("sample", sample_, "samples");
+  v.output("cycles", cycles_);
+}
+
+std::vector<rt::ParamError> IterativeLearningControl::configure(const rt::BlockSetup& /*setup*/) {
+  auto errs = params_.validate();
+  if (!errs.empty()) {
+    return errs;
+  }
+  u_.assign(static_cast<std::size_t>(params_.n_samples), params_.u_initial);
+  e_.assign(u_.size(), 0.0);
+  return errs;
+}
+
+void IterativeLearningControl::activate() noexcept {
+  std::fill(u_.begin(), u_.end(), params_.u_initial);
+  std::fill(e_.begin(), e_.end(), 0.0);
+  idx_ = -1;
+  prev_edge_ = false;
+  overrun_ = false;
+  x_ = 0.0;
+  last_e_ = 0.0;
+  cycles_done_ = 0;
+  const Gains g = gains(params_);
+  l1_.set(g.l1);
+  l2_.set(g.l2);
+  l3_.set(g.l3);
+  u_out_.set(params_.u_initial);
+  mean_error_.set(0.0);
+  x_out_.set(0.0);
+  sample_.set(-1);
+  cycles_.set(0);
+}
+
+void IterativeLearningControl::learn() noexcept {
+  const auto& p = params_;
+  const Gains g = gains(p);
+  const std::size_t n = u_.size();
+  double mean = 0.0;
+  for (double e : e_) {
+    mean += e;
+  }
+  mean /= static_cast<double>(n);
+  // v = u_j + L·e_j (into u_, in place), then u_j+1 = Q·v.
+  for (std::size_t i = 0; i < n; ++i) {
+    u_[i] += g.l1 * (e_[i] - mean) + g.l2 * mean + g.l3 * x_;
+  }
+  x_ += mean;
+  const double a = p.q_pole;
+  if (a > 0.0) {
+    const double v0 = u_[0];
+    double s = 0.0;
+    for (std::size_t i = 1; i < n; ++i) {
+      s = a * s + (1.0 - a) * (u_[i] - v0);
+      u_[i] = v0 + s;
+    }
+  }
+  for (double& u : u_) {
+    u = std::min(std::max(u, p.u_min), p.u_max);
+  }
+  ++cycles_done_;
+  mean_error_.set(mean);
+  x_out_.set(x_);
+  cycles_.set(cycles_done_);
+}
+
+rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const auto& p = params_;
+  const double y = y_.get();
+  const double ref = y_ref_.get();
+  const bool edge_in = cycle_start_.get();
+  const bool rising = edge_in && !prev_edge_;
+  prev_edge_ = edge_in;
+  const auto n = static_cast<std::int64_t>(u_.size());
+  if (!std::isfinite(y) || !std::isfinite(ref) || n == 0) {
+    return rt::BlockStatus::kFault;
+  }
+  const bool learning = enable_.get();
+  if (idx_ >= 0) {
+    last_e_ = ref - y;
+    e_[static_cast<std::size_t>(idx_)] = last_e_;
+  }
+  const bool boundary = rising || (p.auto_cycle && (idx_ < 0 || idx_ == n - 1));
+  if (boundary) {
+    if (idx_ >= 0) {
+      for (std::int64_t i = idx_ + 1; i < n; ++i) {
+        e_[static_cast<std::size_t>(i)] = last_e_;  // a cycle cut short
+      }
+      if (learning) {
+        learn();
+      }
+    }
+    idx_ = 0;
+    overrun_ = false;
+  } else if (idx_ >= 0) {
+    if (idx_ + 1 < n) {
+      ++idx_;
+    } else {
+      overrun_ = true;
+    }
+  }
+  if (idx_ < 0) {
+    u_out_.set(p.u_initial);
+    return rt::BlockStatus::kOk;
+  }
+  u_out_.set(u_[static_cast<std::size_t>(idx_)]);
+  sample_.set(idx_);
+  return overrun_ ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
+}
+
+std::vector<rt::ParamError> IterativeLearningControl::stage_param(std::size_t index,
+                                                                  const rt::ParamValue& v) {
+  if (index == kSamplesIndex) {
+    return {{"n_samples", "cannot change at run time (it sizes the buffers); reload the config"}};
+  }
+  return BlockWithParams::stage_param(index, v);
+}
+
+}  // namespace edm::blocks

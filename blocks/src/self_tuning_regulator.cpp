@@ -1,0 +1,203 @@
+#include "edm/blocks/self_tuning_regulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edm::blocks {
+namespace {
+
+constexpr std::size_t kDelayIndex = 0;  // delay_v in SelfTuningRegulatorParams::visit()
+
+}  // namespace
+
+std::vector<rt::ParamError> SelfTuningRegulatorParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  rt::require_range(errs, "delay_v", static_cast<double>(delay_v), 0.0,
+                    static_cast<double>(kMaxDelay));
+  const std::pair<const char*, double> all[] = {{"beta00", beta00},
+                                                {"us_per_unit_v", us_per_unit_v},
+                                                {"u_v_min", u_v_min},
+                                                {"u_v_max", u_v_max},
+                                                {"u_v_initial", u_v_initial},
+                                                {"beta01_init", beta01_init},
+                                                {"beta0c_init", beta0c_init},
+                                                {"ti_us", ti_us},
+                                                {"to_min_us", to_min_us},
+                                                {"to_max_us", to_max_us},
+                                                {"to_initial_us", to_initial_us},
+                                                {"beta1c_init", beta1c_init},
+                                                {"lambda", lambda},
+                                                {"p0", p0},
+                                                {"trace_max", trace_max},
+                                                {"y_rv_good", y_rv_good},
+                                                {"y_rt_good", y_rt_good},
+                                                {"transient_arc_limit", transient_arc_limit},
+                                                {"stable_arc_limit", stable_arc_limit},
+                                                {"ref_rise", ref_rise},
+                                                {"ref_step", ref_step},
+                                                {"y_rv_min", y_rv_min},
+                                                {"y_rt_min", y_rt_min}};
+  for (const auto& [name, value] : all) {
+    rt::require_finite(errs, name, value);
+  }
+  if (!errs.empty()) {
+    return errs;
+  }
+  if (beta00 == 0.0) {
+    errs.push_back({"beta00", "must be != 0 (the law divides by it)"});
+  }
+  rt::require_positive(errs, "us_per_unit_v", us_per_unit_v);
+  rt::require_ordered(errs, "u_v_min", u_v_min, "u_v_max", u_v_max);
+  rt::require_positive(errs, "ti_us", ti_us);
+  rt::require_positive(errs, "to_min_us", to_min_us);
+  rt::require_ordered(errs, "to_min_us", to_min_us, "to_max_us", to_max_us);
+  rt::require_range(errs, "lambda", lambda, 0.5, 1.0);
+  rt::require_positive(errs, "p0", p0);
+  rt::require_ordered(errs, "p0", 2.0 * p0, "trace_max", trace_max);
+  rt::require_range(errs, "y_rv_good", y_rv_good, 0.0, 2.0);
+  rt::require_range(errs, "y_rt_good", y_rt_good, 0.0, 2.0);
+  rt::require_range(errs, "transient_arc_limit", transient_arc_limit, 0.0, 1.0);
+  rt::require_range(errs, "stable_arc_limit", stable_arc_limit, 0.0, 1.0);
+  rt::require_range(errs, "ref_rise", ref_rise, 1e-9, 1.0);
+  rt::require_non_negative(errs, "ref_step", ref_step);
+  rt::require_range(errs, "y_rv_min", y_rv_min, 0.0, 2.0);
+  rt::require_range(errs, "y_rt_min", y_rt_min, 0.0, 2.0);
+  if (errs.empty()) {
+    rt::require_range(errs, "u_v_initial", u_v_initial, u_v_min, u_v_max);
+    rt::require_range(errs, "to_initial_us", to_initial_us, to_min_us, to_max_us);
+    rt::require_ordered(errs, "y_rv_min", y_rv_min, "y_rv_good", y_rv_good);
+    rt::require_ordered(errs, "y_rt_min", y_rt_min, "y_rt_good", y_rt_good);
+  }
+  return errs;
+}
+
+void SelfTuningRegulator::visit_pins(rt::PinVisitor& v) {
+  v.input("ratio_normal", ratio_normal_, "1");
+  v.input("ratio_transient_arc", ratio_transient_arc_, "1");
+  v.input("ratio_stable_arc", ratio_stable_arc_, "1");
+  v.input("ratio_short", ratio_short_, "1");
+  v.input("y_rv_ref", y_rv_ref_, "1");
+  v.input("y_rt_ref", y_rt_ref_, "1");
+  v.input("enable", enable_);
+  v.output("servo_ref_v", servo_ref_v_, "V");
+  v.output("off_time_us", off_time_us_, "us");
+  v.output("u_v", u_v_out_, "1");
+  v.output("y_v", y_v_out_, "1");
+  v.output("y_t", y_t_out_, "1");
+  v.output("y_rv", y_rv_out_, "1");
+  v.output("y_rt", y_rt_out_, "1");
+  v.output("beta01", beta01_, "1");
+  v.output("beta0c", beta0c_, "1");
+  v.output("beta1c", beta1c_, "1");
+  v.output("k1", k1_, "1");
+  v.output("saturated", saturated_);
+}
+
+void SelfTuningRegulator::activate() noexcept {
+  const auto& p = params_;
+  const double main_init[2] = {p.beta01_init, p.beta0c_init};
+  main_.reset(2, p.p0, main_init);
+  const double aux_init[1] = {p.beta1c_init};
+  aux_.reset(1, p.p0, aux_init);
+  hist_v_.fill(std::clamp(p.u_v_initial, p.u_v_min, p.u_v_max));
+  u_t_ = std::clamp(p.to_initial_us, p.to_min_us, p.to_max_us);
+  y_rv_ = p.y_rv_good;
+  y_rt_ = p.y_rt_good;
+  y_v_out_.set(0.0);
+  y_t_out_.set(0.0);
+  k1_.set(p.ti_us / (p.ti_us + u_t_));
+  saturated_.set(false);
+  publish();
+}
+
+void SelfTuningRegulator::publish() noexcept {
+  servo_ref_v_.set(params_.us_per_unit_v * hist_v_[0]);
+  off_time_us_.set(u_t_);
+  u_v_out_.set(hist_v_[0]);
+  y_rv_out_.set(y_rv_);
+  y_rt_out_.set(y_rt_);
+  beta01_.set(main_.theta(0));
+  beta0c_.set(main_.theta(1));
+  beta1c_.set(aux_.theta(0));
+}
+
+rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const auto& p = params_;
+  const double phi_e = ratio_normal_.get();
+  const double phi_e2 = ratio_transient_arc_.get();
+  const double phi_a = ratio_stable_arc_.get();
+  const double phi_s = ratio_short_.get();
+  const double rv_in = y_rv_ref_.get();
+  const double rt_in = y_rt_ref_.get();
+  if (!std::isfinite(phi_e) || !std::isfinite(phi_e2) || !std::isfinite(phi_a) ||
+      !std::isfinite(phi_s) || !std::isfinite(rv_in) || !std::isfinite(rt_in)) {
+    return rt::BlockStatus::kFault;
+  }
+  // K1 = ti/tp of the period just measured (the off time commanded last sample).
+  const double k1 = p.ti_us / (p.ti_us + u_t_);
+  const double y_v = phi_e + 2.0 * phi_e2 + 2.0 * phi_a + 2.0 * phi_s;
+  const double y_t = k1 * (phi_e + 2.0 * phi_e2 + 2.0 * phi_a);
+  y_v_out_.set(y_v);
+  y_t_out_.set(y_t);
+  k1_.set(k1);
+  if (!enable_.get()) {
+    // Hold u; the history still shifts, so the model's timing stays true on re-enable.
+    for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
+      hist_v_[i] = hist_v_[i - 1];
+    }
+    saturated_.set(false);
+    publish();
+    return rt::BlockStatus::kOk;
+  }
+
+  // Reference decision (§3).
+  if (phi_a > p.stable_arc_limit) {
+    y_rv_ = std::max(p.y_rv_min, y_rv_ - p.ref_step);
+    y_rt_ = std::max(p.y_rt_min, y_rt_ - p.ref_step);
+  } else if (phi_e2 < p.transient_arc_limit) {
+    y_rv_ += p.ref_rise * (p.y_rv_good - y_rv_);
+    y_rt_ += p.ref_rise * (p.y_rt_good - y_rt_);
+  }
+  const double y_rv = rv_in > 0.0 ? rv_in : y_rv_;
+  const double y_rt = rt_in > 0.0 ? rt_in : y_rt_;
+
+  // Main loop: y_v(k) − β00·u_v(k−d−1) = β01·u_v(k−d−2) + β0c.
+  const auto d = static_cast<std::size_t>(p.delay_v);
+  const double phi_v[2] = {hist_v_[d + 1], 1.0};
+  const RlsCore::Result rv =
+      main_.update(phi_v, y_v - p.beta00 * hist_v_[d], p.lambda, p.trace_max);
+  // Auxiliary loop: y_t(k) − β10·u_t(k−1) = β1c.
+  const double beta10 = -1.0 / p.ti_us;
+  const double one[1] = {1.0};
+  const RlsCore::Result rt_res = aux_.update(one, y_t - beta10 * u_t_, p.lambda, p.trace_max);
+  if (!rv.ok || !rt_res.ok) {
+    return rt::BlockStatus::kFault;
+  }
+
+  // Minimum-variance laws: the model's prediction put on the reference.
+  const double u_v_raw = (y_rv - main_.theta(0) * hist_v_[0] - main_.theta(1)) / p.beta00;
+  const double u_t_raw = (y_rt - aux_.theta(0)) / beta10;
+  if (!std::isfinite(u_v_raw) || !std::isfinite(u_t_raw)) {
+    return rt::BlockStatus::kFault;
+  }
+  const double u_v = std::clamp(u_v_raw, p.u_v_min, p.u_v_max);
+  u_t_ = std::clamp(u_t_raw, p.to_min_us, p.to_max_us);
+  for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
+    hist_v_[i] = hist_v_[i - 1];
+  }
+  hist_v_[0] = u_v;
+  const bool saturated = u_v != u_v_raw || u_t_ != u_t_raw;
+  saturated_.set(saturated);
+  publish();
+  return saturated ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
+}
+
+std::vector<rt::ParamError> SelfTuningRegulator::stage_param(std::size_t index,
+                                                             const rt::ParamValue& v) {
+  if (index == kDelayIndex) {
+    return {{"delay_v", "cannot change at run time (regressor history); reload the config"}};
+  }
+  return BlockWithParams::stage_param(index, v);
+}
+
+}  // namespace edm::blocks

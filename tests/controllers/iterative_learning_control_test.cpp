@@ -1,0 +1,246 @@
+// Seed 002 controller: iterative learning control in the lifted domain over a machining cycle,
+// run against the paper's own lifted process model.
+
+#include "edm/blocks/iterative_learning_control.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "blocks/block_harness.hpp"
+
+namespace edm::blocks {
+namespace {
+
+using rt::BlockStatus;
+using test::BlockHarness;
+
+// The paper's process: z_j = P·u_j with P first-sample anchored (row i: 1 − Σ_{m<i} p_m on the
+// first column, p_{i−c} on column c ≥ 1), p_m = (1 − b)·b^m (a first-order closed axis loop,
+// p0 = 1 − b); y = kδ·(z − z_p) + b_y + n; the surface is constant over a cycle and recedes by
+// `recede` (z_A) from one cycle to the next. The block runs in lock-step: each update reads the
+// response to its previous output.
+struct Plant {
+  int n{20};
+  double b{0.0};  // P's pole (0: P = I)
+  double k_delta{2.0};
+  double b_y{0.3};
+  double recede{0.0};
+  std::vector<double> shape;  // repeating within-cycle disturbance n(k) (empty: none)
+};
+
+struct CycleLog {
+  std::vector<double> mean_error;           // ē_j per cycle (as the block measured it)
+  std::vector<std::vector<double>> errors;  // e_j(k)
+};
+
+CycleLog run(const IterativeLearningControlParams& p, const Plant& plant, double surface0,
+             double y_ref, int cycles) {
+  BlockHarness<IterativeLearningControl> h;
+  const auto errs = h.start(p);
+  EXPECT_TRUE(errs.empty()) << test::describe(errs);
+  auto& y = h.source<double>("y");
+  auto& ref = h.source<double>("y_ref");
+  auto& edge = h.source<bool>("cycle_start");
+  ref.set(y_ref);
+  const int n = plant.n;
+  std::vector<double> pm(static_cast<std::size_t>(n));
+  for (int m = 0; m < n; ++m) {
+    pm[static_cast<std::size_t>(m)] = (1.0 - plant.b) * std::pow(plant.b, m);
+  }
+  std::vector<double> u(static_cast<std::size_t>(n));
+  double surface = surface0;
+  y.set(y_ref);
+  CycleLog r;
+  std::vector<double> e(static_cast<std::size_t>(n));
+  for (int j = 0; j < cycles; ++j) {
+    for (int k = 0; k < n; ++k) {
+      edge.set(k == 0);
+      h.step();
+      EXPECT_EQ(h.out<std::int64_t>("sample"), k);
+      u[static_cast<std::size_t>(k)] = h.out("u");
+      // z_j(k) = u(0) + Σ_{c=1..k} p_{k−c}·(u(c) − u(0))   (the lifted P, row k)
+      double z = u[0];
+      for (int c = 1; c <= k; ++c) {
+        z += pm[static_cast<std::size_t>(k - c)] * (u[static_cast<std::size_t>(c)] - u[0]);
+      }
+      const double dist = plant.shape.empty() ? 0.0 : plant.shape[static_cast<std::size_t>(k)];
+      const double yk = plant.k_delta * (z - surface) + plant.b_y + dist;
+      y.set(yk);
+      e[static_cast<std::size_t>(k)] = y_ref - yk;
+    }
+    double mean = 0.0;
+    for (double v : e) {
+      mean += v / n;
+    }
+    r.mean_error.push_back(mean);
+    r.errors.push_back(e);
+    surface += plant.recede;
+  }
+  return r;
+}
+
+IterativeLearningControlParams params(int n, double p0, double k_delta, double q_pole, double l1,
+                                      double l2, double l3) {
+  IterativeLearningControlParams p;
+  p.n_samples = n;
+  p.p0 = p0;
+  p.k_delta = k_delta;
+  p.q_pole = q_pole;
+  p.lambda1 = l1;
+  p.lambda2 = l2;
+  p.lambda3 = l3;
+  return p;
+}
+
+TEST(IterativeLearningControl, gains_follow_the_pole_placement_formulas) {
+  const auto p = params(50, 0.4, 2.0, 0.3, 0.6, 0.5, 0.2);
+  const auto g = IterativeLearningControl::gains(p);
+  const double q0 = 0.7;
+  EXPECT_DOUBLE_EQ(g.l1, (q0 - 0.2) / (2.0 * q0 * 0.4));
+  EXPECT_DOUBLE_EQ(g.l2, (2.0 - 0.6 - 0.5) / 2.0);
+  EXPECT_DOUBLE_EQ(g.l3, (1.0 - 0.6) * (1.0 - 0.5) / 2.0);
+}
+
+TEST(IterativeLearningControl, cycle_mean_error_contracts_with_the_chosen_forward_poles) {
+  // A gap offset at the start (surface 0.25 below the gap the reference wants). Q and P keep
+  // constants, so the cycle means obey exactly ē_j+2 = (λ1 + λ2)·ē_j+1 − λ1·λ2·ē_j, i.e.
+  // ē_j = c1·λ1^j + c2·λ2^j: check the recurrence and the closed form's decay.
+  Plant plant;
+  plant.b = 0.6;  // p0 = 0.4
+  const double l1 = 0.7;
+  const double l2 = 0.4;
+  const auto p = params(plant.n, 1.0 - plant.b, plant.k_delta, 0.3, l1, l2, 0.3);
+  const double y_ref = plant.k_delta * 0.05 + plant.b_y;  // wanted gap 0.05
+  const CycleLog r = run(p, plant, -0.30, y_ref, 30);     // start gap 0.30
+  ASSERT_GT(std::fabs(r.mean_error[0]), 0.4);
+  for (std::size_t j = 0; j + 2 < r.mean_error.size(); ++j) {
+    const double predicted = (l1 + l2) * r.mean_error[j + 1] - l1 * l2 * r.mean_error[j];
+    EXPECT_NEAR(r.mean_error[j + 2], predicted, 1e-9 * std::fabs(r.mean_error[0])) << "j=" << j;
+  }
+  // Closed form from the first two cycles: c1 + c2 = ē0, c1·λ1 + c2·λ2 = ē1.
+  const double c1 = (r.mean_error[1] - l2 * r.mean_error[0]) / (l1 - l2);
+  const double c2 = r.mean_error[0] - c1;
+  for (std::size_t j = 0; j < r.mean_error.size(); ++j) {
+    const double jd = static_cast<double>(j);
+    EXPECT_NEAR(r.mean_error[j], c1 * std::pow(l1, jd) + c2 * std::pow(l2, jd), 1e-9);
+  }
+  EXPECT_LT(std::fabs(r.mean_error.back()), 1e-4 * std::fabs(r.mean_error[0]));
+}
+
+TEST(IterativeLearningControl, a_receding_surface_is_followed_with_zero_mean_error) {
+  // z_A: the surface recedes by 0.02 per cycle (a ramp in the cycle index). The controller's
+  // two integrations (u and x) follow a ramp with zero steady-state mean error.
+  Plant plant;
+  plant.b = 0.5;
+  plant.recede = -0.02;
+  const auto p = params(plant.n, 0.5, plant.k_delta, 0.2, 0.5, 0.4, 0.3);
+  const double y_ref = plant.k_delta * 0.05 + plant.b_y;
+  const CycleLog r = run(p, plant, -0.05, y_ref, 80);
+  EXPECT_GT(std::fabs(r.mean_error[1]), 1e-3) << "the recession disturbs the gap";
+  EXPECT_LT(std::fabs(r.mean_error.back()), 1e-6);
+}
+
+TEST(IterativeLearningControl, a_repeating_error_shape_contracts_by_lambda3_per_cycle) {
+  // P = I (p0 = 1) and Q = I (q0 = 1): the zero-mean part of the error obeys
+  // w_j+1 = (1 − kδ·l1)·w_j = λ3·w_j exactly, a repeating disturbance is learnt away.
+  Plant plant;
+  plant.b = 0.0;
+  plant.shape.resize(static_cast<std::size_t>(plant.n));
+  for (int k = 0; k < plant.n; ++k) {
+    plant.shape[static_cast<std::size_t>(k)] = 0.1 * std::sin(2.0 * 3.14159265358979 * k / plant.n);
+  }
+  const double lambda3 = 0.35;
+  const auto p = params(plant.n, 1.0, plant.k_delta, 0.0, 0.5, 0.5, lambda3);
+  const double y_ref = plant.k_delta * 0.05 + plant.b_y;
+  const CycleLog r = run(p, plant, -0.05, y_ref, 12);
+  auto shape_norm = [](const std::vector<double>& e) {
+    double mean = 0.0;
+    for (double v : e) {
+      mean += v / static_cast<double>(e.size());
+    }
+    double s = 0.0;
+    for (double v : e) {
+      s += (v - mean) * (v - mean);
+    }
+    return std::sqrt(s);
+  };
+  ASSERT_GT(shape_norm(r.errors[0]), 0.1);
+  for (std::size_t j = 0; j + 1 < r.errors.size(); ++j) {
+    EXPECT_NEAR(shape_norm(r.errors[j + 1]) / shape_norm(r.errors[j]), lambda3, 1e-9) << j;
+  }
+}
+
+TEST(IterativeLearningControl, with_a_real_axis_and_q_filter_the_learning_converges) {
+  // P and Q first-order (p0 = 0.5, q0 = 0.8). The repeating disturbance cancels from the
+  // cycle-to-cycle difference Δ_j = e_j+1 − e_j, which therefore obeys the homogeneous closed
+  // loop whose eigenvalues eq. (1) places at λ1, λ2 (means) and λ3 (the diagonal of the lower-
+  // triangular within-cycle map): Δ_j → 0 geometrically. The limit error is not 0: Q discards
+  // part of the learning (the usual ILC trade-off between robustness and residual error).
+  Plant plant;
+  plant.b = 0.5;
+  plant.shape.resize(static_cast<std::size_t>(plant.n));
+  for (int k = 0; k < plant.n; ++k) {
+    plant.shape[static_cast<std::size_t>(k)] = 0.1 * std::sin(2.0 * 3.14159265358979 * k / plant.n);
+  }
+  const auto p = params(plant.n, 0.5, plant.k_delta, 0.2, 0.5, 0.5, 0.3);
+  const double y_ref = plant.k_delta * 0.05 + plant.b_y;
+  const CycleLog r = run(p, plant, -0.05, y_ref, 80);
+  auto diff = [&](std::size_t j) {
+    double s = 0.0;
+    for (std::size_t k = 0; k < r.errors[j].size(); ++k) {
+      const double d = r.errors[j + 1][k] - r.errors[j][k];
+      s += d * d;
+    }
+    return std::sqrt(s);
+  };
+  auto rms = [](const std::vector<double>& e) {
+    double s = 0.0;
+    for (double v : e) {
+      s += v * v;
+    }
+    return std::sqrt(s / static_cast<double>(e.size()));
+  };
+  ASSERT_GT(diff(0), 1e-3);
+  EXPECT_LT(diff(r.errors.size() - 2), 1e-6 * diff(0));
+  EXPECT_LT(rms(r.errors.back()), 0.2 * rms(r.errors[0])) << "most of the error is learnt";
+  EXPECT_GT(rms(r.errors.back()), 1e-4) << "Q leaves a residual";
+}
+
+TEST(IterativeLearningControl, cycle_handling_and_validation) {
+  IterativeLearningControlParams p;
+  p.n_samples = 4;
+  p.u_initial = 1.5;
+  BlockHarness<IterativeLearningControl> h;
+  ASSERT_TRUE(h.start(p).empty());
+  auto& edge = h.source<bool>("cycle_start");
+  h.source<double>("y").set(0.0);
+  EXPECT_EQ(h.step(), BlockStatus::kOk);
+  EXPECT_EQ(h.out("u"), 1.5) << "before the first edge: u_initial";
+  EXPECT_EQ(h.out<std::int64_t>("cycles"), 0);
+  edge.set(true);
+  h.step();
+  edge.set(false);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(h.step(), BlockStatus::kOk);
+  }
+  EXPECT_EQ(h.step(), BlockStatus::kSaturated) << "a cycle longer than N";
+  EXPECT_EQ(h.out<std::int64_t>("sample"), 3);
+  edge.set(true);
+  h.step();
+  EXPECT_EQ(h.out<std::int64_t>("cycles"), 1);
+  EXPECT_EQ(h.out<std::int64_t>("sample"), 0);
+  p.p0 = 0.0;
+  EXPECT_FALSE(p.validate().empty());
+  p = {};
+  p.lambda3 = 1.0;
+  EXPECT_FALSE(p.validate().empty());
+  p = {};
+  p.q_pole = 1.0;
+  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(h.block().stage_param(0, rt::ParamValue::of_int(8)).empty());
+}
+
+}  // namespace
+}  // namespace edm::blocks
