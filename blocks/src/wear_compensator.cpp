@@ -47,17 +47,26 @@ void WearCompensator::compute_ratio() noexcept {
   area_ratio_ = params_.hole_area_mm2 / params_.electrode_area_mm2;
 }
 
-rt::BlockStatus WearCompensator::update(const rt::CycleContext& /*ctx*/) noexcept {
+rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
   double wear = wear_mm_.get();
   if (reset_wear_.get()) {
     wear = 0.0;
     front_mm_ = 0.0;
     deepest_mm_ = 0.0;
+    have_release_ = false;
   } else if (!std::isfinite(wear)) {  // a corrupt restored value
     wear = 0.0;
     status = rt::BlockStatus::kFault;
   }
+  // The time since the last cycle, not the period: omitted cycles (the axis kept its last
+  // command) count too.
+  double elapsed_s = dt_s_;
+  if (have_release_ && ctx.release > last_release_) {
+    elapsed_s = std::clamp(rt::to_seconds(ctx.release - last_release_), dt_s_, 10.0 * dt_s_);
+  }
+  have_release_ = true;
+  last_release_ = ctx.release;
   const double vz_in = vz_in_mm_s_.get();
   if (!std::isfinite(vz_in)) {
     vz_out_mm_s_.set(0.0);
@@ -66,7 +75,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& /*ctx*/) noexcep
     return rt::BlockStatus::kFault;
   }
   // High-water mark of the front: only depth never reached before is erosion progress.
-  front_mm_ += vz_in * dt_s_;
+  front_mm_ += vz_in * elapsed_s;
   if (!std::isfinite(front_mm_)) {  // absurd feeds: restart the tracking, compensate nothing
     front_mm_ = 0.0;
     deepest_mm_ = 0.0;

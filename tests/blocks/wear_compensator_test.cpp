@@ -46,6 +46,25 @@ TEST(WearCompensatorTest, vd_equals_eq8_for_constant_feeds) {
   }
 }
 
+// A loaded real-time machine may omit cycles while the axis keeps its last command: the front
+// moved for the whole time since the previous release, and that new depth wears the electrode.
+TEST(WearCompensatorTest, omitted_cycles_still_count_as_front_progress) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start(WearCompensatorParams{}).empty());
+  h.source<double>("wear_ratio").set(0.6);
+  const double vz = -0.5;
+  step(h, vz);                 // cycle 0
+  h.set_cycle(h.cycle() + 2);  // cycles 1 and 2 omitted
+  step(h, vz);                 // cycle 3: 3 ms of feed since cycle 0
+  const auto& p = h.block().params();
+  const double area_ratio = p.hole_area_mm2 / p.electrode_area_mm2;
+  // eq. 8 over 4 ms of new depth (1 ms before cycle 0's own step + 3 ms since).
+  EXPECT_NEAR(h.out("wear_mm"), 0.6 * area_ratio * 0.5 * 4e-3, 1e-12);
+  h.set_cycle(h.cycle() + 1000);  // a long pause counts at most 10 periods
+  step(h, vz);
+  EXPECT_NEAR(h.out("wear_mm"), 0.6 * area_ratio * 0.5 * 14e-3, 1e-12);
+}
+
 TEST(WearCompensatorTest, no_compensation_while_retracting_holding_or_disabled) {
   BlockHarness<WearCompensator> h(1ms);
   ASSERT_TRUE(h.start(WearCompensatorParams{}).empty());

@@ -8,9 +8,11 @@
 //
 // Estimator of v_bottom: the gap controller's command vz_in is the velocity the electrode FRONT
 // needs relative to the work to hold the gap (commanding the axis vz_in − Vd makes the front move
-// at exactly vz_in, because the electrode shortens at Vd). The block integrates the front
-// position p += vz_in·dt and keeps its deepest point so far (a high-water mark): the hole bottom
-// advances only when the front goes deeper than it has ever been,
+// at exactly vz_in, because the electrode shortens at Vd). The front is integrated over the time
+// since the previous cycle's release (up to 10 periods), so cycles a loaded real-time machine
+// omits — while the axis keeps moving at the last command — still count. The block integrates the
+// front position p += vz_in·dt and keeps its deepest point so far (a high-water mark): the hole
+// bottom advances only when the front goes deeper than it has ever been,
 //   v_bottom·dt = max(0, −p − deepest),   deepest = max(deepest, −p).
 // For a steady downward feed this is v_bottom = |vz_in| (eq. 8 exactly); the servo's back-and-
 // forth motion over already-eroded depth (short-circuit retracts, gap oscillation at a high Kg)
@@ -72,9 +74,11 @@ class WearCompensator final : public rt::BlockWithParams<WearCompensatorParams> 
   rt::Output<double> vd_mm_s_;
   rt::Output<double> wear_mm_;
   double dt_s_{0.0};
-  double area_ratio_{1.0};  // A_hole / A_e
-  double front_mm_{0.0};    // ∫ vz_in dt since the last reset (0 = where the reset happened)
-  double deepest_mm_{0.0};  // max(−front_mm_) so far, ≥ 0
+  double area_ratio_{1.0};    // A_hole / A_e
+  double front_mm_{0.0};      // ∫ vz_in dt since the last reset (0 = where the reset happened)
+  double deepest_mm_{0.0};    // max(−front_mm_) so far, ≥ 0
+  bool have_release_{false};  // last_release_ is valid (not the first cycle since a reset)
+  rt::TimePoint last_release_{};
 };
 
 }  // namespace edm::blocks
