@@ -128,9 +128,14 @@ int cmd_run(const Args& args, const edm::hmi::ConnectionSettings& settings) {
     case RunOutcome::kLost:
       std::fprintf(stderr, "edmhmi: %s\n", r.message.c_str());
       return kExitFailure;
+    case RunOutcome::kInterrupted:
+      if (!r.message.empty()) {  // no report: the end was not seen
+        std::fprintf(stderr, "edmhmi: %s\n", r.message.c_str());
+        return kExitInterrupted;
+      }
+      break;
     case RunOutcome::kFinished:
     case RunOutcome::kAborted:
-    case RunOutcome::kInterrupted:
       break;
   }
   std::fputs(edm::hmi::format_report(r.report).c_str(), stdout);

@@ -179,6 +179,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   bool offline = false;  // (not an optional: GCC 12 -Wmaybe-uninitialized false positive)
   Clock::time_point offline_since{};
   bool stop_sent = false;
+  Clock::time_point stop_sent_at{};
   DepthRate rate;
   std::uint64_t seen = 0;
   StatusMessage last = before;
@@ -221,7 +222,20 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
       offline = false;
       if (cb.note) cb.note("reconnected");
     }
+    if (interrupt.load() && !client.connected()) {
+      // Interrupted and cut off (e.g. the whole process group got the Ctrl-C, edmplc too): the
+      // operator wants out; there is nobody to send the stop to.
+      result.outcome = RunOutcome::kInterrupted;
+      result.message = "interrupted while disconnected from edmplc; the job's state is unknown";
+      return result;
+    }
+    if (interrupt.load() && stop_sent && Clock::now() - stop_sent_at > std::chrono::seconds(10)) {
+      result.outcome = RunOutcome::kInterrupted;
+      result.message = "interrupted; the machine did not confirm the stop within 10 s";
+      return result;
+    }
     if (interrupt.load() && !stop_sent && client.connected()) {
+      stop_sent_at = Clock::now();
       stop_sent = true;
       const bridge::Reply r = client.request("cycle.stop");
       if (cb.note) {
