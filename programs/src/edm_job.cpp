@@ -84,6 +84,7 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
   std::vector<rt::ParamError> errs;
   machine_ = setup.machine;
   job_ = setup.job;
+  if (job_ != nullptr) job_->attach_runner();
   tables_ = setup.tables;
   if (machine_ == nullptr || job_ == nullptr || tables_ == nullptr) {
     errs.push_back({"", "EdmJob needs the runtime's machine, job store and tables"});

@@ -110,6 +110,13 @@ class BridgeFixture : public ::testing::Test {
       ro.stop = &stop_;
       rt_->run(ro);
     });
+    // run() powers the machine on (OFF → READY) on its thread: wait for that, not for a time.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (rt_->machine().state() == rt::MachineState::kOff &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::yield();
+    }
+    ASSERT_NE(rt_->machine().state(), rt::MachineState::kOff) << "the runtime did not start";
   }
   void TearDown() override {
     stop_ = true;

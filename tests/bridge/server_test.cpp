@@ -308,6 +308,19 @@ TEST_F(Bridge, estop_and_reset_drive_the_state_machine) {
   EXPECT_EQ(c.request("cycle.stop").body["state"], "READY");
 }
 
+TEST_F(Bridge, a_machine_that_runs_part_programs_needs_one_to_start) {
+  start();
+  rt_->job().attach_runner();  // as EdmJob does at configure time
+  Client c;
+  c.connect(client_opts());
+  const Reply r = c.request("cycle.start");
+  expect_error(r, ErrorCode::kInvalidState);
+  EXPECT_NE(r.message.find("no part program loaded"), std::string::npos) << r.message;
+  EXPECT_EQ(rt_->machine().state(), rt::MachineState::kReady);
+  ASSERT_TRUE(c.upload_program(line_program(3)));
+  EXPECT_EQ(c.request("cycle.start").body["state"], "RUNNING");
+}
+
 TEST_F(Bridge, variables_list_read_write_force) {
   start();
   Client c;

@@ -262,6 +262,11 @@ Body op_program_commit(Session& s, const Json& msg) {
 Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
   auto& m = s.server().rt.machine();
   const rt::MachineState before = m.state();
+  const rt::JobStore& job = s.server().rt.job();
+  if (c == rt::MachineCommand::kStart && job.has_runner() && job.loaded_blocks() == 0) {
+    // A machine that runs part programs would only stand in RUNNING doing nothing.
+    return error(ErrorCode::kInvalidState, "cycle.start: no part program loaded (program.commit)");
+  }
   if (m.command(c) != rt::CommandResult::kOk) {
     return error(ErrorCode::kInvalidState,
                  std::string(op) + " is not allowed in " + std::string(to_string(before)));

@@ -71,6 +71,12 @@ class JobStore {
   /// Any thread; the fields are read one by one (each is consistent, the set nearly so).
   [[nodiscard]] JobProgress progress() const noexcept;
 
+  /// Non-RT, at configure time: a block that runs the loaded program (EdmJob) says so; a
+  /// cycle start on such a machine then needs a program (the bridge refuses it otherwise).
+  void attach_runner() noexcept { runner_.store(true, std::memory_order_release); }
+  /// Any thread.
+  [[nodiscard]] bool has_runner() const noexcept { return runner_.load(std::memory_order_acquire); }
+
  private:
   enum class Phase : std::uint8_t { kIdle, kLoading, kActive };
   using Program = std::vector<machining::MotionBlock>;
@@ -83,6 +89,7 @@ class JobStore {
   std::atomic<JobOutcome> outcome_{JobOutcome::kNone};
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<std::uint64_t> jobs_started_{0};
+  std::atomic<bool> runner_{false};
 };
 
 }  // namespace edm::rt
