@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     }
   }
   if (n_seeds < 0) {
-    n_seeds = quick ? 3 : 20;
+    n_seeds = quick ? 5 : 20;
   }
   if (n_seeds < 1) {
     return usage();

@@ -56,3 +56,28 @@ TEST(ControllerBench, B7SameSeedGivesIdenticalFiguresAnotherSeedDoesNot) {
 
 }  // namespace
 }  // namespace edm::bench
+
+namespace edm::bench {
+namespace {
+
+// B1 at full depth (30 mm), seed 1: seed 004's P gap controller reaches the depth; a constant
+// feed of 0.75 mm/s (faster than the hole can be eroded once debris slows it past h/d ≈ 15)
+// jams the electrode into the work: most pulses are shorts and the depth is never reached.
+TEST(ControllerBench, B1PGapControllerReachesDepthConstantFeedJamsInShorts) {
+  const auto scenarios = make_scenarios(/*quick=*/false);
+  ASSERT_EQ(scenarios.at(0).id, "B1");
+  RunSpec p = scenarios[0].variants.at(0).spec;
+  RunSpec constant = scenarios[0].variants.at(2).spec;
+  ASSERT_NE(constant.config.find("constant-feed"), std::string::npos);
+  const Outcome op = run(kRoot, p);
+  const Outcome oc = run(kRoot, constant);
+  EXPECT_EQ(op.reached, 1.0);
+  EXPECT_LT(op.time_to_depth_s, 100.0);
+  EXPECT_LT(op.short_pct, 1.0);
+  EXPECT_EQ(oc.reached, 0.0) << "constant feed reached 30 mm in " << oc.time_to_depth_s << " s";
+  EXPECT_GT(oc.short_pct, 50.0);
+  EXPECT_LT(oc.depth_mm, 30.0 - 1.0);
+}
+
+}  // namespace
+}  // namespace edm::bench

@@ -123,7 +123,7 @@ std::string write_plot(const std::string& dir, const ScenarioResult& r) {
       gp << "set multiplot layout 2,1\n";
     }
     gp << "set title \"" << s.id << ": " << s.title << "\"\nset ylabel \"" << c.header
-       << " (mean ± SD)\"\nset style fill solid 0.5\nset boxwidth 0.6\nset yrange [0:*]\n"
+       << " (mean ± SD)\"\nset style fill solid 0.5\nset boxwidth 0.6\n"
        << "set xtics rotate by -15\nplot '" << s.id
        << ".dat' using 1:2:xtic(4) with boxes notitle, '' using 1:2:3 with yerrorbars lc "
           "rgb 'black' pt 0 notitle\n";
