@@ -1,0 +1,125 @@
+#pragma once
+// The controller benchmark (issue 7, PLANT-MODEL §5): scenarios, one simulated run, reports.
+//
+// A run builds a Runtime from a YAML config (config/bench/controllers/ or config/machines/),
+// edited per scenario and seed, and steps it on the virtual clock in 1 ms slices, sampling the
+// simulator's pins after every slice. Runs are independent (one Runtime each), so run() may be
+// called from several threads at once. Not RT code: runs allocate freely.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace edm::bench {
+
+/// A text edit of the config: `from` must occur in it (replaced once), else run() throws.
+struct Edit {
+  std::string from;
+  std::string to;
+};
+
+/// What to run and what to measure.
+struct RunSpec {
+  std::string config;           // path relative to the source root
+  std::vector<Edit> edits;      // applied in order
+  std::string io_extra;         // extra simulator params, appended after the seed
+  std::uint64_t seed{1};        // replaces the config's `seed: 1` (common random numbers)
+  double limit_s{60.0};         // simulated time limit [s]
+  double target_depth_mm{0.0};  // > 0: time to depth = first io.depth_mm ≥ target − 0.05 mm
+  bool stop_at_depth{false};    // end the run when the depth is reached
+  std::string done_var;         // non-empty: end the run when this variable equals done_value
+  double done_value{4.0};       // DeepHoleDrill's DONE
+  double jump_period_s{0.0};    // > 0: forced jump (io.vz_cmd) every period (B5)
+  double td_ref_us{0.0};        // > 0: RMS(Td − td_ref) over cycles with ignited pulses
+  double rab_ref{0.0};          // > 0: Rab error against this set point (1 s means)
+  double transient_s{0.0};      // Rab error only after this time [s]
+};
+
+/// Outcomes of one run (PLANT-MODEL §5, as far as the simulator exposes them).
+struct Outcome {
+  double time_s{0.0};           // simulated time run [s]
+  double reached{0.0};          // 1: target depth reached (or done_var reached)
+  double time_to_depth_s{0.0};  // [s]; the time limit when not reached
+  double depth_mm{0.0};         // io.depth_mm at the end
+  double depth_error_um{0.0};   // depth − target [µm]
+  double speed_mm_min{0.0};     // depth / time (to depth, break or end) [mm/min]
+  double mrr_mm3_min{0.0};      // sink: depth × 100 mm² / time
+  double short_pct{0.0};        // shorts / all pulses [%]
+  double arc_pct{0.0};          // transient + stable arcs / all pulses [%]
+  double open_pct{0.0};         // open pulses / all pulses [%]
+  double retracts{0.0};         // rising edges of io.vz_cmd above +0.2 mm/s (jumps excluded)
+  double electrode_used_mm{0.0};
+  double td_rms_us{0.0};     // RMS(Td − Td_ref) per cycle
+  double wire_broken{0.0};   // 1: the wire broke
+  double break_time_s{0.0};  // [s]; the time limit when it did not break
+  double rab_mean{0.0};      // mean io.rab after the transient
+  double rab_err_rms{0.0};   // RMS of (1 s mean Rab − ref) after the transient
+  double rab_err_max{0.0};   // max |1 s mean Rab − ref| after the transient
+  // Five-state time ratios [%] (sink): normal (spark), transient arc, stable arc, short, open.
+  double ratio_normal_pct{0.0};
+  double ratio_tarc_pct{0.0};
+  double ratio_sarc_pct{0.0};
+  double ratio_short_pct{0.0};
+  double ratio_open_pct{0.0};
+  double jitter_um{0.0};        // z-jitter RMS per jump cycle [µm], mean over cycles
+  double jitter_first_um{0.0};  // mean of the first 3 cycles
+  double jitter_last_um{0.0};   // mean of the last 3 cycles
+  std::vector<double> jitter_per_cycle_um;
+
+  /// Every scalar, named (CSV columns; B7 compares them bit for bit).
+  [[nodiscard]] std::vector<std::pair<const char*, double>> fields() const;
+};
+
+/// Runs one simulated job. Throws on a config error or a missing variable.
+Outcome run(const std::string& source_root, const RunSpec& spec);
+
+/// One table column: a figure of the Outcome.
+struct Column {
+  std::string header;  // with its unit
+  std::function<double(const Outcome&)> get;
+  int precision{2};
+};
+
+/// One row of a scenario: a controller (or a variant of one) and its run.
+struct Variant {
+  std::string name;
+  RunSpec spec;
+};
+
+struct Scenario {
+  std::string id;     // B1, B2, B5, B6a …; file names out/bench/controllers/<id>.*
+  std::string title;  // one line
+  std::vector<Variant> variants;
+  std::vector<Column> columns;
+  std::size_t plot_column{0};  // the column of the bar plot
+  bool plot_jitter{false};     // also plot jitter per cycle against the cycle number
+};
+
+/// The scenarios; `quick` shortens runs (the seed count is the caller's).
+std::vector<Scenario> make_scenarios(bool quick);
+
+/// Mean and sample SD.
+std::pair<double, double> mean_sd(const std::vector<double>& v);
+
+}  // namespace edm::bench
+
+namespace edm::bench {
+
+/// The runs of one scenario: outcomes[variant][seed index].
+struct ScenarioResult {
+  const Scenario* scenario{nullptr};
+  std::vector<std::vector<Outcome>> outcomes;
+};
+
+/// Markdown: a heading line, then one row per variant, each column as mean ± SD over seeds.
+std::string markdown_table(const ScenarioResult& r);
+/// `<dir>/<id>.csv`: one line per (variant, seed) with every Outcome field.
+void write_csv(const std::string& dir, const ScenarioResult& r,
+               const std::vector<std::uint64_t>& seeds);
+/// `<dir>/<id>.gp` (+ `.dat`); runs gnuplot to `<id>.png` when `gnuplot` is found. Returns a
+/// note for the log (the PNG path, or why there is none).
+std::string write_plot(const std::string& dir, const ScenarioResult& r);
+
+}  // namespace edm::bench

@@ -1,0 +1,181 @@
+// The controller benchmark's scenarios (PLANT-MODEL §5): which configs, which edits, which
+// figures. Everything a reader needs to reproduce a row is here or in the config it names.
+
+#include <string>
+#include <vector>
+
+#include "bench.hpp"
+
+namespace edm::bench {
+namespace {
+
+Column col(std::string header, double Outcome::*field, int precision = 2) {
+  return {std::move(header), [field](const Outcome& o) { return o.*field; }, precision};
+}
+
+// Seed 000's cases on the wire machine. `servo_ref_v`, `arc_off_us`: the fixed settings of the
+// uncontrolled machine, which are also the controller's initial settings; `table5`: the row of
+// Table 5 (ol, Ku, Kv, Rab_ref) the controlled variants use.
+struct WireCase {
+  std::string id, title, io_extra;
+  double servo_ref_v, arc_off_us;
+  double ol, ku, kv, rab_ref;
+};
+
+std::vector<Variant> wire_variants(const WireCase& c, double limit_s) {
+  auto fmt = [](double x) {
+    std::string s = std::to_string(x);
+    s.erase(s.find_last_not_of('0') + 1);
+    if (!s.empty() && s.back() == '.') {
+      s += '0';
+    }
+    return s;
+  };
+  RunSpec base;
+  base.io_extra = c.io_extra;
+  base.limit_s = limit_s;
+  base.rab_ref = c.rab_ref;
+  base.transient_s = 10.0;
+  RunSpec fixed = base;
+  fixed.config = "config/bench/controllers/wire-fixed.yaml";
+  fixed.edits = {{"io.servo_ref_v: 40.0", "io.servo_ref_v: " + fmt(c.servo_ref_v)},
+                 {"io.arc_off_time_us: 20.0", "io.arc_off_time_us: " + fmt(c.arc_off_us)}};
+  const std::vector<Edit> pi_edits = {
+      {"u_initial_us: 20, v_initial_v: 40",
+       "u_initial_us: " + fmt(c.arc_off_us) + ", v_initial_v: " + fmt(c.servo_ref_v)},
+      {"ol: 3.0, ku: 0.07, kv: 0.14, rab_ref_default: 0.42",
+       "ol: " + fmt(c.ol) + ", ku: " + fmt(c.ku) + ", kv: " + fmt(c.kv) +
+           ", rab_ref_default: " + fmt(c.rab_ref)}};
+  RunSpec grey = base;
+  grey.config = "config/bench/controllers/wire-stfpi.yaml";
+  grey.edits = pi_edits;
+  RunSpec nogrey = base;
+  nogrey.config = "config/bench/controllers/wire-stfpi-nogrey.yaml";
+  nogrey.edits = pi_edits;
+  return {{"no control (fixed settings)", fixed},
+          {"self-tuning fuzzy PI + grey predictor", grey},
+          {"self-tuning fuzzy PI, no predictor", nogrey}};
+}
+
+}  // namespace
+
+std::vector<Scenario> make_scenarios(bool quick) {
+  std::vector<Scenario> out;
+  const double depth = quick ? 10.0 : 30.0;
+  const std::string depth_s = quick ? "10" : "30";
+  const double drill_limit = quick ? 60.0 : 200.0;
+
+  // B1: Ø1.0/0.3 tube, 30 mm hole; time to depth (true depth ≥ target − 50 µm).
+  {
+    Scenario s;
+    s.id = "B1";
+    s.title = "drilling Ø1.0/0.3 mm tube to " + depth_s + " mm (drill preset, F = 1)";
+    RunSpec p;
+    p.config = "config/bench/controllers/drill-p.yaml";
+    p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
+    p.limit_s = drill_limit;
+    p.target_depth_mm = depth;
+    p.done_var = "cycle.drill.state";
+    p.td_ref_us = 8.0;
+    RunSpec lut = p;
+    lut.config = "config/bench/controllers/drill-fuzzy-lut.yaml";
+    lut.edits.clear();
+    lut.done_var.clear();
+    lut.stop_at_depth = true;
+    RunSpec constant = lut;
+    constant.config = "config/bench/controllers/drill-constant-feed.yaml";
+    s.variants = {{"P gap controller on Td (seed 004)", p},
+                  {"fuzzy LUT servo on open/short counts (seed 003)", lut},
+                  {"no control (constant feed 0.75 mm/s)", constant}};
+    s.columns = {col("reached", &Outcome::reached),
+                 col("time to depth s", &Outcome::time_to_depth_s, 1),
+                 col("short %", &Outcome::short_pct),
+                 col("arc %", &Outcome::arc_pct),
+                 col("open %", &Outcome::open_pct),
+                 col("retracts", &Outcome::retracts, 0),
+                 col("electrode used mm", &Outcome::electrode_used_mm),
+                 col("RMS(Td−8 µs) µs", &Outcome::td_rms_us, 1)};
+    s.plot_column = 1;
+    out.push_back(std::move(s));
+  }
+  // B2: blind hole with and without real-time wear compensation; depth error at DONE.
+  {
+    Scenario s;
+    s.id = "B2";
+    s.title = "blind " + depth_s + " mm hole, depth error (DeepHoleDrill's own depth estimate)";
+    RunSpec p;
+    p.config = "config/bench/controllers/drill-p.yaml";
+    p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
+    p.limit_s = drill_limit;
+    p.target_depth_mm = depth;
+    p.done_var = "cycle.drill.state";
+    RunSpec off = p;
+    off.edits.push_back({"drill.enable_wear_comp: true", "drill.enable_wear_comp: false"});
+    s.variants = {{"P + real-time wear compensation (eq. 8)", p},
+                  {"P without wear compensation", off}};
+    s.columns = {col("done", &Outcome::reached), col("depth error µm", &Outcome::depth_error_um, 0),
+                 col("electrode used mm", &Outcome::electrode_used_mm),
+                 col("cycle time s", &Outcome::time_s, 1)};
+    s.plot_column = 1;
+    out.push_back(std::move(s));
+  }
+  // B5: die sinking 10 × 10 mm with a forced jump every 1.5 s.
+  {
+    Scenario s;
+    s.id = "B5";
+    s.title =
+        "die sinking 10 × 10 mm, jump every 1.5 s (≈ 1 mm up at 30 mm/s, back to ≈ 0.15 mm above)";
+    RunSpec v;
+    v.config = "config/machines/sink-sim.yaml";
+    v.limit_s = quick ? 15.0 : 45.0;
+    v.jump_period_s = 1.5;
+    RunSpec str = v;
+    str.config = "config/machines/sink-str-sim.yaml";
+    s.variants = {{"voltage servo 45 V (baseline)", v}, {"self-tuning regulator (seed 001)", str}};
+    s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
+                 col("spark %", &Outcome::ratio_normal_pct, 1),
+                 col("transient arc %", &Outcome::ratio_tarc_pct),
+                 col("stable arc %", &Outcome::ratio_sarc_pct),
+                 col("short %", &Outcome::ratio_short_pct),
+                 col("open %", &Outcome::ratio_open_pct, 1),
+                 col("z-jitter µm (mean/cycle)", &Outcome::jitter_um),
+                 col("first 3 cycles µm", &Outcome::jitter_first_um),
+                 col("last 3 cycles µm", &Outcome::jitter_last_um)};
+    s.plot_column = 0;
+    s.plot_jitter = true;
+    out.push_back(std::move(s));
+  }
+  // B6: seed 000's four cases on the wire machine.
+  const double wire_limit = quick ? 20.0 : 60.0;
+  const std::vector<WireCase> cases = {
+      {"B6a", "wire, case 1: improper settings (H = 10 mm, pulse-off time 10 µs)",
+       "wire_thickness_profile: '0:10', default_off_time_us: 10", 30.0, 9.0, 2.0, 0.06, 0.03, 0.42},
+      {"B6b", "wire, case 2: thick work (H = 100 mm)", "wire_thickness_profile: '0:100'", 30.0, 9.0,
+       2.0, 0.06, 0.03, 0.42},
+      {"B6c", "wire, case 3: thickness step 10 → 30 mm at 3 mm of cut",
+       "wire_thickness_profile: '0:10,3:30'", 30.0, 9.0, 2.0, 0.08, 0.16, 0.42},
+      {"B6d", "wire, case 4: internal hole at 3 … 4 mm of cut (H = 10 mm)",
+       "wire_thickness_profile: '0:10', wire_hole_from_mm: 3, wire_hole_to_mm: 4", 30.0, 9.0, 3.0,
+       0.07, 0.14, 0.42},
+  };
+  for (const WireCase& c : cases) {
+    Scenario s;
+    s.id = c.id;
+    s.title = c.title + "; fixed settings " + std::to_string(static_cast<int>(c.servo_ref_v)) +
+              " V / " + std::to_string(static_cast<int>(c.arc_off_us)) + " µs arc-off";
+    s.variants = wire_variants(c, wire_limit);
+    s.columns = {col("wire broken", &Outcome::wire_broken),
+                 col("time to break s", &Outcome::break_time_s, 1),
+                 col("cut speed mm/min", &Outcome::speed_mm_min),
+                 col("short %", &Outcome::short_pct),
+                 col("arc %", &Outcome::arc_pct),
+                 col("Rab mean", &Outcome::rab_mean, 3),
+                 col("Rab err RMS", &Outcome::rab_err_rms, 3),
+                 col("Rab err max", &Outcome::rab_err_max, 3)};
+    s.plot_column = 0;
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace edm::bench

@@ -1,0 +1,83 @@
+// The controller benchmark's runner (apps/bench/controllers): B7 determinism on short runs, and
+// a controller property the benchmark measures.
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstdint>
+#include <string>
+
+#include "controllers/bench.hpp"
+
+namespace edm::bench {
+namespace {
+
+const std::string kRoot = EDM_SOURCE_DIR;
+
+// The scenario's variant by name (fails the test if the scenario list changed).
+RunSpec spec_of(const std::string& id, std::size_t variant, bool quick = true) {
+  for (const Scenario& s : make_scenarios(quick)) {
+    if (s.id == id && variant < s.variants.size()) {
+      return s.variants[variant].spec;
+    }
+  }
+  ADD_FAILURE() << "no scenario " << id << " variant " << variant;
+  return {};
+}
+
+void expect_bitwise_equal(const Outcome& a, const Outcome& b) {
+  const auto fa = a.fields();
+  const auto fb = b.fields();
+  ASSERT_EQ(fa.size(), fb.size());
+  for (std::size_t i = 0; i < fa.size(); ++i) {
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(fa[i].second),
+              std::bit_cast<std::uint64_t>(fb[i].second))
+        << fa[i].first << ": " << fa[i].second << " vs " << fb[i].second;
+  }
+  EXPECT_EQ(a.jitter_per_cycle_um, b.jitter_per_cycle_um);
+}
+
+TEST(ControllerBench, B7SameSeedGivesIdenticalFiguresAnotherSeedDoesNot) {
+  for (const auto& [id, variant] :
+       {std::pair<std::string, std::size_t>{"B1", 0}, {"B5", 1}, {"B6a", 1}}) {
+    SCOPED_TRACE(id);
+    RunSpec spec = spec_of(id, variant);
+    spec.limit_s = 4.0;
+    spec.seed = 11;
+    const Outcome a = run(kRoot, spec);
+    const Outcome b = run(kRoot, spec);
+    expect_bitwise_equal(a, b);
+    EXPECT_GT(a.depth_mm, 0.0) << "the run machined something";
+    spec.seed = 12;
+    const Outcome c = run(kRoot, spec);
+    EXPECT_NE(a.depth_mm, c.depth_mm) << "another seed, other noise";
+  }
+}
+
+}  // namespace
+}  // namespace edm::bench
+
+namespace edm::bench {
+namespace {
+
+// B1 at full depth (30 mm), seed 1: seed 004's P gap controller reaches the depth; a constant
+// feed of 0.75 mm/s (faster than the hole can be eroded once debris slows it past h/d ≈ 15)
+// jams the electrode into the work: most pulses are shorts and the depth is never reached.
+TEST(ControllerBench, B1PGapControllerReachesDepthConstantFeedJamsInShorts) {
+  const auto scenarios = make_scenarios(/*quick=*/false);
+  ASSERT_EQ(scenarios.at(0).id, "B1");
+  RunSpec p = scenarios[0].variants.at(0).spec;
+  RunSpec constant = scenarios[0].variants.at(2).spec;
+  ASSERT_NE(constant.config.find("constant-feed"), std::string::npos);
+  const Outcome op = run(kRoot, p);
+  const Outcome oc = run(kRoot, constant);
+  EXPECT_EQ(op.reached, 1.0);
+  EXPECT_LT(op.time_to_depth_s, 100.0);
+  EXPECT_LT(op.short_pct, 1.0);
+  EXPECT_EQ(oc.reached, 0.0) << "constant feed reached 30 mm in " << oc.time_to_depth_s << " s";
+  EXPECT_GT(oc.short_pct, 50.0);
+  EXPECT_LT(oc.depth_mm, 30.0 - 1.0);
+}
+
+}  // namespace
+}  // namespace edm::bench
