@@ -123,9 +123,10 @@ std::string format_progress(const ProgressView& v, int bar_width) {
 
 std::string format_report(const JobReport& r) {
   std::string out;
+  // The longest label ("wall radius (measured)", 22) still gets two spaces before its value.
   auto row = [&out](std::string_view label, const std::string& value) {
     char buf[48];
-    std::snprintf(buf, sizeof buf, "  %-22s", std::string(label).c_str());
+    std::snprintf(buf, sizeof buf, "  %-24s", std::string(label).c_str());
     out += buf + value + "\n";
   };
   out += "job report: " + r.part + (r.machine.empty() ? "" : " on " + r.machine) + "\n";
