@@ -248,14 +248,21 @@ TEST_F(EdmhmiProcessTest, TraceWritesACsvWithIncreasingTime) {
   ASSERT_TRUE(std::getline(in, line));
   EXPECT_EQ(line, "t_s,cycle,io.z_mm");
   int rows = 0;
-  double last_t = -1.0;
-  long long last_cycle = -1;
+  double last_t = -1.0, first_t = 0.0;
+  long long last_cycle = -1, first_cycle = 0;
   while (std::getline(in, line)) {
     double t = 0.0, z = 0.0;
     long long cycle = 0;
     ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lld,%lf", &t, &cycle, &z), 3) << line;
     ASSERT_GT(t, last_t) << "row " << rows << ": " << line;
     ASSERT_GT(cycle, last_cycle) << "row " << rows << ": " << line;
+    if (rows == 0) {
+      first_t = t;
+      first_cycle = cycle;
+    }
+    // The motion task's releases lie on its 1 ms grid (virtual clock): t_s keeps every digit.
+    ASSERT_NEAR(t - first_t, 0.001 * static_cast<double>(cycle - first_cycle), 1e-9)
+        << "row " << rows << ": " << line;
     last_t = t;
     last_cycle = cycle;
     ++rows;
