@@ -105,6 +105,8 @@ std::string format_progress(const ProgressView& v, int bar_width) {
   } else if (v.blocks > 0) {
     fraction = static_cast<double>(v.block) / static_cast<double>(v.blocks);
   }
+  const bool finished = v.outcome == "finished";  // its end block is the last index, not N
+  if (finished) fraction = 1.0;
   fraction = std::clamp(fraction, 0.0, 1.0);
   const int filled = static_cast<int>(std::lround(fraction * bar_width));
   std::string line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
@@ -115,7 +117,9 @@ std::string format_progress(const ProgressView& v, int bar_width) {
           "/" + std::to_string(v.blocks) + " (line " + std::to_string(v.line) + " " +
           std::string(machining::to_string(v.kind)) + ")  ";
   line += format_duration(v.elapsed_s) + " elapsed";
-  line += "  ETA " + (v.eta_s ? format_duration(*v.eta_s) : std::string("--:--"));
+  line += "  ETA " + (finished  ? format_duration(0.0)
+                      : v.eta_s ? format_duration(*v.eta_s)
+                                : std::string("--:--"));
   line += "  " + v.state;
   if (const auto sf = v.figures.short_fraction()) line += fmt("  short %.2f%%", *sf * 100.0);
   return line;

@@ -51,6 +51,20 @@ TEST_F(EdmhmiProcessTest, RunDrillThenFinishReportsTheFullDepth) {
   const auto status_depth = number_after(s.out, "cnc.job.job_depth_mm");
   ASSERT_TRUE(status_depth) << s.out;
   EXPECT_NEAR(*status_depth, *reached, 1e-3) << s.out;
+
+  // A finished job does not block the next program (no drilling: no depth row).
+  const std::string part = dir_.file("move.nc");
+  std::ofstream(part) << "G90 G00 Z5\nG00 X-10 Y10\nG01 X-12 F120\nM30\n";
+  const Outcome next = edmhmi({"run", "--quiet", part});
+  ASSERT_EQ(next.code, 0) << next.out << next.err;
+  EXPECT_EQ(next.err, "");
+  EXPECT_EQ(row_value(next.out, "outcome"), "finished") << next.out;
+  EXPECT_EQ(row_value(next.out, "depth reached"), "") << next.out;
+  const Outcome s2 = edmhmi({"status"});
+  EXPECT_NE(s2.out.find("job: finished, program #2"), std::string::npos) << s2.out;
+  const auto x = number_after(s2.out, "io.x_mm");
+  ASSERT_TRUE(x) << s2.out;
+  EXPECT_NEAR(*x, -12.0, 0.01) << s2.out;
 }
 
 TEST_F(EdmhmiProcessTest, SigkillMidJobTheJobCompletesAndStatusShowsItFinished) {

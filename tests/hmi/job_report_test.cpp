@@ -247,5 +247,30 @@ TEST(FormatProgress, DrillingBarFollowsTheDepth) {
   EXPECT_NE(line.find("0:20 elapsed  ETA 0:20  RUNNING"), std::string::npos) << line;
 }
 
+TEST(FormatProgress, BlockBarAndAFinishedJobAtHundredPercent) {
+  ProgressView v;
+  v.state = "RUNNING";
+  v.outcome = "running";
+  v.block = 7;
+  v.blocks = 14;
+  v.line = 12;
+  v.kind = MotionKind::kRapid;
+  v.elapsed_s = 42.0;
+  v.eta_s = 42.0;
+  const std::string half = format_progress(v, 10);
+  EXPECT_EQ(half.rfind("[#####.....]  50% block 8/14 (line 12 rapid)  0:42 elapsed  ETA 0:42", 0),
+            0u)
+      << half;
+  // The last status of a finished job sits on its end block (index N-1): the bar is full.
+  v.state = "READY";
+  v.outcome = "finished";
+  v.block = 13;
+  v.kind = MotionKind::kEnd;
+  v.eta_s = 3.0;
+  const std::string done = format_progress(v, 10);
+  EXPECT_EQ(done.rfind("[##########] 100% block 14/14", 0), 0u) << done;
+  EXPECT_NE(done.find("ETA 0:00  READY"), std::string::npos) << done;
+}
+
 }  // namespace
 }  // namespace edm::hmi::test
