@@ -21,6 +21,15 @@ std::map<std::string, std::string>& fake_env() {
   return env;
 }
 
+ConnectionFlags flags(const std::string& host, const std::string& port,
+                      const std::string& token_file) {
+  ConnectionFlags f;
+  f.host = host;
+  f.port = port;
+  f.token_file = token_file;
+  return f;
+}
+
 const char* lookup(const char* name) {
   const auto it = fake_env().find(name);
   return it == fake_env().end() ? nullptr : it->second.c_str();
@@ -77,8 +86,7 @@ TEST_F(ResolveConnection, FlagsWinOverEnvironment) {
                 {"EDM_PORT", "7801"},
                 {"EDM_TOKEN_FILE", env_file},
                 {"EDM_TOKEN", "tok-env"}};
-  const ConnectionSettings s =
-      resolve_connection({.host = "10.0.0.5", .port = "7999", .token_file = flag_file}, lookup);
+  const ConnectionSettings s = resolve_connection(flags("10.0.0.5", "7999", flag_file), lookup);
   EXPECT_EQ(s.host, "10.0.0.5");
   EXPECT_EQ(s.port, 7999);
   EXPECT_EQ(s.token, "tok-flag");
@@ -103,7 +111,7 @@ TEST_F(ResolveConnection, EmptyEnvironmentValuesCountAsUnset) {
 
 TEST_F(ResolveConnection, BadPortIsRefusedNamingWhereItCameFrom) {
   for (const std::string bad : {"0", "65536", "-1", "77x", "x", " 7730", "99999999999"}) {
-    const std::string flag_error = error_of({.port = bad});
+    const std::string flag_error = error_of(flags("", bad, ""));
     EXPECT_NE(flag_error.find("--port: '" + bad + "'"), std::string::npos)
         << bad << ": " << flag_error;
     fake_env() = {{"EDM_PORT", bad}};
@@ -112,13 +120,13 @@ TEST_F(ResolveConnection, BadPortIsRefusedNamingWhereItCameFrom) {
         << bad << ": " << env_error;
     fake_env().clear();
   }
-  EXPECT_EQ(resolve_connection({.port = "1"}, lookup).port, 1);
-  EXPECT_EQ(resolve_connection({.port = "65535"}, lookup).port, 65535);
+  EXPECT_EQ(resolve_connection(flags("", "1", ""), lookup).port, 1);
+  EXPECT_EQ(resolve_connection(flags("", "65535", ""), lookup).port, 65535);
 }
 
 TEST_F(ResolveConnection, BadPortInTheEnvironmentIsIgnoredWhenTheFlagIsGiven) {
   fake_env() = {{"EDM_PORT", "nonsense"}};
-  EXPECT_EQ(resolve_connection({.port = "7001"}, lookup).port, 7001);
+  EXPECT_EQ(resolve_connection(flags("", "7001", ""), lookup).port, 7001);
 }
 
 TEST_F(ResolveConnection, EmptyOrMissingTokenFileIsRefused) {
@@ -126,10 +134,10 @@ TEST_F(ResolveConnection, EmptyOrMissingTokenFileIsRefused) {
   const std::string blank = token_file("blank.token", "   \n\ntoken-on-line-3\n");
   const std::string missing = dir_.file("missing.token");
   for (const std::string& f : {empty, blank}) {
-    const std::string e = error_of({.token_file = f});
+    const std::string e = error_of(flags("", "", f));
     EXPECT_NE(e.find("token file '" + f + "': empty first line"), std::string::npos) << e;
   }
-  EXPECT_NE(error_of({.token_file = missing}).find("token file '" + missing + "': cannot be read"),
+  EXPECT_NE(error_of(flags("", "", missing)).find("token file '" + missing + "': cannot be read"),
             std::string::npos);
   // From the environment too, and a bad $EDM_TOKEN_FILE is not silently replaced by $EDM_TOKEN.
   fake_env() = {{"EDM_TOKEN_FILE", missing}, {"EDM_TOKEN", "tok-env"}};

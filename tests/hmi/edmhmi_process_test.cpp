@@ -25,6 +25,10 @@ TEST_F(EdmhmiProcessTest, RunDrillThenFinishReportsTheFullDepth) {
   // The progress (not a terminal: one line per block) showed the drilling.
   EXPECT_NE(r.err.find("depth "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(" / 15.000 mm"), std::string::npos) << r.err;
+  // The last progress line is the finished job: a full bar.
+  const auto last_line = r.err.rfind('\n', r.err.size() - 2);
+  const std::string last = r.err.substr(last_line == std::string::npos ? 0 : last_line + 1);
+  EXPECT_NE(last.find("] 100% block 15/15 (line 18 end)"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("job report: " + kDrillThenFinish + " on drill-sim\n"), std::string::npos)
       << r.out;
   EXPECT_EQ(row_value(r.out, "outcome"), "finished") << r.out;
@@ -64,7 +68,8 @@ TEST_F(EdmhmiProcessTest, RunDrillThenFinishReportsTheFullDepth) {
   EXPECT_NE(s2.out.find("job: finished, program #2"), std::string::npos) << s2.out;
   const auto x = number_after(s2.out, "io.x_mm");
   ASSERT_TRUE(x) << s2.out;
-  EXPECT_NEAR(*x, -12.0, 0.01) << s2.out;
+  // (The job ends its last move without waiting for the axes to settle: tens of µm remain.)
+  EXPECT_NEAR(*x, -12.0, 0.05) << s2.out;
 }
 
 TEST_F(EdmhmiProcessTest, SigkillMidJobTheJobCompletesAndStatusShowsItFinished) {
