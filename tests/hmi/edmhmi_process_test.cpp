@@ -109,6 +109,25 @@ TEST_F(EdmhmiProcessTest, SigkillMidJobTheJobCompletesAndStatusShowsItFinished) 
   EXPECT_EQ(done, total) << after.out;
 }
 
+TEST_F(EdmhmiProcessTest, InterruptStopsTheJobAndExits130) {
+  start_plc();
+  Proc& run = spawn({"run", kDrillThenFinish});
+  ASSERT_TRUE(poll_until([&] { return run.err().find(" / 15.000 mm") != std::string::npos; }, 30s))
+      << run.err() << run.out();
+  run.signal(SIGINT);  // Ctrl-C: the operator's stop, not an abandonment
+  const auto code = run.wait(30s);
+  ASSERT_TRUE(code) << run.err();
+  EXPECT_EQ(*code, 130) << run.out() << run.err();
+  EXPECT_NE(run.err().find("edmhmi: interrupted: cycle.stop sent"), std::string::npos) << run.err();
+  EXPECT_EQ(row_value(run.out(), "outcome"), "aborted") << run.out();
+  const auto reached = number_after(run.out(), "depth reached");
+  ASSERT_TRUE(reached) << run.out();
+  EXPECT_LT(*reached, kHoleDepthMm - 1.0) << run.out();
+  const Outcome s = edmhmi({"status"});
+  EXPECT_NE(s.out.find("job: aborted, program #1"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("state READY"), std::string::npos) << s.out;
+}
+
 TEST_F(EdmhmiProcessTest, ProgramBeyondTheSoftLimitIsRefusedBeforeAnythingIsSent) {
   start_plc();
   const std::string part = dir_.file("too-far.nc");
