@@ -147,6 +147,10 @@ std::string format_report(const JobReport& r) {
     if (f.depth_mm) depth += fmt(", error %+.4f mm", *f.depth_mm - r.targets.deepest_drill_mm);
     row("depth reached", depth + ")");
     if (f.hole_depth_mm) row("hole depth (measured)", fmt("%.4f mm", *f.hole_depth_mm));
+  } else if (f.depth_mm && *f.depth_mm > 0.0) {
+    // The program is not known (`edmhmi status` after a restart): the machine's figures alone.
+    row("depth reached", fmt("%.4f mm", *f.depth_mm));
+    if (f.hole_depth_mm) row("hole depth (measured)", fmt("%.4f mm", *f.hole_depth_mm));
   }
   if (r.targets.largest_radius_mm > 0.0 && f.wall_radius_mm) {
     row("wall radius (measured)",

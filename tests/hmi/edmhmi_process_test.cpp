@@ -94,11 +94,16 @@ TEST_F(EdmhmiProcessTest, SigkillMidJobTheJobCompletesAndStatusShowsItFinished) 
       << after.out << after.err;
   EXPECT_NE(after.out.find("state READY"), std::string::npos) << after.out;
   EXPECT_EQ(after.out.find("(alarm "), std::string::npos) << after.out;
+  // The report of `status` (the machine's figures) and its variables show the full depth.
+  const auto reached = number_after(after.out, "  depth reached");
+  const auto measured = number_after(after.out, "  hole depth (measured)");
   const auto depth = number_after(after.out, "cnc.job.job_depth_mm");
   const auto hole = number_after(after.out, "io.depth_mm");
-  ASSERT_TRUE(depth && hole) << after.out;
-  EXPECT_NEAR(*depth, kHoleDepthMm, kDepthToleranceMm) << after.out;
-  EXPECT_NEAR(*hole, kHoleDepthMm, kDepthToleranceMm) << after.out;
+  ASSERT_TRUE(reached && measured && depth && hole) << after.out;
+  EXPECT_NEAR(*reached, kHoleDepthMm, kDepthToleranceMm) << after.out;
+  EXPECT_NEAR(*measured, kHoleDepthMm, kDepthToleranceMm) << after.out;
+  EXPECT_NEAR(*depth, *reached, 1e-3) << after.out;
+  EXPECT_NEAR(*hole, *measured, 1e-3) << after.out;
   // Every block ran: "blocks  N of N".
   std::istringstream in(row_value(after.out, "blocks"));
   std::size_t done = 0, total = 0;

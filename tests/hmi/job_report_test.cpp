@@ -224,9 +224,23 @@ TEST(FormatReport, NoDrillingNoDepthRow) {
   JobReport r = sample_report();
   r.targets.deepest_drill_mm = 0.0;
   r.targets.largest_radius_mm = 0.0;
+  r.end.depth_mm = 0.0;
   const std::string text = format_report(r);
   EXPECT_EQ(text.find("depth reached"), std::string::npos) << text;
+  EXPECT_EQ(text.find("hole depth"), std::string::npos) << text;
   EXPECT_EQ(text.find("wall radius"), std::string::npos) << text;
+}
+
+TEST(FormatReport, UnknownProgramStillShowsTheDepthTheMachineReached) {
+  // `edmhmi status` knows the job's figures, not its program.
+  JobReport r = sample_report();
+  r.targets = {};
+  r.targets.blocks = 12;
+  const std::string text = format_report(r);
+  EXPECT_NE(text.find(row("depth reached", "14.9876 mm")), std::string::npos) << text;
+  EXPECT_NE(text.find(row("hole depth (measured)", "14.9912 mm")), std::string::npos) << text;
+  EXPECT_EQ(text.find("program 15"), std::string::npos) << text;
+  EXPECT_EQ(text.find("error"), std::string::npos) << text;
 }
 
 TEST(FormatProgress, DrillingBarFollowsTheDepth) {
