@@ -163,31 +163,41 @@ class EdmhmiProcessTest : public ::testing::Test {
     if (plc_) plc_->kill();
   }
 
-  /// Starts edmplc on `config` and waits until its bridge says hello (deadline, no fixed sleep).
+  /// Starts edmplc on `config` and waits until its bridge listens and says hello (deadline, no
+  /// fixed sleep). Another port is tried when the free one was taken in between.
   void start_plc(const std::string& config = kDrillSim, const std::string& token = "") {
-    port_ = free_port();
-    plc_ = std::make_unique<Proc>(
-        std::vector<std::string>{EDM_EDMPLC_PATH, "--config", config, "--clock", "virtual",
-                                 "--speed", kSpeed, "--bridge-port", std::to_string(port_)},
-        dir_.file("edmplc.out"), dir_.file("edmplc.err"));
-    const bool up = poll_until(
-        [&] {
-          if (plc_->poll()) return true;  // ended: reported below
-          edm::bridge::Client c;
-          edm::bridge::ClientOptions o;
-          o.port = static_cast<std::uint16_t>(port_);
-          o.token = token;
-          o.timeout = 2000ms;
-          try {
-            c.connect(o);
-            return true;
-          } catch (const edm::bridge::ClientError&) {
-            return false;
-          }
-        },
-        20s, 25ms);
-    ASSERT_TRUE(up && !plc_->poll()) << "edmplc did not come up on port " << port_ << "\n"
-                                     << plc_->out() << plc_->err();
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      port_ = free_port();
+      plc_ = std::make_unique<Proc>(
+          std::vector<std::string>{EDM_EDMPLC_PATH, "--config", config, "--clock", "virtual",
+                                   "--speed", kSpeed, "--bridge-port", std::to_string(port_)},
+          dir_.file("edmplc.out"), dir_.file("edmplc.err"));
+      const auto listening = [&] {
+        return (plc_->out() + plc_->err()).find("bridge: listening on") != std::string::npos;
+      };
+      const bool up = poll_until(
+          [&] {
+            if (plc_->poll()) return true;   // ended: retried or reported below
+            if (!listening()) return false;  // (a connect could reach another port's owner)
+            edm::bridge::Client c;
+            edm::bridge::ClientOptions o;
+            o.port = static_cast<std::uint16_t>(port_);
+            o.token = token;
+            o.timeout = 2000ms;
+            try {
+              c.connect(o);
+              return true;
+            } catch (const edm::bridge::ClientError&) {
+              return false;
+            }
+          },
+          20s, 25ms);
+      if (up && !plc_->poll()) return;
+      const std::string log = plc_->out() + plc_->err();
+      if (plc_->poll() && log.find("in use") != std::string::npos) continue;
+      FAIL() << "edmplc did not come up on port " << port_ << "\n" << log;
+    }
+    FAIL() << "edmplc found no free port";
   }
 
   /// The connection flags for the test's edmplc.
