@@ -260,6 +260,22 @@ TEST_F(EdmhmiProcessTest, HoldAndResumeWhenIdleAreInvalidState) {
   }
 }
 
+TEST_F(EdmhmiProcessTest, EstopRefusesRunsUntilReset) {
+  start_plc();
+  const Outcome estop = edmhmi({"estop"});
+  EXPECT_EQ(estop.code, 0) << estop.out << estop.err;
+  EXPECT_NE(estop.out.find("estop: machine ESTOP"), std::string::npos) << estop.out;
+  const Outcome run = edmhmi({"run", kDrillThenFinish});
+  EXPECT_EQ(run.code, 1) << run.out << run.err;
+  EXPECT_NE(run.err.find("edmhmi: the machine is in ESTOP"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("edmhmi reset"), std::string::npos) << run.err;
+  const Outcome s = edmhmi({"status"});
+  EXPECT_NE(s.out.find("job: no program loaded"), std::string::npos) << s.out;
+  const Outcome reset = edmhmi({"reset"});
+  EXPECT_EQ(reset.code, 0) << reset.out << reset.err;
+  EXPECT_NE(reset.out.find("reset: machine READY"), std::string::npos) << reset.out;
+}
+
 TEST_F(EdmhmiProcessTest, WatchPrintsTheRequestedNumberOfSamples) {
   start_plc();
   // The port from the environment this time.
