@@ -145,9 +145,11 @@ int cmd_trace(const Args& args, const edm::hmi::ConnectionSettings& settings) {
         if (!row.is_array() || row.size() != vars.size() + 2) continue;
         std::vector<std::string> cells(names.size());
         for (std::size_t k = 0; k < vars.size(); ++k) {
-          if (column[k] >= 0) cells[static_cast<std::size_t>(column[k])] = value_text(row[k + 2]);
+          if (column[k] >= 0) cells[static_cast<std::size_t>(column[k])] = row[k + 2].dump();
         }
-        csv << value_text(row[0]) << ',' << row[1].dump();
+        // Every digit the machine sent (shortest round trip): %.6g would round t_s to 10 ms
+        // after 1000 s of uptime and to whole seconds after a day.
+        csv << row[0].dump() << ',' << row[1].dump();
         for (const std::string& c : cells) csv << ',' << c;
         csv << '\n';
         ++rows;

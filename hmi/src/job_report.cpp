@@ -105,6 +105,8 @@ std::string format_progress(const ProgressView& v, int bar_width) {
   } else if (v.blocks > 0) {
     fraction = static_cast<double>(v.block) / static_cast<double>(v.blocks);
   }
+  const bool finished = v.outcome == "finished";  // its end block is the last index, not N
+  if (finished) fraction = 1.0;
   fraction = std::clamp(fraction, 0.0, 1.0);
   const int filled = static_cast<int>(std::lround(fraction * bar_width));
   std::string line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
@@ -115,7 +117,9 @@ std::string format_progress(const ProgressView& v, int bar_width) {
           "/" + std::to_string(v.blocks) + " (line " + std::to_string(v.line) + " " +
           std::string(machining::to_string(v.kind)) + ")  ";
   line += format_duration(v.elapsed_s) + " elapsed";
-  line += "  ETA " + (v.eta_s ? format_duration(*v.eta_s) : std::string("--:--"));
+  line += "  ETA " + (finished  ? format_duration(0.0)
+                      : v.eta_s ? format_duration(*v.eta_s)
+                                : std::string("--:--"));
   line += "  " + v.state;
   if (const auto sf = v.figures.short_fraction()) line += fmt("  short %.2f%%", *sf * 100.0);
   return line;
@@ -123,9 +127,10 @@ std::string format_progress(const ProgressView& v, int bar_width) {
 
 std::string format_report(const JobReport& r) {
   std::string out;
+  // The longest label ("wall radius (measured)", 22) still gets two spaces before its value.
   auto row = [&out](std::string_view label, const std::string& value) {
     char buf[48];
-    std::snprintf(buf, sizeof buf, "  %-22s", std::string(label).c_str());
+    std::snprintf(buf, sizeof buf, "  %-24s", std::string(label).c_str());
     out += buf + value + "\n";
   };
   out += "job report: " + r.part + (r.machine.empty() ? "" : " on " + r.machine) + "\n";
@@ -141,6 +146,10 @@ std::string format_report(const JobReport& r) {
     depth += fmt(" (program %.4f mm", r.targets.deepest_drill_mm);
     if (f.depth_mm) depth += fmt(", error %+.4f mm", *f.depth_mm - r.targets.deepest_drill_mm);
     row("depth reached", depth + ")");
+    if (f.hole_depth_mm) row("hole depth (measured)", fmt("%.4f mm", *f.hole_depth_mm));
+  } else if (f.depth_mm && *f.depth_mm > 0.0) {
+    // The program is not known (`edmhmi status` after a restart): the machine's figures alone.
+    row("depth reached", fmt("%.4f mm", *f.depth_mm));
     if (f.hole_depth_mm) row("hole depth (measured)", fmt("%.4f mm", *f.hole_depth_mm));
   }
   if (r.targets.largest_radius_mm > 0.0 && f.wall_radius_mm) {
