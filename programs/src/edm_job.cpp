@@ -204,6 +204,7 @@ void EdmJob::params_changed() noexcept {
 
 void EdmJob::activate_self() noexcept {
   state_value_ = State::kIdle;
+  hold_valid_ = false;
   step_ = Step::kEnter;
   condition_ = nullptr;
   polarity_positive_value_ = false;
@@ -474,10 +475,16 @@ rt::BlockStatus EdmJob::update(const rt::CycleContext& ctx) noexcept {
   }
 
   const rt::MachineState ms = ctx.state;
+  if (rt::is_safe_state(ms)) hold_valid_ = false;  // loops off: follow the axes
   if (state_value_ == State::kIdle) {
-    hold_x_ = x;
-    hold_y_ = y;
-    hold_z_ = z;
+    // Between jobs the loops hold where the last move ended (so its overshoot settles back),
+    // or, after power-on or a safe state, where the axes are.
+    if (!hold_valid_) {
+      hold_x_ = x;
+      hold_y_ = y;
+      hold_z_ = z;
+      hold_valid_ = !rt::is_safe_state(ms);
+    }
     if (ms == rt::MachineState::kRunning && job_->rt_begin()) {
       state_value_ = State::kRun;
       state_.set(1);

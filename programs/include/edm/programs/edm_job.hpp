@@ -158,6 +158,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   State state_value_{State::kIdle};
   Step step_{Step::kEnter};
   double hold_x_{0.0}, hold_y_{0.0}, hold_z_{0.0};  // references while no move is interpolated
+  bool hold_valid_{false};  // hold_* are set (false after activation and in a safe state)
   rt::TimePoint wait_until_{};
   const machining::Condition* condition_{nullptr};
   bool polarity_positive_value_{false};
