@@ -220,8 +220,8 @@ TEST_F(Bridge, ten_thousand_block_program_commits_and_errors_name_the_line) {
 
 TEST_F(Bridge, status_subscription_has_the_rate_and_no_seq_gaps) {
   start();
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  EventSink sink;
   c.set_event_handler(sink.handler());
   c.connect(client_opts());
   const auto t0 = std::chrono::steady_clock::now();
@@ -248,8 +248,8 @@ TEST_F(Bridge, a_stalled_100hz_subscriber_delays_neither_others_nor_the_tasks) {
   slow.send(
       "{\"id\":1,\"op\":\"hello\",\"protocol\":1}\n"
       "{\"id\":2,\"op\":\"subscribe\",\"topics\":[\"status\"],\"rate_hz\":100}\n");
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client good;
-  EventSink sink;
   good.set_event_handler(sink.handler());
   good.connect(client_opts());
   const std::uint64_t cycles0 = rt_->tasks().front()->cycles();
@@ -274,8 +274,8 @@ TEST_F(Bridge, a_stalled_100hz_subscriber_delays_neither_others_nor_the_tasks) {
 
 TEST_F(Bridge, alarms_reach_subscribers_and_the_log_alike) {
   start();
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  EventSink sink;
   c.set_event_handler(sink.handler());
   c.connect(client_opts());
   ASSERT_TRUE(c.subscribe({"alarm"}));
@@ -346,8 +346,8 @@ TEST_F(Bridge, variables_list_read_write_force) {
 
 TEST_F(Bridge, trace_streams_samples_from_its_own_tap) {
   start();
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  EventSink sink;
   c.set_event_handler(sink.handler());
   c.connect(client_opts());
   expect_error(c.trace_start({"nope.x"}), ErrorCode::kNotFound);
@@ -368,8 +368,8 @@ TEST_F(Bridge, trace_streams_samples_from_its_own_tap) {
 
 TEST_F(Bridge, reconnect_replays_the_subscription) {
   start();
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  EventSink sink;
   c.set_event_handler(sink.handler());
   c.connect(client_opts());
   ASSERT_TRUE(c.subscribe({"status"}, 20));
