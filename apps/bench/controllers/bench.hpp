@@ -22,19 +22,22 @@ struct Edit {
 
 /// What to run and what to measure.
 struct RunSpec {
-  std::string config;           // path relative to the source root
-  std::vector<Edit> edits;      // applied in order
-  std::string io_extra;         // extra simulator params, appended after the seed
-  std::uint64_t seed{1};        // replaces the config's `seed: 1` (common random numbers)
-  double limit_s{60.0};         // simulated time limit [s]
-  double target_depth_mm{0.0};  // > 0: time to depth = first io.depth_mm ≥ target − 0.05 mm
-  bool stop_at_depth{false};    // end the run when the depth is reached
-  std::string done_var;         // non-empty: end the run when this variable equals done_value
-  double done_value{4.0};       // DeepHoleDrill's DONE
-  double jump_period_s{0.0};    // > 0: forced jump (io.vz_cmd) every period (B5)
-  double td_ref_us{0.0};        // > 0: RMS(Td − td_ref) over cycles with ignited pulses
-  double rab_ref{0.0};          // > 0: Rab error against this set point (1 s means)
-  double transient_s{0.0};      // Rab error only after this time [s]
+  std::string config;            // path relative to the source root
+  std::vector<Edit> edits;       // applied in order
+  std::string io_extra;          // extra simulator params, appended after the seed
+  std::uint64_t seed{1};         // replaces the config's `seed: 1` (common random numbers)
+  double limit_s{60.0};          // simulated time limit [s]
+  double target_depth_mm{0.0};   // > 0: time to depth = first io.depth_mm ≥ target − 0.05 mm
+  bool stop_at_depth{false};     // end the run when the depth is reached
+  std::string done_var;          // non-empty: end the run when this variable equals done_value
+  double done_value{4.0};        // DeepHoleDrill's DONE
+  double jump_period_s{0.0};     // > 0: forced jump (io.vz_cmd) every period (B5)
+  double td_ref_us{0.0};         // > 0: RMS(Td − td_ref) over cycles with ignited pulses
+  double rab_ref{0.0};           // > 0: Rab error against this set point (1 s means)
+  double transient_s{0.0};       // Rab error only after this time [s]
+  double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
+  double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
+  double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)
 };
 
 /// Outcomes of one run (PLANT-MODEL §5, as far as the simulator exposes them).
@@ -66,6 +69,15 @@ struct Outcome {
   double jitter_um{0.0};        // z-jitter RMS per jump cycle [µm], mean over cycles
   double jitter_first_um{0.0};  // mean of the first 3 cycles
   double jitter_last_um{0.0};   // mean of the last 3 cycles
+  // B4: the 64 wall bins of the simulator at the end.
+  double wall_err_um{0.0};     // mean bin radius − target [µm]
+  double circularity_um{0.0};  // max − min bin radius [µm]
+  double wall_worst_um{0.0};   // the bin farthest from the target, signed [µm]
+  // B3: from the first cycle at the drop depth to the target depth, in 100 ms windows.
+  double recovery_s{0.0};      // drop → first 1 s of windows with ≤ 1 % shorts and progress
+  double peak_short_pct{0.0};  // max short % of a window
+  double peak_arc_pct{0.0};    // max arc % (transient + stable) of a window
+  double stalls{0.0};          // whole seconds after the drop with < 5 µm of true depth gained
   std::vector<double> jitter_per_cycle_um;
 
   /// Every scalar, named (CSV columns; B7 compares them bit for bit).
