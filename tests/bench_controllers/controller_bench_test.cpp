@@ -130,3 +130,27 @@ TEST(ControllerBench, B4CalibratedWallFinishHitsTheRadiusRoundly) {
 
 }  // namespace
 }  // namespace edm::bench
+
+namespace edm::bench {
+namespace {
+
+// B5 (quick, 15 s = 10 jump cycles), seed 1: seed 002's ILC, its cycle driven by the bench's
+// forced jump, holds the z-jitter of the last cycles well below the voltage servo's at a
+// comparable removal rate (issue 7: "z-jitter falls … compared with the P/integral controller").
+TEST(ControllerBench, B5IlcJitterBelowTheVoltageServo) {
+  const auto all = make_scenarios(/*quick=*/true);
+  const Scenario& b5 = scenario(all, "B5");
+  ASSERT_EQ(b5.variants.size(), 3U);
+  ASSERT_NE(b5.variants[2].spec.config.find("sink-ilc"), std::string::npos);
+  const Outcome servo = run(kRoot, b5.variants[0].spec);
+  const Outcome ilc = run(kRoot, b5.variants[2].spec);
+  ASSERT_EQ(ilc.jitter_per_cycle_um.size(), servo.jitter_per_cycle_um.size());
+  EXPECT_LT(ilc.jitter_last_um, 0.5 * servo.jitter_last_um)
+      << "ILC " << ilc.jitter_last_um << " µm, servo " << servo.jitter_last_um << " µm";
+  EXPECT_GT(ilc.jitter_last_um, 0.0) << "the ILC's Z moved within the cycles";
+  EXPECT_GT(ilc.mrr_mm3_min, 0.8 * servo.mrr_mm3_min);
+  EXPECT_LT(ilc.ratio_short_pct, 1.0);
+}
+
+}  // namespace
+}  // namespace edm::bench

@@ -22,19 +22,22 @@ struct Edit {
 
 /// What to run and what to measure.
 struct RunSpec {
-  std::string config;            // path relative to the source root
-  std::vector<Edit> edits;       // applied in order
-  std::string io_extra;          // extra simulator params, appended after the seed
-  std::uint64_t seed{1};         // replaces the config's `seed: 1` (common random numbers)
-  double limit_s{60.0};          // simulated time limit [s]
-  double target_depth_mm{0.0};   // > 0: time to depth = first io.depth_mm ≥ target − 0.05 mm
-  bool stop_at_depth{false};     // end the run when the depth is reached
-  std::string done_var;          // non-empty: end the run when this variable equals done_value
-  double done_value{4.0};        // DeepHoleDrill's DONE
-  double jump_period_s{0.0};     // > 0: forced jump (io.vz_cmd) every period (B5)
-  double td_ref_us{0.0};         // > 0: RMS(Td − td_ref) over cycles with ignited pulses
-  double rab_ref{0.0};           // > 0: Rab error against this set point (1 s means)
-  double transient_s{0.0};       // Rab error only after this time [s]
+  std::string config;           // path relative to the source root
+  std::vector<Edit> edits;      // applied in order
+  std::string io_extra;         // extra simulator params, appended after the seed
+  std::uint64_t seed{1};        // replaces the config's `seed: 1` (common random numbers)
+  double limit_s{60.0};         // simulated time limit [s]
+  double target_depth_mm{0.0};  // > 0: time to depth = first io.depth_mm ≥ target − 0.05 mm
+  bool stop_at_depth{false};    // end the run when the depth is reached
+  std::string done_var;         // non-empty: end the run when this variable equals done_value
+  double done_value{4.0};       // DeepHoleDrill's DONE
+  double jump_period_s{0.0};    // > 0: forced jump (io.vz_cmd) every period (B5)
+  double td_ref_us{0.0};        // > 0: RMS(Td − td_ref) over cycles with ignited pulses
+  double rab_ref{0.0};          // > 0: Rab error against this set point (1 s means)
+  double transient_s{0.0};      // Rab error only after this time [s]
+  std::string jump_cycle_var;   // non-empty (B5 ILC): forced 1 for the first ms of each jump
+  std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
+  double jump_hold_value{0.0};
   double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
   double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
   double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)

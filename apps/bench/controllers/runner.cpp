@@ -233,14 +233,29 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     // Jumps: forced up, forced back down short of the start, then the servo closes the gap.
     if (period_ms > 0 && k > period_ms) {
       const std::int64_t phase = (k - 1) % period_ms;
+      auto force = [&](const std::string& name, double value) {
+        if (name.empty()) {
+          return;
+        }
+        if (const rt::VarStatus st = vars.force(name, value); !st) {
+          throw std::runtime_error(spec.config + ": cannot force '" + name + "': " + st.message);
+        }
+      };
       if (phase == 0) {
         o.jitter_per_cycle_um.push_back(fit.rms_residual() * 1000.0);
         fit = LineFit{};
         vars.force("io.vz_cmd", 30.0);
+        force(spec.jump_cycle_var, 1.0);
+        force(spec.jump_hold_var, spec.jump_hold_value);
+      } else if (phase == 1) {
+        force(spec.jump_cycle_var, 0.0);
       } else if (phase == kJumpUpMs) {
         vars.force("io.vz_cmd", -30.0);
       } else if (phase == kJumpUpMs + kJumpDownMs) {
         vars.unforce("io.vz_cmd");
+        if (!spec.jump_hold_var.empty()) {
+          vars.unforce(spec.jump_hold_var);
+        }
       }
     }
     sched.run_until(rt::TimePoint{1ms * k});

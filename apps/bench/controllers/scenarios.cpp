@@ -202,7 +202,14 @@ std::vector<Scenario> make_scenarios(bool quick) {
     v.jump_period_s = 1.5;
     RunSpec str = v;
     str.config = "config/machines/sink-str-sim.yaml";
-    s.variants = {{"voltage servo 45 V (baseline)", v}, {"self-tuning regulator (seed 001)", str}};
+    RunSpec ilc = v;
+    ilc.config = "config/bench/controllers/sink-ilc.yaml";
+    ilc.jump_cycle_var = "gap.ilc.cycle_start";
+    ilc.jump_hold_var = "gap.ilc.y";
+    ilc.jump_hold_value = 45.0;
+    s.variants = {{"voltage servo 45 V (baseline)", v},
+                  {"self-tuning regulator (seed 001)", str},
+                  {"iterative learning control (seed 002)", ilc}};
     s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
                  col("spark %", &Outcome::ratio_normal_pct, 1),
                  col("transient arc %", &Outcome::ratio_tarc_pct),
