@@ -171,8 +171,8 @@ std::vector<Scenario> make_scenarios(bool quick) {
     w.done_value = 4.0;
     w.wall_growth_mm = 0.05;
     // As shipped, kr·Tdm (Tdm ≈ 50 µs) is above dr_max every revolution: a fixed 2 µm step
-    // (kr 1 gave identical figures on seeds 1-2). kr 2e-5 keeps dr = kr·Tdm ≈ 1 µm below dr_max, so the
-    // step follows Tdm; the coarse fixed step is 10 µm per revolution.
+    // (kr 1 gave identical figures on seeds 1-2). kr 2e-5 keeps dr = kr·Tdm ≈ 1 µm below dr_max, so
+    // the step follows Tdm; the coarse fixed step is 10 µm per revolution.
     RunSpec adaptive = w;
     adaptive.edits = {{"kr: 0.0001,", "kr: 0.00002,"}};
     RunSpec coarse = w;
