@@ -23,6 +23,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "controllers/bench.hpp"
@@ -156,14 +157,16 @@ int main(int argc, char** argv) {
   if (only.empty() || only.find(",B7,") != std::string::npos) {
     md << "**B7** determinism: the same seed twice\n\n| run | identical |\n|---|---|\n";
     const auto b7 = edm::bench::make_scenarios(true);
-    const std::size_t picks[][2] = {{0, 0}, {2, 1}, {3, 1}};  // B1 P, B5 STR, B6a fuzzy + grey
-    for (const auto& [si, vi] : picks) {
-      edm::bench::RunSpec spec = b7[si].variants[vi].spec;
+    const std::pair<const char*, std::size_t> picks[] = {
+        {"B1", 0}, {"B5", 1}, {"B5", 2}, {"B6a", 1}};  // B1 P, B5 STR and ILC, B6a fuzzy + grey
+    for (const auto& [id, vi] : picks) {
+      const auto it = std::find_if(b7.begin(), b7.end(), [&](const auto& s) { return s.id == id; });
+      edm::bench::RunSpec spec = it->variants.at(vi).spec;
       spec.seed = 7;
       spec.limit_s = std::min(spec.limit_s, 10.0);
       const bool same = identical(edm::bench::run(root, spec), edm::bench::run(root, spec));
       b7_ok = b7_ok && same;
-      md << "| " << b7[si].id << " " << b7[si].variants[vi].name << ", seed 7, 10 s | "
+      md << "| " << it->id << " " << it->variants[vi].name << ", seed 7, 10 s | "
          << (same ? "yes" : "NO") << " |\n";
     }
     md << '\n';

@@ -35,6 +35,12 @@ struct RunSpec {
   double td_ref_us{0.0};        // > 0: RMS(Td − td_ref) over cycles with ignited pulses
   double rab_ref{0.0};          // > 0: Rab error against this set point (1 s means)
   double transient_s{0.0};      // Rab error only after this time [s]
+  std::string jump_cycle_var;   // non-empty (B5 ILC): forced 1 for the first ms of each jump
+  std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
+  double jump_hold_value{0.0};
+  double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
+  double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
+  double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)
 };
 
 /// Outcomes of one run (PLANT-MODEL §5, as far as the simulator exposes them).
@@ -66,6 +72,15 @@ struct Outcome {
   double jitter_um{0.0};        // z-jitter RMS per jump cycle [µm], mean over cycles
   double jitter_first_um{0.0};  // mean of the first 3 cycles
   double jitter_last_um{0.0};   // mean of the last 3 cycles
+  // B4: the 64 wall bins of the simulator at the end.
+  double wall_err_um{0.0};     // mean bin radius − target [µm]
+  double circularity_um{0.0};  // max − min bin radius [µm]
+  double wall_worst_um{0.0};   // the bin farthest from the target, signed [µm]
+  // B3: from the first cycle at the drop depth to the target depth, in 100 ms windows.
+  double recovery_s{0.0};      // drop → first 1 s of windows with ≤ 1 % shorts and progress
+  double peak_short_pct{0.0};  // max short % of a window
+  double peak_arc_pct{0.0};    // max arc % (transient + stable) of a window
+  double stalls{0.0};          // whole seconds after the drop with < 5 µm of true depth gained
   std::vector<double> jitter_per_cycle_um;
 
   /// Every scalar, named (CSV columns; B7 compares them bit for bit).

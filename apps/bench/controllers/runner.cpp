@@ -19,6 +19,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/scheduler.hpp"
+#include "edm/sim/plant.hpp"
 #include "edm/sim/sim_driver.hpp"
 
 namespace edm::bench {
@@ -122,7 +123,14 @@ std::vector<std::pair<const char*, double>> Outcome::fields() const {
           {"ratio_open_pct", ratio_open_pct},
           {"jitter_um", jitter_um},
           {"jitter_first_um", jitter_first_um},
-          {"jitter_last_um", jitter_last_um}};
+          {"jitter_last_um", jitter_last_um},
+          {"wall_err_um", wall_err_um},
+          {"circularity_um", circularity_um},
+          {"wall_worst_um", wall_worst_um},
+          {"recovery_s", recovery_s},
+          {"peak_short_pct", peak_short_pct},
+          {"peak_arc_pct", peak_arc_pct},
+          {"stalls", stalls}};
 }
 
 std::pair<double, double> mean_sd(const std::vector<double>& v) {
@@ -182,6 +190,30 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   const bool has_done = !spec.done_var.empty();
   const rt::PinRef done = has_done ? pin(spec.done_var) : rt::PinRef{};
 
+  const sim::Plant* plant = nullptr;
+  double wall_target_mm = 0.0;
+  if (spec.wall_growth_mm > 0) {
+    auto* drv = dynamic_cast<sim::SimDriver*>(&r->driver());
+    if (drv == nullptr) {
+      throw std::runtime_error(spec.config + ": B4 needs the sim driver");
+    }
+    plant = &drv->plant();
+    double s0 = 0;
+    for (std::size_t j = 0; j < sim::Plant::kWallBins; ++j) {
+      s0 += plant->wall_bin_radius_mm(j);
+    }
+    wall_target_mm = s0 / static_cast<double>(sim::Plant::kWallBins) + spec.wall_growth_mm;
+  }
+  // B3: 100 ms windows from the drop on: short %, arc %, true depth gained [mm].
+  struct Window {
+    double short_pct, arc_pct, gained_mm;
+  };
+  std::vector<Window> windows;
+  bool dropped = false;
+  double win_pulses[3] = {0, 0, 0};  // all, shorts, arcs
+  int win_n = 0;
+  double win_d0 = 0;
+
   rt::VirtualClock clock;
   rt::VirtualScheduler sched(tasks, clock);
   Outcome o;
@@ -201,14 +233,29 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     // Jumps: forced up, forced back down short of the start, then the servo closes the gap.
     if (period_ms > 0 && k > period_ms) {
       const std::int64_t phase = (k - 1) % period_ms;
+      auto force = [&](const std::string& name, double value) {
+        if (name.empty()) {
+          return;
+        }
+        if (const rt::VarStatus st = vars.force(name, value); !st) {
+          throw std::runtime_error(spec.config + ": cannot force '" + name + "': " + st.message);
+        }
+      };
       if (phase == 0) {
         o.jitter_per_cycle_um.push_back(fit.rms_residual() * 1000.0);
         fit = LineFit{};
         vars.force("io.vz_cmd", 30.0);
+        force(spec.jump_cycle_var, 1.0);
+        force(spec.jump_hold_var, spec.jump_hold_value);
+      } else if (phase == 1) {
+        force(spec.jump_cycle_var, 0.0);
       } else if (phase == kJumpUpMs) {
         vars.force("io.vz_cmd", -30.0);
       } else if (phase == kJumpUpMs + kJumpDownMs) {
         vars.unforce("io.vz_cmd");
+        if (!spec.jump_hold_var.empty()) {
+          vars.unforce(spec.jump_hold_var);
+        }
       }
     }
     sched.run_until(rt::TimePoint{1ms * k});
@@ -261,6 +308,26 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
         rab_sec = rab_sec_n = 0;
       }
     }
+    const bool cutting = !has_done || spec.window_end_state <= 0 ||
+                         rt::read_pin_as_double(done) < spec.window_end_state;
+    if (spec.flush_drop_mm > 0 && !reached && cutting) {
+      if (!dropped && d >= spec.flush_drop_mm) {
+        dropped = true;
+        win_d0 = d;
+      }
+      if (dropped) {
+        win_pulses[0] += c[0] + c[1] + c[2] + c[3] + c[4];
+        win_pulses[1] += c[4];
+        win_pulses[2] += c[2] + c[3];
+        if (++win_n == 100) {
+          const double all = std::max(1.0, win_pulses[0]);
+          windows.push_back({100.0 * win_pulses[1] / all, 100.0 * win_pulses[2] / all, d - win_d0});
+          win_pulses[0] = win_pulses[1] = win_pulses[2] = 0;
+          win_n = 0;
+          win_d0 = d;
+        }
+      }
+    }
     if (spec.target_depth_mm > 0 && !reached && d >= spec.target_depth_mm - 0.05) {
       reached = true;
       o.time_to_depth_s = t_s;
@@ -304,6 +371,43 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   }
   o.rab_mean = rab_n > 0 ? rab_sum / rab_n : 0.0;
   o.rab_err_rms = rab_err_n > 0 ? std::sqrt(rab_err_ss / rab_err_n) : 0.0;
+  if (plant != nullptr) {
+    double sum = 0, lo = 1e9, hi = -1e9;
+    for (std::size_t j = 0; j < sim::Plant::kWallBins; ++j) {
+      const double x = plant->wall_bin_radius_mm(j);
+      sum += x;
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+    o.wall_err_um = (sum / static_cast<double>(sim::Plant::kWallBins) - wall_target_mm) * 1000.0;
+    o.circularity_um = (hi - lo) * 1000.0;
+    const double e_lo = (lo - wall_target_mm) * 1000.0, e_hi = (hi - wall_target_mm) * 1000.0;
+    o.wall_worst_um = std::abs(e_lo) > std::abs(e_hi) ? e_lo : e_hi;
+  }
+  if (spec.flush_drop_mm > 0) {
+    constexpr std::size_t kSettled = 10;  // 1 s of 100 ms windows
+    std::size_t ok_run = 0;
+    o.recovery_s = -1.0;
+    for (std::size_t i = 0; i < windows.size(); ++i) {
+      const Window& w = windows[i];
+      o.peak_short_pct = std::max(o.peak_short_pct, w.short_pct);
+      o.peak_arc_pct = std::max(o.peak_arc_pct, w.arc_pct);
+      ok_run = w.short_pct <= 1.0 && w.gained_mm > 0 ? ok_run + 1 : 0;
+      if (ok_run == kSettled && o.recovery_s < 0) {
+        o.recovery_s = static_cast<double>(i + 1 - kSettled) * 0.1;
+      }
+    }
+    if (o.recovery_s < 0) {  // never settled: the whole time after the drop
+      o.recovery_s = static_cast<double>(windows.size()) * 0.1;
+    }
+    for (std::size_t i = 0; i + kSettled <= windows.size(); i += kSettled) {
+      double gained = 0;
+      for (std::size_t m = i; m < i + kSettled; ++m) {
+        gained += windows[m].gained_mm;
+      }
+      o.stalls += gained < 0.005 ? 1.0 : 0.0;
+    }
+  }
   const auto& j = o.jitter_per_cycle_um;
   o.jitter_um = mean_of(j, 0, j.size());
   o.jitter_first_um = mean_of(j, 0, std::min<std::size_t>(3, j.size()));

@@ -119,6 +119,77 @@ std::vector<Scenario> make_scenarios(bool quick) {
     s.plot_column = 1;
     out.push_back(std::move(s));
   }
+  // B3: B1's drilling with the flushing factor dropped to 0.3 from half the depth on.
+  {
+    Scenario s;
+    s.id = "B3";
+    const double drop = depth / 2.0;
+    const std::string drop_s = quick ? "5" : "15";
+    s.title = "B1 with flushing × 0.3 from " + drop_s + " mm (flush_drop_depth_mm " + drop_s +
+              ", flush_drop_factor 0.3), " + depth_s + " mm";
+    const std::string extra = "flush_drop_depth_mm: " + drop_s + ", flush_drop_factor: 0.3";
+    RunSpec p;
+    p.config = "config/bench/controllers/drill-p.yaml";
+    p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
+    p.io_extra = extra;
+    p.limit_s = drill_limit;
+    p.target_depth_mm = depth;
+    p.done_var = "cycle.drill.state";
+    p.flush_drop_mm = drop;
+    p.window_end_state = 3.0;  // DeepHoleDrill's RETRACT: the drilling is over
+    RunSpec lut = p;
+    lut.config = "config/bench/controllers/drill-fuzzy-lut.yaml";
+    lut.edits.clear();
+    lut.done_var.clear();
+    lut.stop_at_depth = true;
+    s.variants = {{"P gap controller on Td (seed 004)", p},
+                  {"fuzzy LUT servo on open/short counts (seed 003)", lut}};
+    s.columns = {col("done / reached", &Outcome::reached),
+                 col("true depth mm", &Outcome::depth_mm),
+                 col("time s", &Outcome::time_s, 1),
+                 col("recovery s", &Outcome::recovery_s, 1),
+                 col("peak short % (100 ms)", &Outcome::peak_short_pct, 1),
+                 col("peak arc % (100 ms)", &Outcome::peak_arc_pct, 1),
+                 col("stalls", &Outcome::stalls, 1),
+                 col("short %", &Outcome::short_pct),
+                 col("arc %", &Outcome::arc_pct),
+                 col("retracts", &Outcome::retracts, 0)};
+    s.plot_column = 2;
+    out.push_back(std::move(s));
+  }
+  // B4: orbit finish of a hole wall (+0.05 mm of radius) by WallFinish, eq. 20-21.
+  {
+    Scenario s;
+    s.id = "B4";
+    s.title =
+        "orbit finish of the Ø1.1 mm hole wall by +0.05 mm (drill preset hole 2 mm deep, tube "
+        "Ø1.0, positive polarity)";
+    RunSpec w;
+    w.config = "config/bench/controllers/finish-wall.yaml";
+    w.limit_s = 120.0;
+    w.done_var = "cycle.finish.state";
+    w.done_value = 4.0;
+    w.wall_growth_mm = 0.05;
+    // As shipped, kr·Tdm (Tdm ≈ 50 µs) is above dr_max every revolution: a fixed 2 µm step
+    // (kr 1 gave identical figures on seeds 1-2). kr 2e-5 keeps dr = kr·Tdm ≈ 1 µm below dr_max, so
+    // the step follows Tdm; the coarse fixed step is 10 µm per revolution.
+    RunSpec adaptive = w;
+    adaptive.edits = {{"kr: 0.0001,", "kr: 0.00002,"}};
+    RunSpec coarse = w;
+    coarse.edits = {{"kr: 0.0001, dr_max_mm: 0.002", "kr: 1.0, dr_max_mm: 0.01"}};
+    s.variants = {{"WallFinish as shipped (kr 1e-4 mm/µs, dr_max 2 µm: 2 µm/rev)", w},
+                  {"WallFinish, kr 2e-5 (dr = kr·Tdm ≈ 1 µm/rev)", adaptive},
+                  {"fixed coarse step (kr 1, dr_max 10 µm: 10 µm/rev)", coarse}};
+    s.columns = {col("done", &Outcome::reached),
+                 col("radius error µm", &Outcome::wall_err_um, 1),
+                 col("circularity µm", &Outcome::circularity_um, 1),
+                 col("worst bin µm", &Outcome::wall_worst_um, 1),
+                 col("finish time s", &Outcome::time_s, 1),
+                 col("short %", &Outcome::short_pct),
+                 col("arc %", &Outcome::arc_pct)};
+    s.plot_column = 1;
+    out.push_back(std::move(s));
+  }
   // B5: die sinking 10 × 10 mm with a forced jump every 1.5 s.
   {
     Scenario s;
@@ -131,7 +202,14 @@ std::vector<Scenario> make_scenarios(bool quick) {
     v.jump_period_s = 1.5;
     RunSpec str = v;
     str.config = "config/machines/sink-str-sim.yaml";
-    s.variants = {{"voltage servo 45 V (baseline)", v}, {"self-tuning regulator (seed 001)", str}};
+    RunSpec ilc = v;
+    ilc.config = "config/bench/controllers/sink-ilc.yaml";
+    ilc.jump_cycle_var = "gap.ilc.cycle_start";
+    ilc.jump_hold_var = "gap.ilc.y";
+    ilc.jump_hold_value = 45.0;
+    s.variants = {{"voltage servo 45 V (baseline)", v},
+                  {"self-tuning regulator (seed 001)", str},
+                  {"iterative learning control (seed 002)", ilc}};
     s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
                  col("spark %", &Outcome::ratio_normal_pct, 1),
                  col("transient arc %", &Outcome::ratio_tarc_pct),
