@@ -1,0 +1,243 @@
+// edm-greyhorizon — redoes seed 000's choice of the grey predictor's horizon p for each
+// Butterworth cut-off (Lee & Liao 2003, Table 2) on Rab recorded from the wire simulator.
+// Records io.rab every 40 ms (the paper's sampling period) from config/machines/wire-sim.yaml on
+// the virtual clock, then for each Wn picks p by RMS error against the 50-step moving average
+// shifted 25 steps (apps/greyhorizon/horizon.hpp). Same seed → same table.
+// Exit codes: 0 ok, 1 the run failed (wire broken, config error), 2 bad arguments.
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "edm/blocks/register.hpp"
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/loopback_driver.hpp"
+#include "edm/runtime/runtime.hpp"
+#include "edm/runtime/scheduler.hpp"
+#include "edm/sim/sim_driver.hpp"
+#include "horizon.hpp"
+
+namespace {
+
+using namespace std::chrono_literals;
+namespace gh = edm::greyhorizon;
+namespace rt = edm::rt;
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailed = 1;
+constexpr int kExitBadInput = 2;
+constexpr std::int64_t kSampleMs = 40;  // the paper's sampling period of Rab
+
+// Table 2 of the paper: Wn (fraction of Nyquist) and the chosen horizon p.
+constexpr std::pair<double, int> kPaperTable[] = {{0.010, 46}, {0.012, 37}, {0.015, 27},
+                                                  {0.020, 17}, {0.030, 6},  {0.050, 1}};
+
+constexpr const char* kUsage =
+    "usage: edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--csv PATH]\n"
+    "                       [--max-p P] [--window n] [--warmup W]\n"
+    "  --seed     simulator seed (default 1)\n"
+    "  --samples  Rab samples at 40 ms (default 3000 = 120 s)\n"
+    "  --skip-s   simulated seconds before the record starts (default 2)\n"
+    "  --config   wire machine config (default <source>/config/machines/wire-sim.yaml)\n"
+    "  --csv      also write the RMS error for every Wn and p to PATH\n"
+    "  --raw      also write the recorded Rab (one sample a line) to PATH\n"
+    "  --max-p    largest horizon tried (default 60)\n"
+    "  --window   GM(1,1) window n (default 5, as the block)\n"
+    "  --warmup   samples not scored at the start (default 300)\n";
+
+int bad(const std::string& msg) {
+  std::fprintf(stderr, "edm-greyhorizon: %s\n%s", msg.c_str(), kUsage);
+  return kExitBadInput;
+}
+
+std::optional<std::int64_t> parse_int(std::string_view text) {
+  const std::string s(text);
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const long long v = std::strtoll(s.c_str(), &end, 10);
+  if (end != s.c_str() + s.size()) return std::nullopt;
+  return static_cast<std::int64_t>(v);
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw std::runtime_error(path + ": cannot read");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Rab every 40 ms from the wire simulator, after skip_ms of cutting.
+std::vector<double> record_rab(const std::string& config_path, std::int64_t seed,
+                               std::size_t samples, std::int64_t skip_ms) {
+  std::string text = slurp(config_path);
+  const std::string from = "seed: 1}";
+  const auto at = text.find(from);
+  if (at == std::string::npos) {
+    throw std::runtime_error(config_path + ": no 'seed: 1}' in the io params to replace");
+  }
+  text.replace(at, from.size(), "seed: " + std::to_string(seed) + "}");
+
+  rt::BlockRegistry blocks;
+  rt::DriverRegistry drivers;
+  edm::blocks::register_builtin_blocks(blocks);
+  rt::register_runtime_drivers(drivers);
+  edm::sim::register_sim_driver(drivers);
+  rt::BuildOptions options;
+  options.load_retain = false;
+  auto r = rt::Runtime::build(rt::parse_config_text(text, config_path), blocks, drivers, options);
+  std::vector<rt::Task*> tasks;
+  for (const auto& t : r->tasks()) {
+    t->detach_trace();
+    tasks.push_back(t.get());
+  }
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  auto pin = [&](const std::string& name) {
+    const rt::Variable* v = r->variables().find(name);
+    if (v == nullptr || !v->is_pin()) {
+      throw std::runtime_error(config_path + ": no pin '" + name + "'");
+    }
+    return v->pin;
+  };
+  const rt::PinRef rab = pin("io.rab");
+  const rt::PinRef broken = pin("io.wire_broken");
+
+  rt::VirtualClock clock;
+  rt::VirtualScheduler sched(tasks, clock);
+  std::vector<double> x;
+  x.reserve(samples);
+  const std::int64_t end_ms = skip_ms + static_cast<std::int64_t>(samples) * kSampleMs;
+  for (std::int64_t k = 1; k <= end_ms; ++k) {
+    sched.run_until(rt::TimePoint{1ms * k});
+    if (k > skip_ms && (k - skip_ms) % kSampleMs == 0) {
+      if (rt::read_pin_as_double(broken) != 0.0) {
+        throw std::runtime_error("the wire broke at t = " + std::to_string(k) +
+                                 " ms: the record would be dead");
+      }
+      x.push_back(rt::read_pin_as_double(rab));
+    }
+  }
+  return x;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::int64_t seed = 1;
+  std::int64_t samples = 3000;
+  std::int64_t skip_s = 2;
+  std::int64_t max_p = 60;
+  std::int64_t window = 5;
+  std::int64_t warmup = 300;
+  std::string config = std::string(EDM_SOURCE_DIR) + "/config/machines/wire-sim.yaml";
+  std::string csv;
+  std::string raw;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return kExitOk;
+    }
+    if (i + 1 >= argc) return bad(std::string(a) + ": missing value");
+    const std::string_view v = argv[++i];
+    auto as_int = [&](std::int64_t& out, std::int64_t lo, std::int64_t hi) {
+      const auto n = parse_int(v);
+      if (!n || *n < lo || *n > hi) return false;
+      out = *n;
+      return true;
+    };
+    bool ok = true;
+    if (a == "--seed") {
+      ok = as_int(seed, 0, INT64_MAX);
+    } else if (a == "--samples") {
+      ok = as_int(samples, 1, 10'000'000);
+    } else if (a == "--skip-s") {
+      ok = as_int(skip_s, 0, 100'000);
+    } else if (a == "--max-p") {
+      ok = as_int(max_p, 0, 10'000);
+    } else if (a == "--window") {
+      ok = as_int(window, 4, 1024);
+    } else if (a == "--warmup") {
+      ok = as_int(warmup, 0, 10'000'000);
+    } else if (a == "--config") {
+      config = v;
+    } else if (a == "--csv") {
+      csv = v;
+    } else if (a == "--raw") {
+      raw = v;
+    } else {
+      return bad("unknown option " + std::string(a));
+    }
+    if (!ok) return bad("bad value for " + std::string(a) + ": " + std::string(v));
+  }
+
+  gh::HorizonOptions opt;
+  opt.max_horizon = static_cast<std::size_t>(max_p);
+  opt.window = static_cast<std::size_t>(window);
+  opt.warmup = static_cast<std::size_t>(warmup);
+  try {
+    const std::vector<double> x =
+        record_rab(config, seed, static_cast<std::size_t>(samples), skip_s * 1000);
+    double mean = 0;
+    for (double v : x) mean += v;
+    mean /= static_cast<double>(x.size());
+    double var = 0;
+    for (double v : x) var += (v - mean) * (v - mean);
+    const double sd = std::sqrt(var / static_cast<double>(x.size()));
+    std::printf("Rab from %s, seed %lld: %zu samples at %lld ms, mean %.3f, SD %.3f\n",
+                config.c_str(), static_cast<long long>(seed), x.size(),
+                static_cast<long long>(kSampleMs), mean, sd);
+    std::printf(
+        "GM(1,1) window %zu, p = 0..%zu, objective: %zu-step moving average shifted %zu, "
+        "scored after %zu samples\n\n",
+        opt.window, opt.max_horizon, opt.ma_length, opt.ma_shift, opt.warmup);
+    std::printf(
+        "| Wn | p (ours) | RMS at p | RMS at p = 0 | RMS at paper's p | p (paper) | "
+        "filter DC delay |\n|---|---|---|---|---|---|---|\n");
+    std::vector<gh::HorizonResult> results;
+    for (const auto& [wn, paper_p] : kPaperTable) {
+      gh::HorizonResult res = gh::choose_horizon(x, wn, opt);
+      const auto pp = static_cast<std::size_t>(paper_p);
+      const double at_paper = pp < res.rms.size() ? res.rms[pp] : std::nan("");
+      std::printf("| %.3f | %zu | %.4f | %.4f | %.4f | %d | %.1f |\n", wn, res.best_p, res.best_rms,
+                  res.rms[0], at_paper, paper_p, gh::butterworth_dc_delay(wn));
+      results.push_back(std::move(res));
+    }
+    if (!csv.empty()) {
+      std::ofstream out(csv);
+      if (!out) throw std::runtime_error(csv + ": cannot write");
+      out << "p";
+      for (const auto& res : results) out << ",rms_wn_" << res.wn;
+      out << "\n";
+      for (std::size_t p = 0; p <= opt.max_horizon; ++p) {
+        out << p;
+        for (const auto& res : results) out << "," << res.rms[p];
+        out << "\n";
+      }
+    }
+    if (!raw.empty()) {
+      std::ofstream out(raw);
+      if (!out) throw std::runtime_error(raw + ": cannot write");
+      for (double v : x) out << v << "\n";
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "edm-greyhorizon: %s\n", e.what());
+    return kExitFailed;
+  }
+  return kExitOk;
+}

@@ -1,0 +1,97 @@
+// The offline horizon choice of seed 000 (apps/greyhorizon/horizon.hpp) on synthetic signals
+// whose answer is known analytically.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+#include <vector>
+
+#include "edm/blocks/butterworth_low_pass.hpp"
+#include "horizon.hpp"
+
+namespace gh = edm::greyhorizon;
+
+namespace {
+
+constexpr double kPaperWn[] = {0.010, 0.012, 0.015, 0.020, 0.030, 0.050};
+
+std::vector<double> ramp(std::size_t n, double a, double s) {
+  std::vector<double> x(n);
+  for (std::size_t k = 0; k < n; ++k) x[k] = a + s * static_cast<double>(k);
+  return x;
+}
+
+}  // namespace
+
+TEST(GreyHorizon, DcDelayFormulaMatchesTheDesignedCoefficients) {
+  // τ = Σn·b_n/Σb_n − Σn·a_n/Σa_n for the designed H(z), against 1/(√2·tan(πWn/2)).
+  for (double wn : kPaperWn) {
+    const auto c = edm::blocks::ButterworthLowPass::design(wn);
+    const double num = (c.b1 + 2 * c.b2) / (c.b0 + c.b1 + c.b2);
+    const double den = (c.a1 + 2 * c.a2) / (1 + c.a1 + c.a2);
+    EXPECT_NEAR(num - den, gh::butterworth_dc_delay(wn), 1e-6 * gh::butterworth_dc_delay(wn))
+        << "Wn " << wn;
+  }
+  EXPECT_NEAR(gh::butterworth_dc_delay(0.012), 37.5, 0.1);  // the paper's p = 37 at 0.012
+}
+
+TEST(GreyHorizon, FilterLagsARampByItsDcDelay) {
+  const auto x = ramp(3000, 0.3, 1e-4);
+  for (double wn : kPaperWn) {
+    const auto f = gh::butterworth_filter(x, wn);
+    const double lag = (x[2999] - f[2999]) / 1e-4;
+    EXPECT_NEAR(lag, gh::butterworth_dc_delay(wn), 1e-3) << "Wn " << wn;
+  }
+}
+
+TEST(GreyHorizon, ShiftedMovingAverageIsCentred) {
+  const auto x = ramp(200, 0.0, 1.0);
+  const auto o = gh::shifted_moving_average(x, 50, 25);
+  EXPECT_TRUE(std::isnan(o[23]));   // needs x(−1)
+  EXPECT_DOUBLE_EQ(o[24], 24.5);    // mean of x(0 … 49)
+  EXPECT_DOUBLE_EQ(o[100], 100.5);  // centre k + 0.5
+  EXPECT_DOUBLE_EQ(o[174], 174.5);  // last: x(150 … 199)
+  EXPECT_TRUE(std::isnan(o[175]));
+}
+
+TEST(GreyHorizon, ChosenHorizonOnARampIsTheFilterDelay) {
+  // Filter lag τ, objective centred on k + 0.5, GM(1,1) extrapolates a slow ramp ≈ linearly:
+  // the error is ≈ s·(p − τ − 0.5), so the best p is the integer nearest τ + 0.5.
+  const auto x = ramp(3000, 0.3, 1e-4);
+  gh::HorizonOptions opt;
+  opt.warmup = 600;
+  for (double wn : kPaperWn) {
+    const auto r = gh::choose_horizon(x, wn, opt);
+    const double expected = gh::butterworth_dc_delay(wn) + 0.5;
+    EXPECT_LE(std::fabs(static_cast<double>(r.best_p) - expected), 1.0)
+        << "Wn " << wn << " expected ≈ " << expected;
+    EXPECT_LT(r.best_rms, 1e-4 * 1.0);  // within one step of slope
+    EXPECT_GT(r.rms[0], 1e-4 * 8.0);    // no prediction: the whole lag remains
+  }
+}
+
+TEST(GreyHorizon, NoiseShortensTheHorizonAtHighCutOff) {
+  // On a ramp plus white noise, extrapolating 5 filtered samples p steps ahead amplifies the
+  // noise the filter lets through; at Wn = 0.05 (τ ≈ 9) the best p falls below the noise-free
+  // choice, while at Wn = 0.010 (the filter removes nearly all of it) it stays near τ.
+  std::vector<double> x = ramp(6000, 0.3, 5e-5);
+  unsigned s = 12345u;
+  for (double& v : x) {
+    s = s * 1664525u + 1013904223u;
+    v += 0.1 * (static_cast<double>(s >> 8) / 16777216.0 - 0.5);
+  }
+  gh::HorizonOptions opt;
+  opt.warmup = 600;
+  const auto lo = gh::choose_horizon(x, 0.010, opt);
+  const auto hi = gh::choose_horizon(x, 0.050, opt);
+  EXPECT_LT(static_cast<double>(hi.best_p), gh::butterworth_dc_delay(0.050));
+  EXPECT_GT(lo.best_p, hi.best_p);
+}
+
+TEST(GreyHorizon, TooShortARecordIsRefused) {
+  const auto x = ramp(100, 0.3, 1e-4);
+  gh::HorizonOptions opt;
+  EXPECT_THROW(gh::choose_horizon(x, 0.012, opt), std::invalid_argument);
+}
