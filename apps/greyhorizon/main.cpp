@@ -46,12 +46,14 @@ constexpr std::pair<double, int> kPaperTable[] = {{0.010, 46}, {0.012, 37}, {0.0
                                                   {0.020, 17}, {0.030, 6},  {0.050, 1}};
 
 constexpr const char* kUsage =
-    "usage: edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--csv PATH]\n"
+    "usage: edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--io PARAMS]\n"
+    "                       [--csv PATH] [--raw PATH]\n"
     "                       [--max-p P] [--window n] [--warmup W]\n"
     "  --seed     simulator seed (default 1)\n"
     "  --samples  Rab samples at 40 ms (default 3000 = 120 s)\n"
     "  --skip-s   simulated seconds before the record starts (default 2)\n"
     "  --config   wire machine config (default <source>/config/machines/wire-sim.yaml)\n"
+    "  --io       extra simulator params, e.g. \"wire_thickness_profile: '0:10,40:30'\"\n"
     "  --csv      also write the RMS error for every Wn and p to PATH\n"
     "  --raw      also write the recorded Rab (one sample a line) to PATH\n"
     "  --max-p    largest horizon tried (default 60)\n"
@@ -84,14 +86,16 @@ std::string slurp(const std::string& path) {
 
 // Rab every 40 ms from the wire simulator, after skip_ms of cutting.
 std::vector<double> record_rab(const std::string& config_path, std::int64_t seed,
-                               std::size_t samples, std::int64_t skip_ms) {
+                               const std::string& io_extra, std::size_t samples,
+                               std::int64_t skip_ms) {
   std::string text = slurp(config_path);
   const std::string from = "seed: 1}";
   const auto at = text.find(from);
   if (at == std::string::npos) {
     throw std::runtime_error(config_path + ": no 'seed: 1}' in the io params to replace");
   }
-  text.replace(at, from.size(), "seed: " + std::to_string(seed) + "}");
+  text.replace(at, from.size(),
+               "seed: " + std::to_string(seed) + (io_extra.empty() ? "" : ", " + io_extra) + "}");
 
   rt::BlockRegistry blocks;
   rt::DriverRegistry drivers;
@@ -147,6 +151,7 @@ int main(int argc, char** argv) {
   std::string config = std::string(EDM_SOURCE_DIR) + "/config/machines/wire-sim.yaml";
   std::string csv;
   std::string raw;
+  std::string io_extra;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -178,6 +183,8 @@ int main(int argc, char** argv) {
       config = v;
     } else if (a == "--csv") {
       csv = v;
+    } else if (a == "--io") {
+      io_extra = v;
     } else if (a == "--raw") {
       raw = v;
     } else {
@@ -192,7 +199,7 @@ int main(int argc, char** argv) {
   opt.warmup = static_cast<std::size_t>(warmup);
   try {
     const std::vector<double> x =
-        record_rab(config, seed, static_cast<std::size_t>(samples), skip_s * 1000);
+        record_rab(config, seed, io_extra, static_cast<std::size_t>(samples), skip_s * 1000);
     double mean = 0;
     for (double v : x) mean += v;
     mean /= static_cast<double>(x.size());
@@ -202,6 +209,25 @@ int main(int argc, char** argv) {
     std::printf("Rab from %s, seed %lld: %zu samples at %lld ms, mean %.3f, SD %.3f\n",
                 config.c_str(), static_cast<long long>(seed), x.size(),
                 static_cast<long long>(kSampleMs), mean, sd);
+    {
+      // How much slow content the record has: the objective's SD against white noise's
+      // SD/√L (a white record leaves the L-step average nothing else to follow).
+      const auto o = gh::shifted_moving_average(x, opt.ma_length, opt.ma_shift);
+      double om = 0, on = 0, ov = 0;
+      for (std::size_t k = opt.warmup; k < o.size(); ++k) {
+        if (!std::isnan(o[k])) {
+          om += o[k];
+          on += 1;
+        }
+      }
+      om /= on > 0 ? on : 1;
+      for (std::size_t k = opt.warmup; k < o.size(); ++k) {
+        if (!std::isnan(o[k])) ov += (o[k] - om) * (o[k] - om);
+      }
+      std::printf("objective SD %.5f (white noise of the same SD would give %.5f)\n",
+                  std::sqrt(ov / (on > 0 ? on : 1)),
+                  sd / std::sqrt(static_cast<double>(opt.ma_length)));
+    }
     std::printf(
         "GM(1,1) window %zu, p = 0..%zu, objective: %zu-step moving average shifted %zu, "
         "scored after %zu samples\n\n",
@@ -214,7 +240,7 @@ int main(int argc, char** argv) {
       gh::HorizonResult res = gh::choose_horizon(x, wn, opt);
       const auto pp = static_cast<std::size_t>(paper_p);
       const double at_paper = pp < res.rms.size() ? res.rms[pp] : std::nan("");
-      std::printf("| %.3f | %zu | %.4f | %.4f | %.4f | %d | %.1f |\n", wn, res.best_p, res.best_rms,
+      std::printf("| %.3f | %zu | %.5f | %.5f | %.5f | %d | %.1f |\n", wn, res.best_p, res.best_rms,
                   res.rms[0], at_paper, paper_p, gh::butterworth_dc_delay(wn));
       results.push_back(std::move(res));
     }
