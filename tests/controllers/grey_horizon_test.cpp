@@ -74,8 +74,9 @@ TEST(GreyHorizon, ChosenHorizonOnARampIsTheFilterDelay) {
 
 TEST(GreyHorizon, NoiseShortensTheHorizonAtHighCutOff) {
   // On a ramp plus white noise, extrapolating 5 filtered samples p steps ahead amplifies the
-  // noise the filter lets through; at Wn = 0.05 (τ ≈ 9) the best p falls below the noise-free
-  // choice, while at Wn = 0.010 (the filter removes nearly all of it) it stays near τ.
+  // noise the filter lets through, so the best p falls below the noise-free choice τ + ½ (which
+  // the ramp alone gives, test above), and further the more noise the filter passes: at
+  // Wn = 0.05 (τ ≈ 9) it is below τ and below the p chosen at Wn = 0.010 (τ ≈ 45).
   std::vector<double> x = ramp(6000, 0.3, 5e-5);
   unsigned s = 12345u;
   for (double& v : x) {
@@ -87,6 +88,7 @@ TEST(GreyHorizon, NoiseShortensTheHorizonAtHighCutOff) {
   const auto lo = gh::choose_horizon(x, 0.010, opt);
   const auto hi = gh::choose_horizon(x, 0.050, opt);
   EXPECT_LT(static_cast<double>(hi.best_p), gh::butterworth_dc_delay(0.050));
+  EXPECT_LT(static_cast<double>(lo.best_p), gh::butterworth_dc_delay(0.010));
   EXPECT_GT(lo.best_p, hi.best_p);
 }
 
