@@ -61,9 +61,12 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   }
   // The time since the last cycle, not the period: omitted cycles (the axis kept its last
   // command) count too.
+  // A gap of more than 10 periods is a pause of the block (e.g. a feed hold in which it is not
+  // stepped), not omitted cycles: it counts as one period.
   double elapsed_s = dt_s_;
   if (have_release_ && ctx.release > last_release_) {
-    elapsed_s = std::clamp(rt::to_seconds(ctx.release - last_release_), dt_s_, 10.0 * dt_s_);
+    const double gap_s = rt::to_seconds(ctx.release - last_release_);
+    elapsed_s = gap_s <= 10.0 * dt_s_ ? std::max(gap_s, dt_s_) : dt_s_;
   }
   have_release_ = true;
   last_release_ = ctx.release;

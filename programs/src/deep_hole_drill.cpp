@@ -96,6 +96,7 @@ void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
   v.input("enable_wear_comp", enable_wear_comp_);
   v.input("tdr_us", tdr_us_, "us");
   v.input("through", through_);
+  v.input("hold", hold_);
   v.output("vz_cmd_mm_s", vz_cmd_mm_s_, "mm/s");
   v.output("gen_on", gen_on_);
   v.output("state", state_);
@@ -258,6 +259,16 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
   if ((state_value_ == State::kIdle || state_value_ == State::kDone) && rising && !safe) {
     begin_cycle();
+  }
+
+  // HOLD (operator feed hold) while approaching or drilling: generator off, Z still; the gap,
+  // Td and wear children are not stepped, so nothing is learnt or integrated meanwhile and the
+  // cycle continues where it was on release.
+  if (hold_.get() && !safe && (state_value_ == State::kApproach || state_value_ == State::kDrill)) {
+    gen_on_.set(false);
+    vz_cmd_mm_s_.set(0.0);
+    spark_cycles_ = 0;
+    return status;
   }
 
   bool td_stepped = false;

@@ -118,6 +118,7 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
   wire_child(errs, drill_, "drill", "wear_ratio", c_wear_ratio_);
   wire_child(errs, drill_, "drill", "tdr_us", c_tdr_);
   wire_child(errs, drill_, "drill", "through", c_through_);
+  wire_child(errs, drill_, "drill", "hold", c_drill_hold_);
   wire_child(errs, finish_, "finish", "x_mm", c_x_);
   wire_child(errs, finish_, "finish", "y_mm", c_y_);
   wire_child(errs, finish_, "finish", "start", c_finish_start_);
@@ -243,6 +244,7 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   state_.set(0);
   step_ = Step::kEnter;
   c_drill_start_.set(false);
+  c_drill_hold_.set(false);
   c_finish_start_.set(false);
   gen_arm_.set(false);
   gen_on_.set(false);
@@ -413,6 +415,7 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
         return false;
       }
       c_drill_start_.set(false);
+      c_drill_hold_.set(hold);
       job_depth_mm_.set(std::max(job_depth_mm_.get(), drill_depth_->get()));
       job_wear_mm_.set(wear_before_block_ + drill_wear_->get());
       const bool done =

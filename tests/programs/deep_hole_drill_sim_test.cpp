@@ -144,6 +144,49 @@ TEST_P(DrillSeeds, TwentyMillimetreHoleWithAndWithoutWearCompensation) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, DrillSeeds, ::testing::Values(1, 2, 3));
 
+// Feed hold in the middle of a hole: the generator goes off and Z stops at once, nothing erodes
+// or wears meanwhile, and on release the cycle goes on to the same accurate depth.
+TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
+  rt::Config cfg = rt::parse_config_text(slurp(kConfig), "drill-sim-program.yaml");
+  auto r = build_sim_machine(cfg);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  auto& vars = r->variables();
+  std::ostringstream sink;
+  std::int64_t k = 0;
+  auto cycle = [&] {
+    const rt::TimePoint release{1ms * k++};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+  };
+  auto read = [&](const char* n) { return vars.read(n).value(); };
+  while (k < 200'000 && read("cycle.drill.depth_reached_mm") < 8.0) cycle();
+  ASSERT_EQ(read("cycle.drill.state"), 2.0) << "drilling";
+
+  ASSERT_TRUE(vars.force("cycle.drill.hold", 1.0));
+  cycle();
+  EXPECT_EQ(read("cycle.drill.gen_on"), 0.0) << "generator off in the first held cycle";
+  EXPECT_EQ(read("cycle.drill.vz_cmd_mm_s"), 0.0);
+  for (int i = 0; i < 50; ++i) cycle();  // the axis comes to rest
+  const double depth0 = read("io.depth_mm"), electrode0 = read("io.electrode_mm");
+  const double z0 = read("io.z_mm"), estimate0 = read("cycle.drill.depth_reached_mm");
+  for (int i = 0; i < 2000; ++i) cycle();  // 2 s held
+  EXPECT_EQ(read("io.depth_mm"), depth0) << "nothing eroded while held";
+  EXPECT_EQ(read("io.electrode_mm"), electrode0) << "no wear while held";
+  EXPECT_NEAR(read("io.z_mm"), z0, 1e-3) << "Z still";
+  EXPECT_EQ(read("cycle.drill.depth_reached_mm"), estimate0);
+  EXPECT_EQ(read("cycle.drill.state"), 2.0) << "still in DRILL, not restarted";
+
+  ASSERT_TRUE(vars.unforce("cycle.drill.hold"));
+  while (k < 400'000 && read("cycle.drill.state") != 4.0) cycle();
+  ASSERT_EQ(read("cycle.drill.state"), 4.0) << "DONE after the release";
+  std::printf("[drill] held 2 s at %.3f mm, finished at %.4f mm (true %.4f)\n", estimate0,
+              read("cycle.drill.depth_reached_mm"), read("io.depth_mm"));
+  EXPECT_NEAR(read("io.depth_mm"), 20.0, 0.02);
+}
+
 }  // namespace
 }  // namespace edm::test
 

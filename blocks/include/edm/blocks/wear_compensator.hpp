@@ -9,7 +9,8 @@
 // Estimator of v_bottom: the gap controller's command vz_in is the velocity the electrode FRONT
 // needs relative to the work to hold the gap (commanding the axis vz_in − Vd makes the front move
 // at exactly vz_in, because the electrode shortens at Vd). The front is integrated over the time
-// since the previous cycle's release (up to 10 periods), so cycles a loaded real-time machine
+// since the previous cycle's release (up to 10 periods; a longer gap is a pause of the block and
+// counts as one period), so cycles a loaded real-time machine
 // omits — while the axis keeps moving at the last command — still count. The block integrates the
 // front position p += vz_in·dt and keeps its deepest point so far (a high-water mark): the hole
 // bottom advances only when the front goes deeper than it has ever been,

@@ -36,6 +36,8 @@
 // hole is not finished). `start` is ignored while the machine is in a safe state.
 //
 // Inputs tdr_us (> 0: the active condition's Tdr, else the parameter) and through.
+// Input hold (feed hold): in APPROACH or DRILL the generator goes off and vz = 0 at once; the
+// children are not stepped, so the cycle resumes where it was when hold drops.
 // Child parameters: kg, tdr_default_us (gap) and hole_area_mm2, electrode_area_mm2 (wear) and
 // td_window (td) are the composite's own and are copied into the children at configure time; kg and
 // tdr_us are also copied on a runtime write. The other child parameters keep their defaults, except
@@ -121,7 +123,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<double> wear_ratio_;  // ≤ 0 (unwired): use the parameter
   rt::Input<bool> enable_wear_comp_{true};
   rt::Input<double> tdr_us_;  // ≤ 0 (unwired): the tdr_us parameter
-  rt::Input<bool> through_;   // a through hole: detect the breakthrough
+  rt::Input<bool> through_;
+  rt::Input<bool> hold_;  // a through hole: detect the breakthrough
   rt::Output<double> vz_cmd_mm_s_;
   rt::Output<bool> gen_on_;
   rt::Output<std::int64_t> state_;
