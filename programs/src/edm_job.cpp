@@ -118,7 +118,8 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
   wire_child(errs, drill_, "drill", "wear_ratio", c_wear_ratio_);
   wire_child(errs, drill_, "drill", "tdr_us", c_tdr_);
   wire_child(errs, drill_, "drill", "through", c_through_);
-  wire_child(errs, drill_, "drill", "hold", c_drill_hold_);
+  wire_child(errs, drill_, "drill", "hold", c_hold_);
+  wire_child(errs, finish_, "finish", "hold", c_hold_);  // one hold for either child
   wire_child(errs, finish_, "finish", "x_mm", c_x_);
   wire_child(errs, finish_, "finish", "y_mm", c_y_);
   wire_child(errs, finish_, "finish", "start", c_finish_start_);
@@ -244,7 +245,7 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   state_.set(0);
   step_ = Step::kEnter;
   c_drill_start_.set(false);
-  c_drill_hold_.set(false);
+  c_hold_.set(false);
   c_finish_start_.set(false);
   gen_arm_.set(false);
   gen_on_.set(false);
@@ -415,7 +416,7 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
         return false;
       }
       c_drill_start_.set(false);
-      c_drill_hold_.set(hold);
+      c_hold_.set(hold);
       job_depth_mm_.set(std::max(job_depth_mm_.get(), drill_depth_->get()));
       job_wear_mm_.set(wear_before_block_ + drill_wear_->get());
       const bool done =
@@ -437,6 +438,7 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
         return false;
       }
       c_finish_start_.set(false);
+      c_hold_.set(hold);
       const bool done = finish_state_->get() == static_cast<std::int64_t>(WallFinish::State::kDone);
       if (done) {
         hold_x_ = x;

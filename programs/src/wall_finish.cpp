@@ -84,6 +84,7 @@ void WallFinish::visit_own_pins(rt::PinVisitor& v) {
   v.input("start", start_);
   v.input("start_offset_mm", start_offset_mm_, "mm");
   v.input("final_offset_mm", final_offset_mm_, "mm");
+  v.input("hold", hold_);
   v.output("vx_cmd_mm_s", vx_cmd_mm_s_, "mm/s");
   v.output("vy_cmd_mm_s", vy_cmd_mm_s_, "mm/s");
   v.output("gen_on", gen_on_);
@@ -270,8 +271,12 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
     set_state(State::kPolarity);
   }
 
+  // Feed hold in the orbit: generator off, the reference stays where it is (the loops hold the
+  // electrode still), the phase, radius, Td window and revolution count wait.
+  const bool held = hold_.get() && !safe && state_value_ == State::kOrbit;
+
   // The polarity switch runs every cycle (it times the generator-off periods).
-  c_gen_req_.set(state_value_ == State::kOrbit && !safe);
+  c_gen_req_.set(state_value_ == State::kOrbit && !safe && !held);
   status = rt::worst(status, pol_.update(ctx));
   const bool positive = get_or(pol_positive_, false);
   polarity_positive_.set(positive);
@@ -285,7 +290,9 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
   }
 
   double rho_target = 0.0;
-  if (state_value_ == State::kOrbit) {
+  if (held) {
+    rho_target = rho_;
+  } else if (state_value_ == State::kOrbit) {
     status = rt::worst(status, td_.update(ctx));
     const double radius = get_or(orbit_radius_, 0.0);
     // Revolutions count (and Td is collected) only once the reference radius has reached the
@@ -349,7 +356,7 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
     }
   }
 
-  if (state_value_ == State::kOrbit) {
+  if (state_value_ == State::kOrbit && !held) {
     gen_on_.set(get_or(pol_gen_, false));
   } else {
     gen_on_.set(false);

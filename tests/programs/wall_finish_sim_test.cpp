@@ -154,5 +154,55 @@ TEST(WallFinishSim, UncalibratedFinalOffsetEqualToTheGrowth) {
   EXPECT_NEAR(f.r_mean_mm, target, 0.010);
 }
 
+// Feed hold in the orbit: the generator goes off and the electrode stays still, nothing erodes
+// and no revolution counts meanwhile; on release the finish ends within its ±5 µm as without.
+TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
+  rt::Config cfg = rt::parse_config_text(slurp(kConfig), "finish-sim-program.yaml");
+  auto r = build_sim_machine(cfg);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  auto& vars = r->variables();
+  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(r->driver()).plant();
+  const double target = plant.wall_bin_radius_mm(0) + 0.05;
+  std::ostringstream sink;
+  std::int64_t k = 0;
+  auto cycle = [&] {
+    const rt::TimePoint release{1ms * k++};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+  };
+  auto read = [&](const char* n) { return vars.read(n).value(); };
+  while (k < 120'000 && read("cycle.finish.revolutions") < 5.0) cycle();
+  ASSERT_EQ(read("cycle.finish.state"), 2.0) << "orbiting";
+
+  ASSERT_TRUE(vars.force("cycle.finish.hold", 1.0));
+  cycle();
+  EXPECT_EQ(read("cycle.finish.gen_on"), 0.0) << "generator off in the first held cycle";
+  for (int i = 0; i < 200; ++i) cycle();  // the axes come to rest
+  const double r0 = read("io.wall_radius_mm"), x0 = read("io.x_mm"), y0 = read("io.y_mm");
+  const double revs0 = read("cycle.finish.revolutions");
+  for (int i = 0; i < 2000; ++i) cycle();  // 2 s held
+  EXPECT_EQ(read("io.wall_radius_mm"), r0) << "nothing eroded while held";
+  EXPECT_NEAR(read("io.x_mm"), x0, 1e-3);
+  EXPECT_NEAR(read("io.y_mm"), y0, 1e-3);
+  EXPECT_EQ(read("cycle.finish.revolutions"), revs0);
+  EXPECT_EQ(read("cycle.finish.state"), 2.0);
+
+  ASSERT_TRUE(vars.unforce("cycle.finish.hold"));
+  while (k < 240'000 && read("cycle.finish.state") != 4.0) cycle();
+  ASSERT_EQ(read("cycle.finish.state"), 4.0) << "DONE after the release";
+  double r_min = 1e9, r_max = -1e9;
+  for (std::size_t j = 0; j < sim::Plant::kWallBins; ++j) {
+    r_min = std::min(r_min, plant.wall_bin_radius_mm(j));
+    r_max = std::max(r_max, plant.wall_bin_radius_mm(j));
+  }
+  std::printf("[wall_finish_sim] held 2 s after %g revolutions; bins %.4f..%.4f (target %.4f)\n",
+              revs0, r_min, r_max, target);
+  EXPECT_NEAR(r_min, target, 0.005);
+  EXPECT_NEAR(r_max, target, 0.005);
+}
+
 }  // namespace
 }  // namespace edm::test

@@ -15,8 +15,8 @@
 // machine is commanded back to READY. An operator stop (machine READY), FAULT or ESTOP while
 // running aborts the job (kAborted); the children's safe states stop the axes, switch the
 // generator off and back Z off. HOLD pauses interpolated moves and dwells at once, and a drilling
-// block at once too (the drill's `hold`: generator off, Z still, resumed where it was); a
-// finishing (orbit) block runs to its end first; then the job waits for RESUME.
+// block and an orbit-finishing block at once too (the children's `hold`: generator off, axes
+// still, resumed where they were).
 //
 // Blocks (machining::MotionKind):
 //   condition  E<n>: the condition's polarity, on/off time, servo reference, Tdr and wear ratio
@@ -133,7 +133,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   // Cells the children's inputs are wired to.
   rt::Output<std::int64_t> c_td_sum_ns_, c_td_count_, c_n_open_, c_n_short_;
   rt::Output<double> c_x_, c_y_, c_z_;
-  rt::Output<bool> c_drill_start_, c_finish_start_, c_through_, c_drill_hold_;
+  rt::Output<bool> c_drill_start_, c_finish_start_, c_through_, c_hold_;
   rt::Output<double> c_depth_, c_wear_ratio_, c_tdr_, c_final_offset_, c_start_offset_;
   rt::Output<bool> c_lin_start_, c_lin_hold_, c_lin_load_;
   rt::Output<double> c_lx_, c_ly_, c_lz_, c_lin_feed_;

@@ -98,6 +98,7 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_;
   rt::Input<double> x_mm_, y_mm_;
   rt::Input<bool> start_;
+  rt::Input<bool> hold_;  // feed hold in the orbit
   rt::Input<double> start_offset_mm_;
   rt::Input<double> final_offset_mm_;
   rt::Output<double> vx_cmd_mm_s_, vy_cmd_mm_s_;
