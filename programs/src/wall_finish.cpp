@@ -40,6 +40,8 @@ void WallFinishParams::visit(rt::ParamVisitor& v) {
   v.param("settle", settle, "s",
           "generator-off time around the polarity switch (> 0), load time only");
   v.param("td_window", td_window, "cycles", "cycles pooled for Td (1..65536), load time only");
+  v.param("no_spark_timeout", no_spark_timeout, "s",
+          "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off");
 }
 
 std::vector<rt::ParamError> WallFinishParams::validate() const {
@@ -64,6 +66,9 @@ std::vector<rt::ParamError> WallFinishParams::validate() const {
   if (td_window < 1 || td_window > blocks::TdDetectorParams::kMaxWindow) {
     errs.push_back({"td_window", "td_window must be in 1..65536"});
   }
+  if (no_spark_timeout < rt::Duration::zero()) {
+    errs.push_back({"no_spark_timeout", "no_spark_timeout must be >= 0"});
+  }
   return errs;
 }
 
@@ -85,6 +90,7 @@ void WallFinish::visit_own_pins(rt::PinVisitor& v) {
   v.input("start_offset_mm", start_offset_mm_, "mm");
   v.input("final_offset_mm", final_offset_mm_, "mm");
   v.input("hold", hold_);
+  v.output("no_spark", no_spark_);
   v.output("vx_cmd_mm_s", vx_cmd_mm_s_, "mm/s");
   v.output("vy_cmd_mm_s", vy_cmd_mm_s_, "mm/s");
   v.output("gen_on", gen_on_);
@@ -262,6 +268,8 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
     revs_ = 0;
     spark_out_ = false;
     spark_out_left_ = params_.spark_out_revs;
+    dark_s_ = 0.0;
+    no_spark_.set(false);
     const double r0 = start_offset_mm_.get();
     c_r0_.set(r0);
     c_final_.set(std::max(final_offset_mm_.get(), r0));
@@ -294,6 +302,12 @@ rt::BlockStatus WallFinish::update(const rt::CycleContext& ctx) noexcept {
     rho_target = rho_;
   } else if (state_value_ == State::kOrbit) {
     status = rt::worst(status, td_.update(ctx));
+    dark_s_ = td_count_.get() > 0 || n_short_.get() > 0 ? 0.0 : dark_s_ + dt;
+    if (!spark_out_ && params_.no_spark_timeout > rt::Duration::zero() &&
+        dark_s_ >= rt::to_seconds(params_.no_spark_timeout)) {
+      no_spark_.set(true);  // the task raises the block-fault alarm: safe state, job aborted
+      status = rt::BlockStatus::kFault;
+    }
     const double radius = get_or(orbit_radius_, 0.0);
     // Revolutions count (and Td is collected) only once the reference radius has reached the
     // orbit radius: the entry from the centre is not a machining revolution.

@@ -204,5 +204,35 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
   EXPECT_NEAR(r_max, target, 0.005);
 }
 
+// An orbit that never sparks (the electrode 3 mm above the work: no wall, no front) trips the
+// no-spark timeout: a block fault, the machine goes to FAULT, the finish is abandoned.
+TEST(FinishNoSpark, AnOrbitThatNeverSparksFaultsAfterTheTimeout) {
+  std::string text = slurp(kConfig);
+  replace_once(text, "initial_depth_mm: 2}", "initial_depth_mm: 2, start_gap_um: 5000}");
+  replace_once(text, "spark_out_revs: 4}", "spark_out_revs: 4, no_spark_timeout: 3s}");
+  auto r = build_sim_machine(rt::parse_config_text(text, "finish-sim-program.yaml"));
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  rt::VirtualClock clock;
+  auto& task = *r->tasks()[0];
+  auto& vars = r->variables();
+  std::ostringstream sink;
+  std::int64_t k = 0, orbit_from = -1;
+  for (; k < 20'000 && !rt::is_safe_state(r->machine().state()); ++k) {
+    const rt::TimePoint release{1ms * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    if (orbit_from < 0 && vars.read("cycle.finish.state").value() == 2.0) orbit_from = k;
+    EXPECT_EQ(vars.read("io.td_count").value(), 0.0) << "no spark at all";
+  }
+  ASSERT_GE(orbit_from, 0);
+  EXPECT_EQ(r->machine().state(), rt::MachineState::kFault);
+  EXPECT_EQ(r->machine().last_cause(), rt::AlarmCode::kBlockFault);
+  EXPECT_EQ(vars.read("cycle.finish.no_spark").value(), 1.0);
+  const double after_s = static_cast<double>(k - orbit_from) * 1e-3;
+  EXPECT_GE(after_s, 3.0) << "not before the timeout";
+  EXPECT_LT(after_s, 3.1) << "at the timeout";
+}
+
 }  // namespace
 }  // namespace edm::test

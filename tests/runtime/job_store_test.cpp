@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <thread>
 #include <vector>
 
@@ -95,7 +96,12 @@ TEST(JobStore, ConcurrentLoadsNeverTearARunningJob) {
   });
   int jobs = 0;
   int torn = 0;
-  for (int k = 0; k < 20000 || loads.load() < 10; ++k) {
+  // Until both sides have made progress (on a loaded machine the loader may win the first 20000
+  // tries); the deadline only bounds a broken store.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (int k = 0;
+       (k < 20000 || loads.load() < 10 || jobs == 0) && std::chrono::steady_clock::now() < deadline;
+       ++k) {
     if (!s.rt_begin()) continue;
     ++jobs;
     const MotionBlock* first = s.rt_current();

@@ -61,6 +61,9 @@ struct WallFinishParams {
   double f_err_max_mm{blocks::PositionLoopParams{}.f_err_max_mm};  // [mm] > 0 → px, py
   rt::Duration settle{blocks::PolaritySwitchParams{}.settle};      // > 0 → pol (load time only)
   std::int64_t td_window{8};  // cycles, → td.window (load time only)
+  // ORBIT without a single ignited or shorted pulse for this long (outside spark-out) is a fault:
+  // no work, no generator, a wrong offset. 0 s: off.
+  rt::Duration no_spark_timeout{std::chrono::seconds(30)};  // ≥ 0
 
   void visit(rt::ParamVisitor& v);
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
@@ -98,7 +101,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_;
   rt::Input<double> x_mm_, y_mm_;
   rt::Input<bool> start_;
-  rt::Input<bool> hold_;  // feed hold in the orbit
+  rt::Input<bool> hold_;       // feed hold in the orbit
+  rt::Output<bool> no_spark_;  // the no-spark timeout tripped (a fault)
+  double dark_s_{0.0};         // time in ORBIT since the last ignited or shorted pulse
   rt::Input<double> start_offset_mm_;
   rt::Input<double> final_offset_mm_;
   rt::Output<double> vx_cmd_mm_s_, vy_cmd_mm_s_;
