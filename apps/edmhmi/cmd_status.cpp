@@ -38,13 +38,8 @@ int cmd_status(const Args& args, const edm::hmi::ConnectionSettings& settings) {
       edm::hmi::JobReport rep;
       rep.part = "program #" + std::to_string(s.job_generation);
       rep.machine = machine;
-      rep.outcome = s.job_outcome;
-      rep.state = s.state;
-      rep.cause = s.cause;
       rep.targets.blocks = s.job_blocks;
-      rep.blocks_done =
-          s.job_outcome == "finished" ? s.job_blocks : std::min(s.job_block, s.job_blocks);
-      rep.end = edm::hmi::figures_from_status(s);
+      edm::hmi::fill_from_status(rep, s);
       std::fputs(edm::hmi::format_report(rep).c_str(), stdout);
     }
   }

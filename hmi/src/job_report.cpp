@@ -125,6 +125,15 @@ std::string format_progress(const ProgressView& v, int bar_width) {
   return line;
 }
 
+void fill_from_status(JobReport& r, const bridge::StatusMessage& s) {
+  r.outcome = s.job_outcome;
+  r.state = s.state;
+  r.cause = s.state == "FAULT" || s.state == "ESTOP" ? s.cause : 0;
+  r.blocks_done = s.job_outcome == "finished" ? s.job_blocks  // the end block included
+                                              : std::min(s.job_block, s.job_blocks);
+  r.end = figures_from_status(s);
+}
+
 std::string format_report(const JobReport& r) {
   std::string out;
   // The longest label ("wall radius (measured)", 22) still gets two spaces before its value.

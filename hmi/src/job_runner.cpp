@@ -291,14 +291,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
     }
     inbox.alarms.clear();
   }
-  JobReport& rep = result.report;
-  rep.outcome = final_status.job_outcome;
-  rep.state = final_status.state;
-  rep.cause = is_safe_state(final_status.state) ? final_status.cause : 0;
-  rep.blocks_done = final_status.job_outcome == "finished"
-                        ? final_status.job_blocks  // the end block included
-                        : std::min(final_status.job_block, final_status.job_blocks);
-  rep.end = figures_from_status(final_status);
+  fill_from_status(result.report, final_status);
   if (final_status.job_outcome == "finished") {
     result.outcome = RunOutcome::kFinished;
   } else {

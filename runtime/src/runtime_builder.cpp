@@ -381,19 +381,30 @@ class RuntimeBuilder {
     }
   }
 
+  // The pin a config section names, or nullptr after reporting why not (`section`: the message
+  // prefix; `pins_only`: how the message ends for a parameter). A name under "io." is skipped
+  // silently when the driver is unknown (that was reported already).
+  const Variable* find_pin(const NameRef& n, const std::string& section, const char* pins_only) {
+    const Variable* v = rt_->variables_.find(n.name);
+    if (v == nullptr && !rt_->driver_ && n.name.rfind("io.", 0) == 0) {
+      return nullptr;
+    }
+    if (v == nullptr) {
+      diag_.error(n.loc, section + ": unknown variable '" + n.name + "'");
+      return nullptr;
+    }
+    if (!v->is_pin()) {
+      diag_.error(n.loc, section + ": '" + n.name + "' is a parameter; " + pins_only);
+      return nullptr;
+    }
+    return v;
+  }
+
   // The bridge resolves its status variables when it starts; checking them here gives their
-  // file:line:col (and makes `edmplc --check` catch them).
+  // file:line:col (and makes `edmplc --check` catch them). The parser limits their number.
   void check_bridge_vars() {
     for (const NameRef& n : cfg_.bridge.status_vars) {
-      const Variable* v = rt_->variables_.find(n.name);
-      if (v == nullptr && !rt_->driver_ && n.name.rfind("io.", 0) == 0) {
-        continue;  // the unknown driver was reported already
-      }
-      if (v == nullptr) {
-        diag_.error(n.loc, "bridge.status_vars: unknown variable '" + n.name + "'");
-      } else if (!v->is_pin()) {
-        diag_.error(n.loc, "bridge.status_vars: '" + n.name + "' is a parameter; only pins");
-      }
+      find_pin(n, "bridge.status_vars", "only pins");
     }
   }
 
@@ -401,16 +412,8 @@ class RuntimeBuilder {
     std::map<Task*, std::vector<std::pair<std::string, PinRef>>> per_task;
     std::vector<Task*> order;
     for (const NameRef& n : cfg_.trace.variables) {
-      const Variable* v = rt_->variables_.find(n.name);
-      if (v == nullptr && !rt_->driver_ && n.name.rfind("io.", 0) == 0) {
-        continue;  // the unknown driver was reported already
-      }
+      const Variable* v = find_pin(n, "trace", "only pins are traced");
       if (v == nullptr) {
-        diag_.error(n.loc, "trace: unknown variable '" + n.name + "'");
-        continue;
-      }
-      if (!v->is_pin()) {
-        diag_.error(n.loc, "trace: '" + n.name + "' is a parameter; only pins are traced");
         continue;
       }
       if (v->owner == nullptr) {

@@ -75,6 +75,10 @@ struct JobReport {
   int fault_alarms{0};                          // of them, with fault severity
 };
 
+/// The machine's side of a report from one status: outcome, state, the alarm cause (only while in
+/// FAULT/ESTOP: an older cause is stale), blocks done (all of them when finished) and the figures.
+void fill_from_status(JobReport& r, const bridge::StatusMessage& s);
+
 /// The multi-line report edmhmi prints at the end of `run` (and `status` of a finished job).
 std::string format_report(const JobReport& r);
 
