@@ -23,11 +23,18 @@ double wire_break_current_a(double ibk_ref_a, double thickness_mm, double flush_
   return ibk_ref_a * std::sqrt(thickness_mm / 10.0) * flush_f;
 }
 
+double WireBreakMonitor::rate_per_s(double rab) const noexcept {
+  const double x = std::min((rab - rab_ref_) / rab_width_, 50.0);  // e^50: breaks at once anyway
+  return std::exp(x) / (static_cast<double>(rab_mean_ns_) * 1e-9);
+}
+
 bool WireBreakMonitor::update(std::int64_t dt_ns, double mean_current_a, double break_current_a,
                               double rab) noexcept {
   over_current_ns_ = mean_current_a > break_current_a ? over_current_ns_ + dt_ns : 0;
-  over_rab_ns_ = rab > rab_limit_ ? over_rab_ns_ + dt_ns : 0;
-  if (over_current_ns_ >= current_ns_ || over_rab_ns_ >= rab_ns_) broken_ = true;
+  rab_lag_ += (rab - rab_lag_) *
+              (1.0 - std::exp(-static_cast<double>(dt_ns) / static_cast<double>(rab_tau_ns_)));
+  hazard_ += rate_per_s(rab_lag_) * static_cast<double>(dt_ns) * 1e-9;
+  if (over_current_ns_ >= current_ns_ || hazard_ >= threshold_) broken_ = true;
   return broken_;
 }
 

@@ -94,8 +94,17 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("wire_ibk_ref_a", wire_ibk_ref_a, "A", "break current I_BK at H = 10 mm, f = 1");
   v.param("wire_flush_floor", wire_flush_floor, "1", "f = floor + (1 - floor) F_eff");
   v.param("wire_break_current_ms", wire_break_current_ms, "ms", "break after mean I > I_BK this");
-  v.param("wire_break_rab", wire_break_rab, "1", "break if Rab stays above this ...");
-  v.param("wire_break_rab_ms", wire_break_rab_ms, "ms", "... for this long");
+  v.param("wire_break_rab", wire_break_rab, "1", "rupture hazard: at this Rab ...");
+  v.param("wire_break_rab_ms", wire_break_rab_ms, "ms", "... the mean time to break is this");
+  v.param("wire_break_rab_width", wire_break_rab_width, "1", "hazard x e per this Rab above");
+  v.param("wire_break_rab_tau_ms", wire_break_rab_tau_ms, "ms", "hazard acts on Rab lagged by");
+  v.param("wire_kerf_debris_per_mm", wire_kerf_debris_per_mm, "1/mm",
+          "kerf debris c_k added per mm of cut (0 = no kerf debris)");
+  v.param("wire_kerf_flush_s", wire_kerf_flush_s, "s", "tau_k of the kerf debris at H = 10 mm");
+  v.param("wire_kerf_flush_exp", wire_kerf_flush_exp, "1", "tau_k grows as (H/10 mm)^this");
+  v.param("wire_nozzle_radius_mm", wire_nozzle_radius_mm, "mm", "flushing nozzle radius");
+  v.param("wire_hole_flush_factor", wire_hole_flush_factor, "1",
+          "F_eff x this while the nozzle overlaps the internal hole");
   v.param("mean_current_ema_ms", mean_current_ema_ms, "ms", "time constant of mean current");
   v.param("rab_window_ms", rab_window_ms, "ms", "Rab window");
   v.param("mean_voltage_tau_ms", mean_voltage_tau_ms, "ms", "U_av filter time constant");
@@ -206,6 +215,9 @@ std::vector<rt::ParamError> SimParams::validate() const {
                       {"wire_ibk_ref_a", wire_ibk_ref_a},
                       {"wire_break_current_ms", wire_break_current_ms},
                       {"wire_break_rab_ms", wire_break_rab_ms},
+                      {"wire_break_rab_width", wire_break_rab_width},
+                      {"wire_break_rab_tau_ms", wire_break_rab_tau_ms},
+                      {"wire_kerf_flush_s", wire_kerf_flush_s},
                       {"mean_current_ema_ms", mean_current_ema_ms},
                       {"rab_window_ms", rab_window_ms},
                       {"mean_voltage_tau_ms", mean_voltage_tau_ms}}) {
@@ -240,7 +252,10 @@ std::vector<rt::ParamError> SimParams::validate() const {
                       {"flush_drop_factor", flush_drop_factor},
                       {"encoder_um", encoder_um},
                       {"servo_gain_mm_s_per_v", servo_gain_mm_s_per_v},
-                      {"wire_hole_from_mm", wire_hole_from_mm}}) {
+                      {"wire_hole_from_mm", wire_hole_from_mm},
+                      {"wire_kerf_debris_per_mm", wire_kerf_debris_per_mm},
+                      {"wire_kerf_flush_exp", wire_kerf_flush_exp},
+                      {"wire_nozzle_radius_mm", wire_nozzle_radius_mm}}) {
     require_non_negative(e, n, v);
   }
   require_range(e, "debris_c0", debris_c0, 0.0, 1.0);
@@ -251,6 +266,7 @@ std::vector<rt::ParamError> SimParams::validate() const {
   require_range(e, "jump_eps", jump_eps, 0.0, 1.0);
   require_range(e, "wire_flush_floor", wire_flush_floor, 0.0, 1.0);
   require_range(e, "wire_break_rab", wire_break_rab, 0.0, 1.0);
+  require_range(e, "wire_hole_flush_factor", wire_hole_flush_factor, 0.0, 1.0);
   require_range(e, "axis_step_us", axis_step_us, 1.0, 50.0);
   if (removal_mm3_per_j == 0.0 && crater_ref_um3 == 0.0) {
     e.push_back({"removal_mm3_per_j", "removal_mm3_per_j or crater_ref_um3 must be > 0"});
@@ -335,6 +351,18 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.wire_thickness_profile = "0:10,20:60,40:10";
     p.wire_hole_from_mm = 45.0;
     p.wire_hole_to_mm = 47.0;
+    // Abnormal discharges and rupture, calibrated to seed 000's cases (docs/simulator.md §7):
+    // the kerf debris makes Rab climb over seconds with aggressive settings and thick work, and
+    // the wire breaks within about a second once the lagged Rab is above ≈ 0.8; at 0.6 the
+    // mean time to break is ≈ 5 h.
+    p.arc_k_c = 0.8;
+    p.wire_kerf_debris_per_mm = 0.5;
+    p.wire_kerf_flush_s = 2.0;
+    p.wire_kerf_flush_exp = 1.5;
+    p.wire_hole_flush_factor = 0.2;
+    p.wire_break_rab = 0.75;
+    p.wire_break_rab_ms = 10000.0;
+    p.wire_break_rab_width = 0.02;
     return p;
   }
   return std::nullopt;

@@ -77,7 +77,9 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   axis_step_ns_ = std::max<std::int64_t>(1, to_ns(p.axis_step_us));
   rab_ = RabWindow(to_ns(p.rab_window_ms * 1e3));
   wire_monitor_ = WireBreakMonitor(to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab,
-                                   to_ns(p.wire_break_rab_ms * 1e3));
+                                   to_ns(p.wire_break_rab_ms * 1e3), p.wire_break_rab_width,
+                                   to_ns(p.wire_break_rab_tau_ms * 1e3),
+                                   -std::log1p(-uniform(seed_, Stream::kWireBreak, 0)));
   publish();
 }
 
@@ -127,8 +129,14 @@ double Plant::gap_volume_mm3(double gap_um) const noexcept {
 
 double Plant::flush_effective() const noexcept {
   if (!cmd_.flushing_on) return 0.0;
-  const double drop = depth_mm() >= params_.flush_drop_depth_mm ? params_.flush_drop_factor : 1.0;
-  return params_.flush_factor * std::clamp(cmd_.flushing_strength, 0.0, 1.0) * drop;
+  const auto& p = params_;
+  double drop = depth_mm() >= p.flush_drop_depth_mm ? p.flush_drop_factor : 1.0;
+  if (tool_ == Tool::kWire && p.wire_hole_to_mm > p.wire_hole_from_mm &&
+      depth_mm() + p.wire_nozzle_radius_mm > p.wire_hole_from_mm &&
+      depth_mm() - p.wire_nozzle_radius_mm < p.wire_hole_to_mm) {
+    drop *= p.wire_hole_flush_factor;  // the flush escapes through the hole under the nozzle
+  }
+  return p.flush_factor * std::clamp(cmd_.flushing_strength, 0.0, 1.0) * drop;
 }
 
 void Plant::set_commands(const PlantCommands& c) noexcept {
@@ -170,6 +178,13 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
   const double h_flush = tool_ == Tool::kWire ? 0.0 : depth_mm();
   state_.debris = model_.debris_after(state_.debris,
                                       model_.flush_rate_per_s(gap, h_flush, flush_effective()), dt);
+  if (tool_ == Tool::kWire && state_.kerf_debris > 0.0) {
+    const auto& p = params_;
+    const double tau = p.wire_kerf_flush_s *
+                       std::pow(profile_.thickness_mm(depth_mm()) / 10.0, p.wire_kerf_flush_exp);
+    const double r = std::clamp(gap / p.flush_gap_ref_um, 0.0, 1.0);
+    state_.kerf_debris *= std::exp(-flush_effective() * r * r * r * dt / tau);
+  }
   if (params_.jump_eps > 0.0) {  // a retract longer than Δz_j flushes once per jump
     jump_low_z_mm_ = std::min(jump_low_z_mm_, z);
     if (jump_armed_ && z - jump_low_z_mm_ > params_.jump_dz_mm) {
@@ -223,6 +238,7 @@ void Plant::update_wire(std::int64_t t_ns) noexcept {
   const double f = params_.wire_flush_floor + (1.0 - params_.wire_flush_floor) * flush_effective();
   const double ibk =
       wire_break_current_a(params_.wire_ibk_ref_a, profile_.thickness_mm(depth_mm()), f);
+  state_.wire_load = current_sum_a_ / ibk;
   if (wire_monitor_.update(dt, current_sum_a_, ibk, rab_.rab(t_ns))) {
     state_.wire_broken = true;
     set_idle(t_ns);
@@ -237,7 +253,9 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
   if (tool_ == Tool::kWire) {
     const double h = profile_.thickness_mm(depth_mm());
     const double kerf = p.wire_d_mm + 2.0 * std::max(gap_um, 0.0) * 1e-3;  // k = D + 2g
-    double s = depth_mm() + volume_mm3 / (kerf * h);
+    const double ds = volume_mm3 / (kerf * h);
+    state_.kerf_debris = std::min(1.0, state_.kerf_debris + p.wire_kerf_debris_per_mm * ds);
+    double s = depth_mm() + ds;
     if (s >= p.wire_hole_from_mm && s < p.wire_hole_to_mm) s = p.wire_hole_to_mm;  // no material
     hole_bottom_mm_ = -s;
   } else {
@@ -270,7 +288,7 @@ void Plant::start_pulse(std::int64_t t_ns) noexcept {
   ++pulses_this_advance_;
   const auto& p = params_;
   const std::uint64_t k = state_.pulses++;
-  const double c = state_.debris;
+  const double c = std::min(1.0, state_.debris + state_.kerf_debris);  // kerf: wire only
 
   // The gap(s) at this instant and the median delay; when the wall bins compete, the hazards
   // add (same Weibull shape) and the site is drawn in proportion to A_j τ_j^-k (§6.2 step 5).

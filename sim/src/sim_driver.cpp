@@ -86,6 +86,8 @@ void SimDriver::visit_pins(rt::PinVisitor& v) {
   v.output("driver_fault", driver_fault_);
   v.output("true_gap_um", true_gap_um_, "um");
   v.output("true_debris", true_debris_, "1");
+  v.output("true_kerf_debris", true_kerf_debris_, "1");
+  v.output("wire_load", wire_load_, "1");
 
   v.input("vx_cmd", vx_cmd_, "mm/s");
   v.input("vy_cmd", vy_cmd_, "mm/s");
@@ -139,6 +141,8 @@ void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
   driver_fault_.set(st.wire_broken);
   true_gap_um_.set(st.gap_um);
   true_debris_.set(st.debris);
+  true_kerf_debris_.set(st.kerf_debris);
+  wire_load_.set(st.wire_load);
 }
 
 void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {

@@ -1,5 +1,7 @@
 #include "edm/sim/monitors.hpp"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "edm/sim/axis.hpp"
@@ -27,8 +29,13 @@ TEST(SimWire, break_current_law) {
   EXPECT_NEAR(wire_break_current_a(3.0, 10.0, 0.3), 0.9, 1e-12);
 }
 
+// A monitor whose Rab hazard never fires within these tests (mean time 1e9 s at Rab = 1).
+WireBreakMonitor current_only() {
+  return WireBreakMonitor(5 * kMs, 1.0, std::int64_t{1'000'000'000} * 1'000 * kMs, 0.02, kMs, 1.0);
+}
+
 TEST(SimWire, breaks_after_5ms_over_current_not_4ms) {
-  WireBreakMonitor m(5 * kMs, 0.5, 100 * kMs);
+  WireBreakMonitor m = current_only();
   for (int i = 0; i < 40; ++i) m.update(kMs / 10, 3.5, 3.0, 0.0);  // 4 ms over
   EXPECT_FALSE(m.broken());
   m.update(kMs / 10, 2.9, 3.0, 0.0);  // below: the timer restarts
@@ -40,15 +47,39 @@ TEST(SimWire, breaks_after_5ms_over_current_not_4ms) {
   EXPECT_TRUE(m.broken());  // latched
 }
 
-TEST(SimWire, breaks_after_100ms_of_high_rab) {
-  WireBreakMonitor m(5 * kMs, 0.5, 100 * kMs);
-  for (int i = 0; i < 99; ++i) m.update(kMs, 0.0, 3.0, 0.6);
+// Constant Rab r, lag settled (tau 1 µs): λ = e^((r − ref)/w) / T, so the wire breaks at
+// t = threshold / λ — whatever the update step.
+TEST(SimWire, rab_hazard_breaks_at_threshold_over_rate_for_any_step) {
+  const double ref = 0.75, w = 0.02, mean_s = 10.0, threshold = 0.8;
+  for (const double r : {0.70, 0.75, 0.79, 0.85}) {
+    const double expected_s = threshold * mean_s * std::exp(-(r - ref) / w);
+    for (const std::int64_t step : {kMs / 10, kMs, 7 * kMs}) {
+      WireBreakMonitor m(5 * kMs, ref, static_cast<std::int64_t>(mean_s * 1e3) * kMs, w, 1000,
+                         threshold);
+      EXPECT_NEAR(m.rate_per_s(r), std::exp((r - ref) / w) / mean_s, 1e-12);
+      std::int64_t t = 0;
+      while (!m.update(step, 0.0, 3.0, r) && t < 1000'000 * kMs) t += step;
+      t += step;
+      const double t_s = static_cast<double>(t) * 1e-9;
+      EXPECT_GE(t_s, expected_s - 1e-6) << "r " << r << " step " << step;
+      EXPECT_LT(t_s, expected_s + static_cast<double>(step) * 1e-9 + 1e-6)
+          << "r " << r << " step " << step;
+    }
+  }
+}
+
+// The hazard acts on Rab lagged by tau: a 40 ms burst of Rab = 1 (one bad window) does not
+// break a wire that would break in microseconds on the raw value; the same Rab held does.
+TEST(SimWire, rab_hazard_acts_on_the_lagged_rab) {
+  WireBreakMonitor m(5 * kMs, 0.75, 10'000 * kMs, 0.02, 200 * kMs, 1.0);
+  EXPECT_GT(m.rate_per_s(1.0), 1e4);  // on the raw value: mean time to break < 0.1 ms
+  for (int i = 0; i < 40; ++i) m.update(kMs, 0.0, 3.0, 1.0);
+  EXPECT_NEAR(m.rab_lagged(), 1.0 - std::exp(-40.0 / 200.0), 1e-9);
+  for (int i = 0; i < 1000; ++i) m.update(kMs, 0.0, 3.0, 0.3);
   EXPECT_FALSE(m.broken());
-  m.update(kMs, 0.0, 3.0, 0.5);  // not above: restart
-  for (int i = 0; i < 99; ++i) m.update(kMs, 0.0, 3.0, 0.6);
-  EXPECT_FALSE(m.broken());
-  m.update(kMs, 0.0, 3.0, 0.6);
+  for (int i = 0; i < 1000 && !m.broken(); ++i) m.update(kMs, 0.0, 3.0, 1.0);
   EXPECT_TRUE(m.broken());
+  EXPECT_GE(m.hazard(), m.threshold());
 }
 
 TEST(SimRab, window_slides) {

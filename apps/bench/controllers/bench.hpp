@@ -62,7 +62,9 @@ struct Outcome {
   double break_time_s{0.0};  // [s]; the time limit when it did not break
   double rab_mean{0.0};      // mean io.rab after the transient
   double rab_err_rms{0.0};   // RMS of (1 s mean Rab − ref) after the transient
-  double rab_err_max{0.0};   // max |1 s mean Rab − ref| after the transient
+  double rab_above_max{0.0};  // max (1 s mean Rab − ref) after the transient (rupture side)
+  double rab_below_max{0.0};  // max (ref − 1 s mean Rab) after the transient (speed lost)
+  double overload_s{0.0};     // time with Ī > 0.9 I_BK [s] (simulator truth)
   // Five-state time ratios [%] (sink): normal (spark), transient arc, stable arc, short, open.
   double ratio_normal_pct{0.0};
   double ratio_tarc_pct{0.0};

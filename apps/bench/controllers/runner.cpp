@@ -115,7 +115,9 @@ std::vector<std::pair<const char*, double>> Outcome::fields() const {
           {"break_time_s", break_time_s},
           {"rab_mean", rab_mean},
           {"rab_err_rms", rab_err_rms},
-          {"rab_err_max", rab_err_max},
+          {"rab_above_max", rab_above_max},
+          {"rab_below_max", rab_below_max},
+          {"overload_s", overload_s},
           {"ratio_normal_pct", ratio_normal_pct},
           {"ratio_tarc_pct", ratio_tarc_pct},
           {"ratio_sarc_pct", ratio_sarc_pct},
@@ -186,7 +188,7 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   const rt::PinRef td_sum = pin("io.td_sum_ns"), td_count = pin("io.td_count");
   const rt::PinRef depth = pin("io.depth_mm"), z = pin("io.z_mm"), vz = pin("io.vz_cmd");
   const rt::PinRef electrode = pin("io.electrode_mm"), broken = pin("io.wire_broken");
-  const rt::PinRef rab = pin("io.rab");
+  const rt::PinRef rab = pin("io.rab"), wire_load = pin("io.wire_load");
   const bool has_done = !spec.done_var.empty();
   const rt::PinRef done = has_done ? pin(spec.done_var) : rt::PinRef{};
 
@@ -226,6 +228,7 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   double electrode0 = -1.0;
   bool vz_high = false, reached = false;
   double rab_sum = 0, rab_n = 0, rab_sec = 0, rab_sec_n = 0, rab_err_ss = 0, rab_err_n = 0;
+  double sec_open = 0, sec_pulses = 0;
   LineFit fit;
   std::int64_t k = 0;
   std::int64_t end_ms = limit_ms;
@@ -294,18 +297,28 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     if (period_ms > 0 && (k - 1) % period_ms >= kJumpUpMs + kJumpDownMs + kSettleMs) {
       fit.add(t_s, rt::read_pin_as_double(z));
     }
+    if (rt::read_pin_as_double(wire_load) > 0.9) {
+      o.overload_s += 1e-3;
+    }
     if (spec.rab_ref > 0 && t_s > spec.transient_s && o.wire_broken == 0.0) {
       const double x = rt::read_pin_as_double(rab);
       rab_sum += x;
       rab_n += 1;
       rab_sec += x;
       rab_sec_n += 1;
+      sec_open += c[0];
+      sec_pulses += c[0] + c[1] + c[2] + c[3] + c[4];
       if (rab_sec_n >= 1000) {
-        const double e = rab_sec / rab_sec_n - spec.rab_ref;
-        rab_err_ss += e * e;
-        rab_err_n += 1;
-        o.rab_err_max = std::max(o.rab_err_max, std::abs(e));
-        rab_sec = rab_sec_n = 0;
+        // Scored only while the wire cuts: a second with most pulses open (crossing an
+        // internal hole, or backed off the work) has no sparks for Rab to measure.
+        if (sec_open <= 0.5 * sec_pulses) {
+          const double e = rab_sec / rab_sec_n - spec.rab_ref;
+          rab_err_ss += e * e;
+          rab_err_n += 1;
+          o.rab_above_max = std::max(o.rab_above_max, e);
+          o.rab_below_max = std::max(o.rab_below_max, -e);
+        }
+        rab_sec = rab_sec_n = sec_open = sec_pulses = 0;
       }
     }
     const bool cutting = !has_done || spec.window_end_state <= 0 ||

@@ -1,6 +1,7 @@
 // The controller benchmark's scenarios (PLANT-MODEL §5): which configs, which edits, which
 // figures. Everything a reader needs to reproduce a row is here or in the config it names.
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ struct WireCase {
   std::string id, title, io_extra;
   double servo_ref_v, arc_off_us;
   double ol, ku, kv, rab_ref;
+  double transient_s;  // Rab error is scored after this
 };
 
 std::vector<Variant> wire_variants(const WireCase& c, double limit_s) {
@@ -35,7 +37,7 @@ std::vector<Variant> wire_variants(const WireCase& c, double limit_s) {
   base.io_extra = c.io_extra;
   base.limit_s = limit_s;
   base.rab_ref = c.rab_ref;
-  base.transient_s = 10.0;
+  base.transient_s = std::min(c.transient_s, limit_s / 2.0);
   RunSpec fixed = base;
   fixed.config = "config/bench/controllers/wire-fixed.yaml";
   fixed.edits = {{"io.servo_ref_v: 40.0", "io.servo_ref_v: " + fmt(c.servo_ref_v)},
@@ -224,17 +226,24 @@ std::vector<Scenario> make_scenarios(bool quick) {
     out.push_back(std::move(s));
   }
   // B6: seed 000's four cases on the wire machine.
-  const double wire_limit = quick ? 20.0 : 60.0;
+  const double wire_limit = quick ? 30.0 : 120.0;
+  // Thicknesses as in the paper where it gives them (case 1: 50 mm, Fig. 8a; case 2: 100 mm;
+  // case 3: a 20 mm step up); case 4's part is H = 10 mm with a 1 mm hole 6 mm into the cut
+  // (the flushing nozzle, radius 3 mm, is over it from 3 mm on). Every case runs with the
+  // paper's 110 V ignition voltage, so Table 1's 30…70 V servo range spans the gap. Fixed
+  // settings: the aggressive corner of Table 1 (9 µs, 30 V) for the "improper settings" of
+  // cases 1-2; settings that hold on the thin/unholed part (20 µs, 40 V) for cases 3-4.
+  const std::string u0 = "open_voltage_v: 110, ";
   const std::vector<WireCase> cases = {
-      {"B6a", "wire, case 1: improper settings (H = 10 mm, pulse-off time 10 µs)",
-       "wire_thickness_profile: '0:10', default_off_time_us: 10", 30.0, 9.0, 2.0, 0.06, 0.03, 0.42},
-      {"B6b", "wire, case 2: thick work (H = 100 mm)", "wire_thickness_profile: '0:100'", 30.0, 9.0,
-       2.0, 0.06, 0.03, 0.42},
+      {"B6a", "wire, case 1: improper settings (H = 50 mm)",
+       u0 + "wire_thickness_profile: '0:50'", 30.0, 9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
+      {"B6b", "wire, case 2: thick work (H = 100 mm)", u0 + "wire_thickness_profile: '0:100'",
+       30.0, 9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
       {"B6c", "wire, case 3: thickness step 10 → 30 mm at 3 mm of cut",
-       "wire_thickness_profile: '0:10,3:30'", 30.0, 9.0, 2.0, 0.08, 0.16, 0.42},
-      {"B6d", "wire, case 4: internal hole at 3 … 4 mm of cut (H = 10 mm)",
-       "wire_thickness_profile: '0:10', wire_hole_from_mm: 3, wire_hole_to_mm: 4", 30.0, 9.0, 3.0,
-       0.07, 0.14, 0.42},
+       u0 + "wire_thickness_profile: '0:10,3:30'", 40.0, 20.0, 2.0, 0.08, 0.16, 0.42, 10.0},
+      {"B6d", "wire, case 4: internal hole at 6 … 7 mm of cut (H = 10 mm)",
+       u0 + "wire_thickness_profile: '0:10', wire_hole_from_mm: 6, wire_hole_to_mm: 7", 40.0,
+       20.0, 3.0, 0.07, 0.14, 0.42, 10.0},
   };
   for (const WireCase& c : cases) {
     Scenario s;
@@ -249,7 +258,9 @@ std::vector<Scenario> make_scenarios(bool quick) {
                  col("arc %", &Outcome::arc_pct),
                  col("Rab mean", &Outcome::rab_mean, 3),
                  col("Rab err RMS", &Outcome::rab_err_rms, 3),
-                 col("Rab err max", &Outcome::rab_err_max, 3)};
+                 col("Rab above ref max", &Outcome::rab_above_max, 3),
+                 col("Rab below ref max", &Outcome::rab_below_max, 3),
+                 col("time Ī > 0.9 I_BK s", &Outcome::overload_s, 2)};
     s.plot_column = 0;
     out.push_back(std::move(s));
   }

@@ -32,23 +32,49 @@ class ThicknessProfile {
 /// I_BK = I_BK,ref (H / 10 mm)^0.5 f (§6.4, Sato: sub-linear in H, lower with poor flushing).
 double wire_break_current_a(double ibk_ref_a, double thickness_mm, double flush_f) noexcept;
 
-/// Latches "broken" once Ī > I_BK has held for current_ns, or Rab > rab_limit for rab_ns.
+/// Latches "broken" on either of two rupture mechanisms (docs/simulator.md §7):
+///  - mean energy (Sato): Ī > I_BK has held for current_ns;
+///  - abnormal discharges (seed 000, Liao: Rab is the precursor of rupture): a hazard
+///    λ = exp((R̄ − rab_ref) / rab_width) / rab_mean_ns on R̄, Rab through a first-order lag
+///    rab_tau_ns (the wire's heat memory: one noisy window does not break it), so the mean time
+///    to break at
+///    Rab = rab_ref is rab_mean_ns and it falls e-fold every rab_width above. The wire breaks when
+///    ∫λ dt reaches `threshold`, an Exp(1) variate the plant draws from its seed — exact whatever
+///    the update steps, and the same for every controller (common random numbers).
 class WireBreakMonitor {
  public:
   WireBreakMonitor() = default;
-  WireBreakMonitor(std::int64_t current_ns, double rab_limit, std::int64_t rab_ns) noexcept
-      : current_ns_(current_ns), rab_limit_(rab_limit), rab_ns_(rab_ns) {}
+  WireBreakMonitor(std::int64_t current_ns, double rab_ref, std::int64_t rab_mean_ns,
+                   double rab_width, std::int64_t rab_tau_ns, double threshold) noexcept
+      : current_ns_(current_ns),
+        rab_ref_(rab_ref),
+        rab_mean_ns_(rab_mean_ns),
+        rab_width_(rab_width),
+        rab_tau_ns_(rab_tau_ns),
+        threshold_(threshold) {}
   /// The conditions held (or not) over the last dt_ns. Returns broken().
   bool update(std::int64_t dt_ns, double mean_current_a, double break_current_a,
               double rab) noexcept;
   [[nodiscard]] bool broken() const noexcept { return broken_; }
-  void reset() noexcept { over_current_ns_ = over_rab_ns_ = 0, broken_ = false; }
+  /// ∫λ dt so far (the wire breaks at threshold()).
+  [[nodiscard]] double hazard() const noexcept { return hazard_; }
+  [[nodiscard]] double threshold() const noexcept { return threshold_; }
+  /// R̄, the lagged Rab the hazard acts on.
+  [[nodiscard]] double rab_lagged() const noexcept { return rab_lag_; }
+  /// λ at this Rab, per second.
+  [[nodiscard]] double rate_per_s(double rab) const noexcept;
+  void reset() noexcept { over_current_ns_ = 0, hazard_ = rab_lag_ = 0.0, broken_ = false; }
 
  private:
   std::int64_t current_ns_{5'000'000};
-  double rab_limit_{0.5};
-  std::int64_t rab_ns_{100'000'000};
-  std::int64_t over_current_ns_{0}, over_rab_ns_{0};
+  double rab_ref_{0.5};
+  std::int64_t rab_mean_ns_{100'000'000};
+  double rab_width_{0.02};
+  std::int64_t rab_tau_ns_{200'000'000};
+  double threshold_{1.0};
+  double rab_lag_{0.0};
+  std::int64_t over_current_ns_{0};
+  double hazard_{0.0};
   bool broken_{false};
 };
 

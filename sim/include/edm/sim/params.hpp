@@ -120,8 +120,22 @@ struct SimParams {
   double wire_ibk_ref_a{3.0};                  // I_BK at H = 10 mm and f = 1 [bk]
   double wire_flush_floor{0.3};                // f = floor + (1 - floor) F_eff [bk]
   double wire_break_current_ms{5.0};           // break if Ī > I_BK this long
-  double wire_break_rab{0.5};                  // ... or Rab above this ...
-  double wire_break_rab_ms{100.0};             // ... this long
+  double wire_break_rab{0.5};         // abnormal-discharge rupture: at this Rab ...
+  double wire_break_rab_ms{100.0};    // ... the mean time to break is this, and it falls ...
+  double wire_break_rab_width{0.02};  // ... e-fold for every this much Rab above [bk]
+  double wire_break_rab_tau_ms{200.0};  // the hazard acts on Rab through this lag [bk]
+  // Kerf debris c_k: the debris the flushing must carry out along the kerf (height H), slow
+  // against the gap's own c. Each mm of cut adds wire_kerf_debris_per_mm; it is flushed with
+  // τ_k = wire_kerf_flush_s (H/10 mm)^wire_kerf_flush_exp / (F_eff min(1, (g/g_ref)³)).
+  // The pulses see c + c_k. 0 = none (the §6.2 model alone). [bk, calibrated to seed 000]
+  double wire_kerf_debris_per_mm{0.0};
+  double wire_kerf_flush_s{1.0};
+  double wire_kerf_flush_exp{1.0};
+  // An internal hole under the flushing nozzle lets the flush escape: while the nozzle (this
+  // radius, centred on the wire) overlaps [wire_hole_from_mm, wire_hole_to_mm), F_eff is
+  // multiplied by wire_hole_flush_factor. [bk]
+  double wire_nozzle_radius_mm{3.0};
+  double wire_hole_flush_factor{1.0};
   double mean_current_ema_ms{10.0};            // Ī time constant
 
   // --- Sensors (§6.2 step 8) ---

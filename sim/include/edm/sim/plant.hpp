@@ -56,6 +56,7 @@ struct PlantState {
   double vz_mm_s{0.0};
   double gap_um{0.0};               // front gap
   double debris{0.0};               // c in [0, 1]
+  double kerf_debris{0.0};          // WEDM: c_k in [0, 1], slow debris along the kerf
   double depth_mm{0.0};             // hole depth h (drill), or cut length (wire)
   double wall_radius_mm{0.0};       // mean hole wall radius (orbit bins)
   double electrode_length_mm{0.0};  // electrode length left
@@ -64,6 +65,7 @@ struct PlantState {
   std::uint32_t history_open{0}, history_short{0}, history_arc{0};  // last 32 pulses, bit 0 newest
   double rab{0.0};             // (arc + short) / total over the Rab window
   double mean_current_a{0.0};  // WEDM: EMA of Ip·t_on duty (Ī)
+  double wire_load{0.0};       // WEDM: Ī / I_BK (the wire breaks after 5 ms above 1)
   bool wire_broken{false};
   std::uint64_t pulses{0};  // pulse index (keys the random variates)
   // Added by the simulator core:

@@ -15,7 +15,8 @@
 //   gap_voltage_v                       mean gap voltage this cycle
 //   x_mm, y_mm, z_mm                    encoder positions
 //   electrode_mm, depth_mm, wall_radius_mm, wire_broken, driver_fault
-//   true_gap_um, true_debris            the plant's hidden state (for traces, not for control)
+//   true_gap_um, true_debris,           the plant's hidden state (for traces, not for control):
+//   true_kerf_debris, wire_load         WEDM kerf debris c_k and Ī / I_BK
 // outputs from the runtime — latched at the end of each cycle:
 //   vx_cmd, vy_cmd, vz_cmd (mm/s, +z away from the work), gen_arm, gen_on, polarity_positive,
 //   on_time_us, off_time_us, arc_off_time_us (0 = preset), servo_ref_v (V; > 0 switches on the
@@ -79,6 +80,7 @@ class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt
   edm::rt::Output<std::int64_t> hist_open_, hist_short_, hist_arc_;
   edm::rt::Output<double> rab_, gap_voltage_v_, x_mm_, y_mm_, z_mm_;
   edm::rt::Output<double> electrode_mm_, depth_mm_, wall_radius_mm_, true_gap_um_, true_debris_;
+  edm::rt::Output<double> true_kerf_debris_, wire_load_;
   edm::rt::Output<bool> wire_broken_, driver_fault_;
   // Outputs from the runtime.
   edm::rt::Input<double> vx_cmd_, vy_cmd_, vz_cmd_;
