@@ -1,6 +1,7 @@
 // edm-greyhorizon — redoes seed 000's choice of the grey predictor's horizon p for each
 // Butterworth cut-off (Lee & Liao 2003, Table 2) on Rab recorded from the wire simulator.
-// Records io.rab every 40 ms (the paper's sampling period) from config/machines/wire-sim.yaml on
+// Records io.rab every 40 ms (the paper's sampling period) from
+// config/bench/controllers/wire-horizon.yaml (B6 conditions, fixed settings) on
 // the virtual clock, then for each Wn picks p by RMS error against the 50-step moving average
 // shifted 25 steps (apps/greyhorizon/horizon.hpp). Same seed → same table.
 // Exit codes: 0 ok, 1 the run failed (wire broken, config error), 2 bad arguments.
@@ -51,8 +52,10 @@ constexpr const char* kUsage =
     "                       [--max-p P] [--window n] [--warmup W]\n"
     "  --seed     simulator seed (default 1)\n"
     "  --samples  Rab samples at 40 ms (default 3000 = 120 s)\n"
-    "  --skip-s   simulated seconds before the record starts (default 2)\n"
-    "  --config   wire machine config (default <source>/config/machines/wire-sim.yaml)\n"
+    "  --skip-s   simulated seconds before the record starts (default 30: the kerf debris\n"
+    "             settles)\n"
+    "  --config   wire machine config (default\n"
+    "             <source>/config/bench/controllers/wire-horizon.yaml)\n"
     "  --io       extra simulator params, e.g. \"wire_thickness_profile: '0:10,40:30'\"\n"
     "  --csv      also write the RMS error for every Wn and p to PATH\n"
     "  --raw      also write the recorded Rab (one sample a line) to PATH\n"
@@ -144,11 +147,12 @@ std::vector<double> record_rab(const std::string& config_path, std::int64_t seed
 int main(int argc, char** argv) {
   std::int64_t seed = 1;
   std::int64_t samples = 3000;
-  std::int64_t skip_s = 2;
+  std::int64_t skip_s = 30;
   std::int64_t max_p = 60;
   std::int64_t window = 5;
   std::int64_t warmup = 300;
-  std::string config = std::string(EDM_SOURCE_DIR) + "/config/machines/wire-sim.yaml";
+  std::string config =
+      std::string(EDM_SOURCE_DIR) + "/config/bench/controllers/wire-horizon.yaml";
   std::string csv;
   std::string raw;
   std::string io_extra;

@@ -88,6 +88,8 @@ void SelfTuningFuzzyPI::visit_pins(rt::PinVisitor& v) {
   v.input("rab_f", rab_f_, "1");
   v.input("rab_ref", rab_ref_, "1");
   v.input("enable", enable_);
+  v.input("track_arc_off_time_us", track_u_, "us");
+  v.input("track_servo_ref_v", track_v_, "V");
   v.output("arc_off_time_us", arc_off_time_us_, "us");
   v.output("servo_ref_v", servo_ref_v_, "V");
   v.output("du", du_, "1");
@@ -131,6 +133,18 @@ rt::BlockStatus SelfTuningFuzzyPI::update(const rt::CycleContext& /*ctx*/) noexc
     ++samples_;
   }
   if (settling || !enable_.get()) {
+    // Idle: follow the commands another controller applies (when wired, > 0), so that the
+    // incremental law of eq. 4-5 continues from them when this block takes over (bumpless).
+    const double tu = track_u_.get();
+    const double tv = track_v_.get();
+    if (std::isfinite(tu) && tu > 0.0) {
+      u_ = std::min(std::max(tu, p.u_min_us), p.u_max_us);
+    }
+    if (std::isfinite(tv) && tv > 0.0) {
+      v_ = std::min(std::max(tv, p.v_min_v), p.v_max_v);
+    }
+    arc_off_time_us_.set(u_);
+    servo_ref_v_.set(v_);
     du_.set(0.0);
     saturated_.set(false);
     return rt::BlockStatus::kOk;

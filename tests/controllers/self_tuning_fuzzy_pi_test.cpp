@@ -224,6 +224,50 @@ TEST(SelfTuningFuzzyPI, disabled_holds_and_faults_on_non_finite_inputs) {
   EXPECT_EQ(pi.u(), u2);
 }
 
+// Bumpless transfer: while disabled the outputs follow the tracked commands (clamped to Table 1's
+// ranges); on enabling, the incremental law (eq. 4-5) starts from the last tracked values, so
+// the first step differs from them by one increment of eq. 4-5 and no more.
+TEST(SelfTuningFuzzyPI, disabled_block_tracks_the_applied_commands_and_takes_over_bumplessly) {
+  SelfTuningFuzzyPIParams p;  // case 1 of Table 5: u 9 … 50 µs, v 30 … 70 V, starts at 20 / 40
+  BlockHarness<SelfTuningFuzzyPI> h;
+  ASSERT_TRUE(h.start(p).empty());
+  auto& rab_p = h.source<double>("rab_p");
+  auto& rab_f = h.source<double>("rab_f");
+  auto& enable = h.source<bool>("enable");
+  auto& track_u = h.source<double>("track_arc_off_time_us");
+  auto& track_v = h.source<double>("track_servo_ref_v");
+  enable.set(false);
+  rab_p.set(0.5);
+  rab_f.set(0.5);
+  const double us[] = {12.0, 33.3, 80.0, 4.0, 27.5};
+  const double vs[] = {41.7, 55.0, 90.0, 10.0, 48.25};
+  for (int k = 0; k < 5; ++k) {
+    track_u.set(us[k]);
+    track_v.set(vs[k]);
+    EXPECT_EQ(h.step(), BlockStatus::kOk);
+    EXPECT_EQ(h.out("arc_off_time_us"), std::clamp(us[k], p.u_min_us, p.u_max_us)) << k;
+    EXPECT_EQ(h.out("servo_ref_v"), std::clamp(vs[k], p.v_min_v, p.v_max_v)) << k;
+  }
+  enable.set(true);
+  rab_p.set(0.55);  // e = 0.05 below the set point: no overload, Ψ = 1
+  rab_f.set(0.55);
+  h.step();
+  const double e = p.rab_ref_default - 0.55;
+  const double du = h.out("du");
+  const double scale = std::fabs(e) * h.out("phi") * 1.0;
+  EXPECT_NEAR(h.out("arc_off_time_us"), 27.5 + du * p.ku * scale, 1e-12);
+  EXPECT_NEAR(h.out("servo_ref_v"), 48.25 + du * p.kv * scale, 1e-12);
+  EXPECT_LE(std::fabs(h.out("arc_off_time_us") - 27.5), 3.0 * p.ku * std::fabs(e));
+  EXPECT_LE(std::fabs(h.out("servo_ref_v") - 48.25), 3.0 * p.kv * std::fabs(e));
+  // Unwired (0) tracking inputs leave the hold behaviour unchanged.
+  enable.set(false);
+  track_u.set(0.0);
+  track_v.set(0.0);
+  const double u_held = h.out("arc_off_time_us");
+  h.step();
+  EXPECT_EQ(h.out("arc_off_time_us"), u_held);
+}
+
 // A first-order plant: Rab relaxes toward a level that falls as the arc-off time u and the servo
 // reference v rise (paper, Figs. 2-3).
 struct Plant {

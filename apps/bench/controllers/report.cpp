@@ -117,8 +117,8 @@ std::string write_plot(const std::string& dir, const ScenarioResult& r) {
   }
   {
     auto gp = open_out(dir + "/" + s.id + ".gp");
-    gp << "set terminal pngcairo size 900," << (s.plot_jitter ? 900 : 480)
-       << " noenhanced\nset output '" << s.id << ".png'\n";
+    gp << "set terminal pngcairo size 1100," << (s.plot_jitter ? 900 : 480)
+       << " noenhanced\nset output '" << s.id << ".png'\nset rmargin 18\n";
     if (s.plot_jitter) {
       gp << "set multiplot layout 2,1\n";
     }

@@ -106,6 +106,7 @@ class SelfTuningFuzzyPI final : public rt::BlockWithParams<SelfTuningFuzzyPIPara
 
  private:
   rt::Input<double> rab_p_, rab_f_, rab_ref_;
+  rt::Input<double> track_u_, track_v_;  // bumpless transfer: the commands applied while idle
   rt::Input<bool> enable_{true};
   rt::Output<double> arc_off_time_us_, servo_ref_v_, du_, phi_, psi_, error_;
   rt::Output<bool> saturated_;
