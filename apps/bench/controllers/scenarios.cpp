@@ -58,10 +58,16 @@ std::vector<Variant> wire_variants(const WireCase& c, double limit_s) {
   // (8 s) the filter and predictor need to settle, so its start-up transient cannot act.
   RunSpec settled = grey;
   settled.edits.push_back({"settle_samples: 0}", "settle_samples: 200}"});
+  // Gain study: Table 5's Ku and Kv × 3, the smallest multiple (of 1, 3, 10) that brought case
+  // 1's Rab to its set point on seed 101 (not a benchmark seed); docs/benchmarks.md, B6.
+  RunSpec gain3 = grey;
+  gain3.edits[1].to = "ol: " + fmt(c.ol) + ", ku: " + fmt(3.0 * c.ku) + ", kv: " +
+                      fmt(3.0 * c.kv) + ", rab_ref_default: " + fmt(c.rab_ref);
   return {{"no control (fixed settings)", fixed},
           {"self-tuning fuzzy PI + grey predictor", grey},
           {"self-tuning fuzzy PI, no predictor", nogrey},
-          {"self-tuning fuzzy PI + grey, 8 s hold", settled}};
+          {"self-tuning fuzzy PI + grey, 8 s hold", settled},
+          {"self-tuning fuzzy PI + grey, Ku, Kv × 3", gain3}};
 }
 
 }  // namespace
