@@ -18,6 +18,7 @@
 #include "edm/blocks/position_loop.hpp"
 #include "edm/blocks/recursive_least_squares.hpp"
 #include "edm/blocks/self_tuning_fuzzy_pi.hpp"
+#include "edm/blocks/select.hpp"
 #include "edm/blocks/self_tuning_regulator.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/sine_source.hpp"
@@ -33,6 +34,7 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<Limiter>("Limiter", "clamp to [min, max] with an optional slew-rate limit");
   r.add<MovingAverage>("MovingAverage", "mean of the last `window` samples, O(1) per cycle");
   r.add<SineSource>("SineSource", "sine test signal, phase exact from the cycle count");
+  r.add<Select>("Select", "IEC SEL of two signals with a bumpless (ramped) transfer");
   r.add<Integrator>("Integrator", "integrator with clamping anti-windup and reset");
   // Seed 004: deep-hole drilling.
   r.add<TdDetector>("TdDetector", "mean ignition delay and open/short ratios over a window");

@@ -1,0 +1,72 @@
+#include "edm/blocks/select.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edm/blocks/validation.hpp"
+
+namespace edm::blocks {
+
+std::vector<rt::ParamError> SelectParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  if (ramp_time < rt::Duration::zero()) {
+    errs.push_back({"ramp_time", "must be >= 0"});
+  }
+  return errs;
+}
+
+void Select::visit_pins(rt::PinVisitor& v) {
+  v.input("g", g_);
+  v.input("in0", in0_);
+  v.input("in1", in1_);
+  v.output("out", out_);
+  v.output("active0", active0_);
+  v.output("active1", active1_);
+  v.output("transferring", transferring_);
+}
+
+std::vector<rt::ParamError> Select::configure(const rt::BlockSetup& setup) {
+  std::vector<rt::ParamError> errs;
+  require_task_period(errs, setup.period);
+  dt_s_ = rt::to_seconds(setup.period);
+  return errs;
+}
+
+void Select::activate() noexcept {
+  has_prev_ = false;
+  bump_ = ramp_left_s_ = ramp_total_s_ = 0.0;
+  // Blocks ahead of this one in the program, and readers in other tasks, may read the outputs
+  // before the first update: give them the selection and the selected input's value now. The
+  // blocks ahead are activated first, so a g wired to another Select's active1 is already set.
+  const bool sel = g_.get() || params_.select;
+  active0_.set(!sel);
+  active1_.set(sel);
+  transferring_.set(false);
+  const double src = sel ? in1_.get() : in0_.get();
+  out_.set(std::isfinite(src) ? src : 0.0);
+}
+
+rt::BlockStatus Select::update(const rt::CycleContext& /*ctx*/) noexcept {
+  const bool sel = g_.get() || params_.select;
+  const double src = sel ? in1_.get() : in0_.get();
+  if (!std::isfinite(src)) {
+    return rt::BlockStatus::kFault;
+  }
+  if (has_prev_ && sel != sel_) {
+    ramp_total_s_ = rt::to_seconds(params_.ramp_time);
+    ramp_left_s_ = ramp_total_s_;
+    bump_ = ramp_total_s_ > 0.0 ? out_.get() - src : 0.0;
+  } else if (ramp_left_s_ > 0.0) {
+    ramp_left_s_ = std::max(0.0, ramp_left_s_ - dt_s_);
+  }
+  const double weight = ramp_total_s_ > 0.0 ? ramp_left_s_ / ramp_total_s_ : 0.0;
+  out_.set(src + bump_ * weight);
+  sel_ = sel;
+  has_prev_ = true;
+  active0_.set(!sel);
+  active1_.set(sel);
+  transferring_.set(weight > 0.0);
+  return rt::BlockStatus::kOk;
+}
+
+}  // namespace edm::blocks
