@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
     md << "**B7** determinism: the same seed twice\n\n| run | identical |\n|---|---|\n";
     const auto b7 = edm::bench::make_scenarios(true);
     const std::pair<const char*, std::size_t> picks[] = {
-        {"B1", 0}, {"B5", 1}, {"B5", 2}, {"B6a", 1}};  // B1 P, B5 STR and ILC, B6a fuzzy + grey
+        {"B1", 0}, {"B5", 1}, {"B5", 2}, {"B5", 3},  // B1 P, B5 STR, ILC, ILC warm start,
+        {"B6a", 1}};                                  // B6a fuzzy + grey
     for (const auto& [id, vi] : picks) {
       const auto it = std::find_if(b7.begin(), b7.end(), [&](const auto& s) { return s.id == id; });
       edm::bench::RunSpec spec = it->variants.at(vi).spec;

@@ -6,7 +6,9 @@
 namespace edm::blocks {
 namespace {
 
-constexpr std::size_t kSamplesIndex = 0;  // n_samples in IterativeLearningControlParams::visit()
+// Positions in IterativeLearningControlParams::visit().
+constexpr std::size_t kSamplesIndex = 0;       // n_samples
+constexpr std::size_t kWarmCyclesIndex = 11;  // warm_cycles
 
 }  // namespace
 
@@ -14,6 +16,7 @@ std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
   std::vector<rt::ParamError> errs;
   rt::require_range(errs, "n_samples", static_cast<double>(n_samples), 2.0,
                     static_cast<double>(kMaxSamples));
+  rt::require_range(errs, "warm_cycles", static_cast<double>(warm_cycles), 0.0, 1e6);
   const std::pair<const char*, double> all[] = {
       {"p0", p0},           {"k_delta", k_delta}, {"q_pole", q_pole},       {"lambda1", lambda1},
       {"lambda2", lambda2}, {"lambda3", lambda3}, {"u_initial", u_initial}, {"u_min", u_min},
@@ -56,6 +59,7 @@ void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
   v.input("y", y_);
   v.input("y_ref", y_ref_);
   v.input("cycle_start", cycle_start_);
+  v.input("track", track_, "position unit");
   v.input("enable", enable_);
   v.output("u", u_out_);
   v.output("mean_error", mean_error_);
@@ -65,6 +69,7 @@ void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
   v.output("l3", l3_);
   v.output("sample", sample_, "samples");
   v.output("cycles", cycles_);
+  v.output("active", active_);
 }
 
 std::vector<rt::ParamError> IterativeLearningControl::configure(const rt::BlockSetup& /*setup*/) {
@@ -86,6 +91,10 @@ void IterativeLearningControl::activate() noexcept {
   x_ = 0.0;
   last_e_ = 0.0;
   cycles_done_ = 0;
+  warm_done_ = 0;
+  prev_warm_mean_ = 0.0;
+  warm_ = params_.warm_cycles > 0;
+  active_.set(!warm_);
   const Gains g = gains(params_);
   l1_.set(g.l1);
   l2_.set(g.l2);
@@ -129,6 +138,24 @@ void IterativeLearningControl::learn() noexcept {
   cycles_.set(cycles_done_);
 }
 
+void IterativeLearningControl::end_warm_cycle() noexcept {
+  double mean = 0.0;
+  for (double u : u_) {
+    mean += u;
+  }
+  mean /= static_cast<double>(u_.size());
+  ++warm_done_;
+  if (warm_done_ >= params_.warm_cycles) {
+    const Gains g = gains(params_);
+    // The other controller's advance per cycle becomes this one's (l3·x at zero mean error).
+    x_ = warm_done_ >= 2 && g.l3 != 0.0 ? (mean - prev_warm_mean_) / g.l3 : 0.0;
+    learn();
+    warm_ = false;
+    active_.set(true);
+  }
+  prev_warm_mean_ = mean;
+}
+
 rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/) noexcept {
   const auto& p = params_;
   const double y = y_.get();
@@ -140,6 +167,10 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   if (!std::isfinite(y) || !std::isfinite(ref) || n == 0) {
     return rt::BlockStatus::kFault;
   }
+  const double track = track_.get();
+  if (warm_ && (!track_.connected() || !std::isfinite(track))) {
+    return rt::BlockStatus::kFault;  // warm_cycles > 0 needs the applied position wired
+  }
   const bool learning = enable_.get();
   if (idx_ >= 0) {
     last_e_ = ref - y;
@@ -148,10 +179,16 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   const bool boundary = rising || (p.auto_cycle && (idx_ < 0 || idx_ == n - 1));
   if (boundary) {
     if (idx_ >= 0) {
+      const auto last = static_cast<std::size_t>(idx_);
       for (std::int64_t i = idx_ + 1; i < n; ++i) {
         e_[static_cast<std::size_t>(i)] = last_e_;  // a cycle cut short
+        if (warm_) {
+          u_[static_cast<std::size_t>(i)] = u_[last];
+        }
       }
-      if (learning) {
+      if (warm_) {
+        end_warm_cycle();
+      } else if (learning) {
         learn();
       }
     }
@@ -163,6 +200,14 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
     } else {
       overrun_ = true;
     }
+  }
+  if (warm_) {
+    if (idx_ >= 0) {
+      u_[static_cast<std::size_t>(idx_)] = track;  // u_j(k): the position applied at sample k
+      sample_.set(idx_);
+    }
+    u_out_.set(track);
+    return rt::BlockStatus::kOk;
   }
   if (idx_ < 0) {
     u_out_.set(p.u_initial);
@@ -177,6 +222,9 @@ std::vector<rt::ParamError> IterativeLearningControl::stage_param(std::size_t in
                                                                   const rt::ParamValue& v) {
   if (index == kSamplesIndex) {
     return {{"n_samples", "cannot change at run time (it sizes the buffers); reload the config"}};
+  }
+  if (index == kWarmCyclesIndex) {
+    return {{"warm_cycles", "cannot change at run time (the warm-up starts at activation)"}};
   }
   return BlockWithParams::stage_param(index, v);
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "blocks/block_harness.hpp"
@@ -206,6 +207,118 @@ TEST(IterativeLearningControl, with_a_real_axis_and_q_filter_the_learning_conver
   EXPECT_LT(diff(r.errors.size() - 2), 1e-6 * diff(0));
   EXPECT_LT(rms(r.errors.back()), 0.2 * rms(r.errors[0])) << "most of the error is learnt";
   EXPECT_GT(rms(r.errors.back()), 1e-4) << "Q leaves a residual";
+}
+
+// Warm start: while another controller runs the first W cycles, the block outputs `track`,
+// records it as u_j with e_j, and at the end of cycle W outputs u_j+1 = Q·(u_j + L·e_j). The
+// expected cycle is computed here from the lifted matrices of the paper (Q's first column
+// 1 − Σ q, Q(i, m) = q_{i−m} below the diagonal), not from the block's recursion.
+TEST(IterativeLearningControl, warm_start_learns_the_first_cycle_from_the_recorded_one) {
+  constexpr int kN = 12;
+  auto p = params(kN, 0.4, 2.0, 0.3, 0.6, 0.5, 0.2);
+  p.warm_cycles = 1;
+  BlockHarness<IterativeLearningControl> h;
+  ASSERT_TRUE(h.start(p).empty());
+  auto& y = h.source<double>("y");
+  auto& edge = h.source<bool>("cycle_start");
+  auto& track = h.source<double>("track");
+  h.source<double>("y_ref").set(1.0);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> pos(-0.5, 0.5), volt(0.0, 2.0);
+  std::vector<double> u_rec(kN), e_rec(kN);
+  // One sample before the first edge (not recorded), then one whole recorded cycle.
+  track.set(pos(rng));
+  h.step();
+  EXPECT_FALSE(h.out<bool>("active"));
+  for (int k = 0; k < kN; ++k) {
+    edge.set(k == 0);
+    const double t = pos(rng);
+    track.set(t);
+    h.step();  // stores the error of sample k − 1 (y set below), outputs sample k
+    EXPECT_EQ(h.out("u"), t) << "warm-up: u follows track";
+    EXPECT_FALSE(h.out<bool>("active"));
+    u_rec[static_cast<std::size_t>(k)] = t;
+    const double yk = volt(rng);
+    y.set(yk);
+    e_rec[static_cast<std::size_t>(k)] = 1.0 - yk;
+  }
+  // Expected u_1 = Q·(u_0 + L·e_0), x = 0 (one warm cycle gives no advance per cycle).
+  const auto g = IterativeLearningControl::gains(p);
+  double mean = 0.0;
+  for (double e : e_rec) {
+    mean += e / kN;
+  }
+  std::vector<double> v(kN), expected(kN);
+  for (int i = 0; i < kN; ++i) {
+    const auto si = static_cast<std::size_t>(i);
+    v[si] = u_rec[si] + g.l1 * (e_rec[si] - mean) + g.l2 * mean;
+  }
+  const double a = p.q_pole;
+  for (int i = 0; i < kN; ++i) {
+    double row = v[0];
+    for (int m = 1; m <= i; ++m) {
+      row += (1.0 - a) * std::pow(a, i - m) * (v[static_cast<std::size_t>(m)] - v[0]);
+    }
+    expected[static_cast<std::size_t>(i)] = row;
+  }
+  for (int k = 0; k < kN; ++k) {
+    edge.set(k == 0);
+    track.set(99.0);  // no longer read
+    h.step();
+    EXPECT_TRUE(h.out<bool>("active"));
+    EXPECT_NEAR(h.out("u"), expected[static_cast<std::size_t>(k)], 1e-12) << "sample " << k;
+  }
+  EXPECT_EQ(h.out<std::int64_t>("cycles"), 1);
+}
+
+// With W ≥ 2 the forward motion continues at the other controller's last advance per cycle:
+// two recorded cycles at c and c + d with zero error, then (still zero error) c + 2d, c + 3d …
+// With W = 1 there is no advance to continue: the block holds c + d.
+TEST(IterativeLearningControl, warm_start_continues_the_advance_per_cycle) {
+  constexpr int kN = 8;
+  constexpr double c = 0.3, d = -0.011;
+  for (const std::int64_t warm : {1, 2}) {
+    auto p = params(kN, 0.05, 3000.0, 0.9, 0.7, 0.7, 0.09);
+    p.warm_cycles = warm;
+    p.u_min = -20;
+    BlockHarness<IterativeLearningControl> h;
+    ASSERT_TRUE(h.start(p).empty());
+    auto& edge = h.source<bool>("cycle_start");
+    auto& track = h.source<double>("track");
+    h.source<double>("y_ref").set(45.0);
+    h.source<double>("y").set(45.0);
+    const std::int64_t first_learnt = warm;  // cycles 0 … W−1 recorded
+    for (std::int64_t j = 0; j < first_learnt + 3; ++j) {
+      const double recorded = c + d * static_cast<double>(j + 2 - warm);
+      for (int k = 0; k < kN; ++k) {
+        edge.set(k == 0);
+        track.set(recorded);
+        h.step();
+        if (j >= first_learnt) {
+          const double expected =
+              warm >= 2 ? c + d * static_cast<double>(j + 2 - warm) : c + d;
+          EXPECT_NEAR(h.out("u"), expected, 1e-12) << "W " << warm << ", cycle " << j;
+        }
+      }
+    }
+  }
+}
+
+TEST(IterativeLearningControl, warm_start_needs_track_wired_and_is_load_time_only) {
+  IterativeLearningControlParams p;
+  p.n_samples = 4;
+  p.warm_cycles = 1;
+  BlockHarness<IterativeLearningControl> h;
+  ASSERT_TRUE(h.start(p).empty());
+  h.source<double>("y").set(0.0);
+  EXPECT_EQ(h.step(), BlockStatus::kFault) << "warm-up without track: nothing to record";
+  h.source<double>("track").set(std::nan(""));
+  EXPECT_EQ(h.step(), BlockStatus::kFault);
+  h.source<double>("track").set(0.2);
+  EXPECT_EQ(h.step(), BlockStatus::kOk);
+  EXPECT_FALSE(h.block().stage_param(11, rt::ParamValue::of_int(0)).empty());
+  p.warm_cycles = -1;
+  EXPECT_FALSE(p.validate().empty());
 }
 
 TEST(IterativeLearningControl, cycle_handling_and_validation) {

@@ -250,14 +250,17 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
         vars.force("io.vz_cmd", 30.0);
         force(spec.jump_cycle_var, 1.0);
         force(spec.jump_hold_var, spec.jump_hold_value);
+        force(spec.jump_track_var, rt::read_pin_as_double(z));
       } else if (phase == 1) {
         force(spec.jump_cycle_var, 0.0);
       } else if (phase == kJumpUpMs) {
         vars.force("io.vz_cmd", -30.0);
       } else if (phase == kJumpUpMs + kJumpDownMs) {
         vars.unforce("io.vz_cmd");
-        if (!spec.jump_hold_var.empty()) {
-          vars.unforce(spec.jump_hold_var);
+        for (const std::string* name : {&spec.jump_hold_var, &spec.jump_track_var}) {
+          if (!name->empty()) {
+            vars.unforce(*name);
+          }
         }
       }
     }

@@ -220,9 +220,14 @@ std::vector<Scenario> make_scenarios(bool quick) {
     ilc.jump_cycle_var = "gap.ilc.cycle_start";
     ilc.jump_hold_var = "gap.ilc.y";
     ilc.jump_hold_value = 45.0;
+    // The ILC learning from the integral controller's first two jump cycles, then taking over.
+    RunSpec warm = ilc;
+    warm.config = "config/bench/controllers/sink-ilc-warm.yaml";
+    warm.jump_track_var = "gap.ilc.track";
     s.variants = {{"voltage servo 45 V (baseline)", v},
                   {"self-tuning regulator (seed 001)", str},
-                  {"iterative learning control (seed 002)", ilc}};
+                  {"iterative learning control (seed 002)", ilc},
+                  {"ILC learning from the voltage servo's first 2 cycles", warm}};
     s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
                  col("spark %", &Outcome::ratio_normal_pct, 1),
                  col("transient arc %", &Outcome::ratio_tarc_pct),

@@ -27,6 +27,14 @@
 // auto_cycle is set); a cycle cut short repeats its last error over the missing samples, a cycle
 // longer than N holds u_j(N−1) and keeps overwriting e_j(N−1) (status kSaturated). Before the
 // first cycle edge (without auto_cycle) the output is u_initial and nothing is learnt.
+//
+// Warm start (warm_cycles W > 0): another controller (the paper's integral controller) runs the
+// first W complete cycles while this block records the position it applies (input `track`) as
+// u_j, with the error e_j, and outputs u = track (`active` false: wire a Select's g to it). At
+// the end of cycle W it learns u_j+1 = Q·(u_j + L·e_j) from the recorded cycle and takes over
+// (`active` true). With W ≥ 2 it also starts the forward motion where the other controller left
+// it: x = (mean(u_W) − mean(u_W−1))/l3, so that l3·x, the advance per cycle at zero mean error,
+// equals the other controller's last advance per cycle. Without it, x = 0.
 // Cost O(N) per cycle edge, O(1) otherwise. N sizes buffers allocated in configure().
 // RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
 
@@ -51,6 +59,7 @@ struct IterativeLearningControlParams {
   double u_min{-1e9};     // clamp of u [position unit]
   double u_max{1e9};
   bool auto_cycle{false};  // the cycle ends every N samples without cycle_start
+  std::int64_t warm_cycles{0};  // cycles another controller runs while u is recorded from track
 
   void visit(rt::ParamVisitor& v) {
     v.param("n_samples", n_samples, "samples", "samples per cycle N (2..65536), load time only");
@@ -64,6 +73,8 @@ struct IterativeLearningControlParams {
     v.param("u_min", u_min, "", "lower clamp of u");
     v.param("u_max", u_max, "", "upper clamp of u");
     v.param("auto_cycle", auto_cycle, "", "a cycle ends every n_samples without cycle_start");
+    v.param("warm_cycles", warm_cycles, "cycles",
+            "complete cycles recorded from `track` before this block takes over (0: none)");
   }
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
@@ -89,10 +100,14 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
  private:
   void learn() noexcept;
 
-  rt::Input<double> y_, y_ref_;
+  /// End of a warm-up cycle: counts it; after the last one, learns from it and takes over.
+  void end_warm_cycle() noexcept;
+
+  rt::Input<double> y_, y_ref_, track_;
   rt::Input<bool> cycle_start_, enable_{true};
   rt::Output<double> u_out_, mean_error_, x_out_, l1_, l2_, l3_;
   rt::Output<std::int64_t> sample_, cycles_;
+  rt::Output<bool> active_;
   std::vector<double> u_;
   std::vector<double> e_;
   std::int64_t idx_{-1};  // sample output last update; −1 before the first cycle
@@ -101,6 +116,9 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   double x_{0.0};
   double last_e_{0.0};
   std::int64_t cycles_done_{0};
+  std::int64_t warm_done_{0};     // complete cycles recorded from track
+  double prev_warm_mean_{0.0};    // mean of the previous recorded cycle's u
+  bool warm_{false};              // recording from track (warm_done_ < warm_cycles)
 };
 
 }  // namespace edm::blocks
