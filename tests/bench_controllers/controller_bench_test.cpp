@@ -152,6 +152,24 @@ TEST(ControllerBench, B5IlcJitterBelowTheVoltageServo) {
   EXPECT_LT(ilc.ratio_short_pct, 1.0);
 }
 
+// Seed 001's claims on B5: the main loop's y_v tracks its reference and arcs stay suppressed
+// (here: stable arcs at the voltage servo's level, transient arcs within 1.5x of it).
+TEST(ControllerBench, B5StrTracksItsReferenceAndKeepsArcsAtTheBaselinesLevel) {
+  const auto all = make_scenarios(/*quick=*/true);
+  const Scenario& b5 = scenario(all, "B5");
+  ASSERT_NE(b5.variants[1].spec.config.find("sink-str"), std::string::npos);
+  const Outcome servo = run(kRoot, b5.variants[0].spec);
+  const Outcome str = run(kRoot, b5.variants[1].spec);
+  EXPECT_TRUE(std::isnan(servo.loop_err_rms)) << "the servo has no y_v loop";
+  ASSERT_FALSE(std::isnan(str.loop_err_rms));
+  EXPECT_NEAR(str.loop_y_mean, str.loop_ref_mean, 0.1);
+  EXPECT_LT(str.loop_err_rms, 0.1);
+  EXPECT_GT(str.loop_ref_mean, 0.9) << "the reference decision found the gap good";
+  EXPECT_LE(str.ratio_sarc_pct, 2.0 * servo.ratio_sarc_pct + 0.005);
+  EXPECT_LE(str.ratio_tarc_pct, 1.5 * servo.ratio_tarc_pct);
+  EXPECT_GT(str.mrr_mm3_min, servo.mrr_mm3_min);
+}
+
 // The paper's comparison (Fig. 1): the ILC learning from the integral controller (the voltage
 // servo) it replaces. Until the ILC takes over the machine is the servo's, bit for bit; then
 // the ILC's z-jitter falls over the cycles while the servo's stays where it was.

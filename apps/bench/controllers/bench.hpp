@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,6 +40,8 @@ struct RunSpec {
   std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
   double jump_hold_value{0.0};
   std::string jump_track_var;   // non-empty: forced to io.z_mm at the jump's start while forced
+  std::string loop_y_var;       // non-empty (B5 STR): a loop's output y, scored against ...
+  std::string loop_ref_var;     // ... its reference, every ms outside the jumps and settling
   double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
   double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
   double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)
@@ -75,6 +78,10 @@ struct Outcome {
   double jitter_um{0.0};        // z-jitter RMS per jump cycle [µm], mean over cycles
   double jitter_first_um{0.0};  // mean of the first 3 cycles
   double jitter_last_um{0.0};   // mean of the last 3 cycles
+  // RunSpec::loop_y_var against loop_ref_var (NaN: the run has no such loop, printed "—").
+  double loop_y_mean{std::numeric_limits<double>::quiet_NaN()};
+  double loop_ref_mean{std::numeric_limits<double>::quiet_NaN()};
+  double loop_err_rms{std::numeric_limits<double>::quiet_NaN()};
   // B4: the 64 wall bins of the simulator at the end.
   double wall_err_um{0.0};     // mean bin radius − target [µm]
   double circularity_um{0.0};  // max − min bin radius [µm]

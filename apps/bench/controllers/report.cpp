@@ -1,5 +1,7 @@
 // Reports of the controller benchmark: markdown table, CSV, gnuplot plot.
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -49,6 +51,10 @@ std::string markdown_table(const ScenarioResult& r) {
       std::vector<double> xs;
       for (const Outcome& o : r.outcomes[v]) {
         xs.push_back(c.get(o));
+      }
+      if (std::all_of(xs.begin(), xs.end(), [](double x) { return std::isnan(x); })) {
+        md << " — |";  // the figure does not apply to this controller
+        continue;
       }
       const auto [m, sd] = mean_sd(xs);
       md << ' ' << fixed(m, c.precision) << " ± " << fixed(sd, c.precision) << " |";

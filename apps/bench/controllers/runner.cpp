@@ -126,6 +126,9 @@ std::vector<std::pair<const char*, double>> Outcome::fields() const {
           {"jitter_um", jitter_um},
           {"jitter_first_um", jitter_first_um},
           {"jitter_last_um", jitter_last_um},
+          {"loop_y_mean", loop_y_mean},
+          {"loop_ref_mean", loop_ref_mean},
+          {"loop_err_rms", loop_err_rms},
           {"wall_err_um", wall_err_um},
           {"circularity_um", circularity_um},
           {"wall_worst_um", wall_worst_um},
@@ -190,6 +193,10 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   const rt::PinRef electrode = pin("io.electrode_mm"), broken = pin("io.wire_broken");
   const rt::PinRef rab = pin("io.rab"), wire_load = pin("io.wire_load");
   const bool has_done = !spec.done_var.empty();
+  const bool has_loop = !spec.loop_y_var.empty();
+  const rt::PinRef loop_y = has_loop ? pin(spec.loop_y_var) : rt::PinRef{};
+  const rt::PinRef loop_ref = has_loop ? pin(spec.loop_ref_var) : rt::PinRef{};
+  double loop_y_sum = 0, loop_ref_sum = 0, loop_err_ss = 0, loop_n = 0;
   const rt::PinRef done = has_done ? pin(spec.done_var) : rt::PinRef{};
 
   const sim::Plant* plant = nullptr;
@@ -297,8 +304,17 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
       o.retracts += 1;
     }
     vz_high = high;
-    if (period_ms > 0 && (k - 1) % period_ms >= kJumpUpMs + kJumpDownMs + kSettleMs) {
+    const bool servo_part =
+        period_ms == 0 || (k - 1) % period_ms >= kJumpUpMs + kJumpDownMs + kSettleMs;
+    if (period_ms > 0 && servo_part) {
       fit.add(t_s, rt::read_pin_as_double(z));
+    }
+    if (has_loop && servo_part) {
+      const double y = rt::read_pin_as_double(loop_y), yr = rt::read_pin_as_double(loop_ref);
+      loop_y_sum += y;
+      loop_ref_sum += yr;
+      loop_err_ss += (y - yr) * (y - yr);
+      loop_n += 1;
     }
     if (rt::read_pin_as_double(wire_load) > 0.9) {
       o.overload_s += 1e-3;
@@ -386,6 +402,11 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     o.break_time_s = spec.limit_s;
   }
   o.rab_mean = rab_n > 0 ? rab_sum / rab_n : 0.0;
+  if (loop_n > 0) {
+    o.loop_y_mean = loop_y_sum / loop_n;
+    o.loop_ref_mean = loop_ref_sum / loop_n;
+    o.loop_err_rms = std::sqrt(loop_err_ss / loop_n);
+  }
   o.rab_err_rms = rab_err_n > 0 ? std::sqrt(rab_err_ss / rab_err_n) : 0.0;
   if (plant != nullptr) {
     double sum = 0, lo = 1e9, hi = -1e9;

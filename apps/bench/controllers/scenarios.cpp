@@ -215,6 +215,10 @@ std::vector<Scenario> make_scenarios(bool quick) {
     v.jump_period_s = 1.5;
     RunSpec str = v;
     str.config = "config/machines/sink-str-sim.yaml";
+    str.loop_y_var = "adapt.str.y_v";
+    str.loop_ref_var = "adapt.str.y_rv";
+    str.jump_hold_var = "adapt.str.enable";
+    str.jump_hold_value = 0.0;
     RunSpec ilc = v;
     ilc.config = "config/bench/controllers/sink-ilc.yaml";
     ilc.jump_cycle_var = "gap.ilc.cycle_start";
@@ -236,7 +240,10 @@ std::vector<Scenario> make_scenarios(bool quick) {
                  col("open %", &Outcome::ratio_open_pct, 1),
                  col("z-jitter µm (mean/cycle)", &Outcome::jitter_um),
                  col("first 3 cycles µm", &Outcome::jitter_first_um),
-                 col("last 3 cycles µm", &Outcome::jitter_last_um)};
+                 col("last 3 cycles µm", &Outcome::jitter_last_um),
+                 col("y_v (STR)", &Outcome::loop_y_mean, 3),
+                 col("y_rv (STR)", &Outcome::loop_ref_mean, 3),
+                 col("y_v − y_rv RMS", &Outcome::loop_err_rms, 3)};
     s.plot_column = 0;
     s.plot_jitter = true;
     out.push_back(std::move(s));
