@@ -353,6 +353,10 @@ programs:
       - {name: ilc, type: IterativeLearningControl,
          params: {n_samples: 100, p0: 0.5, k_delta: 0.01, q_pole: 0.2, auto_cycle: true,
                   u_min: -0.5, u_max: 0.5}}
+      - {name: ilcw, type: IterativeLearningControl,
+         params: {n_samples: 100, p0: 0.5, k_delta: 0.01, auto_cycle: true, warm_cycles: 2,
+                  u_min: -60, u_max: 20}}
+      - {name: sel, type: Select, params: {ramp_time: 10ms}}
     wires:
       str.ratio_normal: io.ratio_normal
       str.ratio_transient_arc: io.ratio_transient_arc
@@ -365,6 +369,12 @@ programs:
       rls.phi1: 1.0
       ilc.y: io.gap_voltage_v
       ilc.y_ref: 45.0
+      ilcw.y: io.gap_voltage_v
+      ilcw.y_ref: 45.0
+      ilcw.track: io.z_mm
+      sel.g: ilcw.active
+      sel.in0: 0.0
+      sel.in1: ilcw.u
       io.gen_arm: true
       io.gen_on: true
 trace:
@@ -376,6 +386,8 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed001And002Blocks) {
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.001) << "the machine servo sank";
   EXPECT_GE(r->variables().read("sink.ilc.cycles").value(), 29.0) << "the ILC learnt";
+  EXPECT_EQ(r->variables().read("sink.ilcw.active").value(), 1.0) << "the warm start ended";
+  EXPECT_EQ(r->variables().read("sink.sel.active1").value(), 1.0) << "the Select switched";
   EXPECT_NE(r->variables().read("sink.rls.trace_p").value(), 2000.0) << "the RLS estimated";
 }
 
@@ -384,6 +396,13 @@ TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
   auto r = build_shipped("drill-sim-program");
   EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
   EXPECT_EQ(r->variables().read("cycle.drill.state"), 2.0) << "drilling after 5 s";
+}
+
+TEST(Allocations, NoneInsideCyclesOfTheWireMachineWithItsControllerSwitch) {
+  // Butterworth → GM(1,1) → SelfTuningFuzzyPI and the two Selects of the operator's switch.
+  auto r = build_shipped("wire-stfpi-sim");
+  EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
+  EXPECT_EQ(r->variables().read("rupture.sel_u.active1"), 1.0);
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
