@@ -22,6 +22,7 @@
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/low_pass.hpp"
 #include "edm/blocks/moving_average.hpp"
+#include "edm/blocks/select.hpp"
 #include "edm/blocks/sine_source.hpp"
 #include "edm/runtime/block.hpp"
 
@@ -177,6 +178,33 @@ void BM_Integrator(benchmark::State& state) {
   bench_single<Integrator>(state, {.k = 0.5, .min = -1.0, .max = 1.0, .initial = 0.0});
 }
 
+// Select switching every 64 cycles with a 10 ms ramp: most cycles are inside a ramp.
+void BM_Select(benchmark::State& state) {
+  Select block;
+  if (!start(state, block, {.select = false, .ramp_time = 10ms})) {
+    return;
+  }
+  rt::Output<double> source;
+  rt::Output<bool> g;
+  pin_of(block, "in0").as_input<double>()->set_constant(0.5);
+  pin_of(block, "in1").as_input<double>()->connect(source);
+  pin_of(block, "g").as_input<bool>()->connect(g);
+  const rt::PinRef out = pin_of(block, "out");
+  rt::Block& b = block;
+  const auto& table = input_table();
+  rt::CycleContext ctx;
+  ctx.period = kPeriod;
+  ctx.dt_s = 1e-3;
+  ctx.state = rt::MachineState::kRunning;
+  run_cycles(state, [&] {
+    source.set(table[ctx.cycle & (kTableSize - 1)]);
+    g.set(((ctx.cycle >> 6) & 1) != 0);
+    benchmark::DoNotOptimize(b.update(ctx));
+    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
+    ++ctx.cycle;
+  });
+}
+
 // The realistic chain: five blocks, four wires, one task cycle each.
 void BM_Chain(benchmark::State& state) {
   SineSource sine;
@@ -220,6 +248,7 @@ BENCHMARK(BM_Limiter);
 BENCHMARK(BM_MovingAverage)->Arg(16)->Arg(4096);
 BENCHMARK(BM_SineSource);
 BENCHMARK(BM_Integrator);
+BENCHMARK(BM_Select);
 BENCHMARK(BM_Chain);
 
 }  // namespace
