@@ -7,7 +7,7 @@ namespace edm::blocks {
 namespace {
 
 // Positions in IterativeLearningControlParams::visit().
-constexpr std::size_t kSamplesIndex = 0;       // n_samples
+constexpr std::size_t kSamplesIndex = 0;      // n_samples
 constexpr std::size_t kWarmCyclesIndex = 11;  // warm_cycles
 
 }  // namespace

@@ -295,8 +295,7 @@ TEST(IterativeLearningControl, warm_start_continues_the_advance_per_cycle) {
         track.set(recorded);
         h.step();
         if (j >= first_learnt) {
-          const double expected =
-              warm >= 2 ? c + d * static_cast<double>(j + 2 - warm) : c + d;
+          const double expected = warm >= 2 ? c + d * static_cast<double>(j + 2 - warm) : c + d;
           EXPECT_NEAR(h.out("u"), expected, 1e-12) << "W " << warm << ", cycle " << j;
         }
       }

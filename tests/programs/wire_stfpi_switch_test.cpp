@@ -27,8 +27,8 @@ namespace {
 using namespace std::chrono_literals;
 
 TEST(WireStfpiSwitch, the_operator_switches_controller_and_fixed_settings_without_a_bump) {
-  auto r = build_sim_machine(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
-                                                   "/config/machines/wire-stfpi-sim.yaml"));
+  auto r = build_sim_machine(
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/wire-stfpi-sim.yaml"));
   r->machine().command(rt::MachineCommand::kPowerOn);
   std::vector<rt::Task*> tasks;
   for (const auto& t : r->tasks()) {

@@ -39,9 +39,9 @@ struct RunSpec {
   std::string jump_cycle_var;   // non-empty (B5 ILC): forced 1 for the first ms of each jump
   std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
   double jump_hold_value{0.0};
-  std::string jump_track_var;   // non-empty: forced to io.z_mm at the jump's start while forced
-  std::string loop_y_var;       // non-empty (B5 STR): a loop's output y, scored against ...
-  std::string loop_ref_var;     // ... its reference, every ms outside the jumps and settling
+  std::string jump_track_var;    // non-empty: forced to io.z_mm at the jump's start while forced
+  std::string loop_y_var;        // non-empty (B5 STR): a loop's output y, scored against ...
+  std::string loop_ref_var;      // ... its reference, every ms outside the jumps and settling
   double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
   double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
   double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)
@@ -61,11 +61,11 @@ struct Outcome {
   double open_pct{0.0};         // open pulses / all pulses [%]
   double retracts{0.0};         // rising edges of io.vz_cmd above +0.2 mm/s (jumps excluded)
   double electrode_used_mm{0.0};
-  double td_rms_us{0.0};     // RMS(Td − Td_ref) per cycle
-  double wire_broken{0.0};   // 1: the wire broke
-  double break_time_s{0.0};  // [s]; the time limit when it did not break
-  double rab_mean{0.0};      // mean io.rab after the transient
-  double rab_err_rms{0.0};   // RMS of (1 s mean Rab − ref) after the transient
+  double td_rms_us{0.0};      // RMS(Td − Td_ref) per cycle
+  double wire_broken{0.0};    // 1: the wire broke
+  double break_time_s{0.0};   // [s]; the time limit when it did not break
+  double rab_mean{0.0};       // mean io.rab after the transient
+  double rab_err_rms{0.0};    // RMS of (1 s mean Rab − ref) after the transient
   double rab_above_max{0.0};  // max (1 s mean Rab − ref) after the transient (rupture side)
   double rab_below_max{0.0};  // max (ref − 1 s mean Rab) after the transient (speed lost)
   double overload_s{0.0};     // time with Ī > 0.9 I_BK [s] (simulator truth)

@@ -61,8 +61,8 @@ std::vector<Variant> wire_variants(const WireCase& c, double limit_s) {
   // Gain study: Table 5's Ku and Kv × 3, the smallest multiple (of 1, 3, 10) that brought case
   // 1's Rab to its set point on seed 101 (not a benchmark seed); docs/benchmarks.md, B6.
   RunSpec gain3 = grey;
-  gain3.edits[1].to = "ol: " + fmt(c.ol) + ", ku: " + fmt(3.0 * c.ku) + ", kv: " +
-                      fmt(3.0 * c.kv) + ", rab_ref_default: " + fmt(c.rab_ref);
+  gain3.edits[1].to = "ol: " + fmt(c.ol) + ", ku: " + fmt(3.0 * c.ku) + ", kv: " + fmt(3.0 * c.kv) +
+                      ", rab_ref_default: " + fmt(c.rab_ref);
   return {{"no control (fixed settings)", fixed},
           {"self-tuning fuzzy PI + grey predictor", grey},
           {"self-tuning fuzzy PI, no predictor", nogrey},
@@ -258,15 +258,15 @@ std::vector<Scenario> make_scenarios(bool quick) {
   // cases 1-2; settings that hold on the thin/unholed part (20 µs, 40 V) for cases 3-4.
   const std::string u0 = "open_voltage_v: 110, ";
   const std::vector<WireCase> cases = {
-      {"B6a", "wire, case 1: improper settings (H = 50 mm)",
-       u0 + "wire_thickness_profile: '0:50'", 30.0, 9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
-      {"B6b", "wire, case 2: thick work (H = 100 mm)", u0 + "wire_thickness_profile: '0:100'",
+      {"B6a", "wire, case 1: improper settings (H = 50 mm)", u0 + "wire_thickness_profile: '0:50'",
        30.0, 9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
+      {"B6b", "wire, case 2: thick work (H = 100 mm)", u0 + "wire_thickness_profile: '0:100'", 30.0,
+       9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
       {"B6c", "wire, case 3: thickness step 10 → 30 mm at 3 mm of cut",
        u0 + "wire_thickness_profile: '0:10,3:30'", 40.0, 20.0, 2.0, 0.08, 0.16, 0.42, 10.0},
       {"B6d", "wire, case 4: internal hole at 6 … 7 mm of cut (H = 10 mm)",
-       u0 + "wire_thickness_profile: '0:10', wire_hole_from_mm: 6, wire_hole_to_mm: 7", 40.0,
-       20.0, 3.0, 0.07, 0.14, 0.42, 10.0},
+       u0 + "wire_thickness_profile: '0:10', wire_hole_from_mm: 6, wire_hole_to_mm: 7", 40.0, 20.0,
+       3.0, 0.07, 0.14, 0.42, 10.0},
   };
   for (const WireCase& c : cases) {
     Scenario s;

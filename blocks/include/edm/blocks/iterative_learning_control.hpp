@@ -58,7 +58,7 @@ struct IterativeLearningControlParams {
   double u_initial{0.0};  // u before learning and in the first cycle [position unit]
   double u_min{-1e9};     // clamp of u [position unit]
   double u_max{1e9};
-  bool auto_cycle{false};  // the cycle ends every N samples without cycle_start
+  bool auto_cycle{false};       // the cycle ends every N samples without cycle_start
   std::int64_t warm_cycles{0};  // cycles another controller runs while u is recorded from track
 
   void visit(rt::ParamVisitor& v) {
@@ -116,9 +116,9 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   double x_{0.0};
   double last_e_{0.0};
   std::int64_t cycles_done_{0};
-  std::int64_t warm_done_{0};     // complete cycles recorded from track
-  double prev_warm_mean_{0.0};    // mean of the previous recorded cycle's u
-  bool warm_{false};              // recording from track (warm_done_ < warm_cycles)
+  std::int64_t warm_done_{0};   // complete cycles recorded from track
+  double prev_warm_mean_{0.0};  // mean of the previous recorded cycle's u
+  bool warm_{false};            // recording from track (warm_done_ < warm_cycles)
 };
 
 }  // namespace edm::blocks

@@ -30,11 +30,12 @@
 namespace edm::blocks {
 
 struct SelectParams {
-  bool select{false};                        // selects in1 (OR-ed with the input g)
+  bool select{false};                            // selects in1 (OR-ed with the input g)
   rt::Duration ramp_time{rt::Duration::zero()};  // bump decay time after a switch, ≥ 0
 
   void visit(rt::ParamVisitor& v) {
-    v.param("select", select, "", "true selects in1 (OR-ed with the input g); writable at run time");
+    v.param("select", select, "",
+            "true selects in1 (OR-ed with the input g); writable at run time");
     v.param("ramp_time", ramp_time, "s",
             "after a switch, the output's step decays linearly to 0 over this time (0 = at once)");
   }
@@ -59,7 +60,7 @@ class Select final : public rt::BlockWithParams<SelectParams> {
   double dt_s_{0.0};
   bool has_prev_{false};
   bool sel_{false};
-  double bump_{0.0};       // b: out − src at the switch
+  double bump_{0.0};         // b: out − src at the switch
   double ramp_left_s_{0.0};  // time left in the ramp
   double ramp_total_s_{0.0};
 };
