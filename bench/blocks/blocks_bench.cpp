@@ -134,6 +134,25 @@ void run_cycles(benchmark::State& state, Fn&& one_cycle) {
   state.counters["max_ns"] = hist.max_ns();
 }
 
+// Runs block b once per iteration with `source` fed from the random table; `per_cycle(cycle)`
+// sets any further inputs before each update.
+template <class PerCycle>
+void run_block(benchmark::State& state, rt::Block& b, rt::Output<double>& source,
+               const rt::PinRef& out, PerCycle&& per_cycle) {
+  const auto& table = input_table();
+  rt::CycleContext ctx;
+  ctx.period = kPeriod;
+  ctx.dt_s = 1e-3;
+  ctx.state = rt::MachineState::kRunning;
+  run_cycles(state, [&] {
+    source.set(table[ctx.cycle & (kTableSize - 1)]);
+    per_cycle(ctx.cycle);
+    benchmark::DoNotOptimize(b.update(ctx));
+    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
+    ++ctx.cycle;
+  });
+}
+
 // One block with its "in" pin fed from the random table.
 template <class B>
 void bench_single(benchmark::State& state, const typename B::Params& p) {
@@ -145,19 +164,7 @@ void bench_single(benchmark::State& state, const typename B::Params& p) {
   if (auto* in = pin_of(block, "in").template as_input<double>()) {
     in->connect(source);
   }
-  const rt::PinRef out = pin_of(block, "out");
-  rt::Block& b = block;
-  const auto& table = input_table();
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
-  run_cycles(state, [&] {
-    source.set(table[ctx.cycle & (kTableSize - 1)]);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  run_block(state, block, source, pin_of(block, "out"), [](auto /*cycle*/) {});
 }
 
 void BM_Gain(benchmark::State& state) { bench_single<Gain>(state, {.k = 1.5, .offset = 0.25}); }
@@ -189,20 +196,8 @@ void BM_Select(benchmark::State& state) {
   pin_of(block, "in0").as_input<double>()->set_constant(0.5);
   pin_of(block, "in1").as_input<double>()->connect(source);
   pin_of(block, "g").as_input<bool>()->connect(g);
-  const rt::PinRef out = pin_of(block, "out");
-  rt::Block& b = block;
-  const auto& table = input_table();
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
-  run_cycles(state, [&] {
-    source.set(table[ctx.cycle & (kTableSize - 1)]);
-    g.set(((ctx.cycle >> 6) & 1) != 0);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  run_block(state, block, source, pin_of(block, "out"),
+            [&g](auto cycle) { g.set(((cycle >> 6) & 1) != 0); });
 }
 
 // The realistic chain: five blocks, four wires, one task cycle each.
