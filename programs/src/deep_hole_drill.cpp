@@ -1,5 +1,6 @@
 #include "edm/programs/deep_hole_drill.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <string_view>
@@ -97,6 +98,7 @@ void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
   v.input("tdr_us", tdr_us_, "us");
   v.input("through", through_);
   v.input("hold", hold_);
+  v.input("vz_servo_mm_s", vz_servo_, "mm/s");
   v.output("vz_cmd_mm_s", vz_cmd_mm_s_, "mm/s");
   v.output("gen_on", gen_on_);
   v.output("state", state_);
@@ -145,9 +147,9 @@ std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& 
   }
   wire_child(errs, gap_, "gap", "tdr_us", c_tdr_us_);
   gap_vz_ = child_output<double>(errs, gap_, "gap", "vz_mm_s");
-  if (gap_vz_ != nullptr) {
-    wire_child(errs, wear_, "wear", "vz_in_mm_s", *gap_vz_);
-  }
+  wire_child(errs, wear_, "wear", "vz_in_mm_s", c_servo_vz_);
+  servo_v_min_ = -gap_.params().v_feed_max_mm_s;
+  servo_v_max_ = gap_.params().v_retract_max_mm_s;
   wire_child(errs, wear_, "wear", "wear_ratio", c_wear_ratio_);
   wire_child(errs, wear_, "wear", "enable", c_wear_enable_);
   wire_child(errs, wear_, "wear", "reset_wear", c_reset_wear_);
@@ -183,6 +185,7 @@ void DeepHoleDrill::activate_self() noexcept {
   safe_retract_ = false;
   c_reset_wear_.set(false);
   c_wear_enable_.set(true);
+  c_servo_vz_.set(0.0);
   c_wear_ratio_.set(params_.wear_ratio_default);
   vz_cmd_mm_s_.set(0.0);
   gen_on_.set(false);
@@ -291,6 +294,17 @@ rt::BlockStatus DeepHoleDrill::update(const rt::CycleContext& ctx) noexcept {
       status = rt::worst(status, td_.update(ctx));
     }
     status = rt::worst(status, gap_.update(ctx));
+    if (vz_servo_.connected()) {
+      const double v = vz_servo_.get();
+      if (std::isfinite(v)) {
+        c_servo_vz_.set(std::clamp(v, servo_v_min_, servo_v_max_));
+      } else {
+        c_servo_vz_.set(0.0);
+        status = rt::worst(status, rt::BlockStatus::kFault);
+      }
+    } else {
+      c_servo_vz_.set(gap_vz_ != nullptr ? gap_vz_->get() : 0.0);
+    }
     status = rt::worst(status, wear_.update(ctx));
     c_reset_wear_.set(false);
     // The electrode front is z − accumulated wear: the compensated axis travels further than the

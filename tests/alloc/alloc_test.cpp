@@ -187,11 +187,14 @@ std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
   return total;
 }
 
-TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
-  // The whole machine of config/machines/drill-sim.yaml running a job from its JobStore: the
-  // EdmJob sequencer (rapid, condition, gap-controlled drilling with wear compensation) and the
-  // simulator inside the I/O task's input latch. 3 s of drilling, ~60 000 pulses.
-  auto r = build_shipped("drill-sim");
+class DrillMachines : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DrillMachines, NoAllocationInsideCyclesWhileAJobDrills) {
+  // The whole machine of config/machines/<param>.yaml running a job from its JobStore: the
+  // EdmJob sequencer (rapid, condition, gap-controlled drilling with wear compensation; in
+  // drill-fuzzy-sim seed 003's counter and fuzzy LUT servo drive it) and the simulator inside the
+  // I/O task's input latch. 3 s of drilling, ~60 000 pulses.
+  auto r = build_shipped(GetParam());
   std::vector<machining::MotionBlock> job(4);
   job[0].kind = machining::MotionKind::kRapid;
   job[0].target = {0, 0, 0.1};
@@ -208,6 +211,12 @@ TEST(Allocations, NoneInsideCyclesOfTheSimulatedDrillMachine) {
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "it really drilled";
   EXPECT_EQ(r->variables().read("cnc.job.drill.state"), 2.0) << "drilling from the job";
 }
+
+INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachines, ::testing::Values("drill-sim", "drill-fuzzy-sim"),
+                         [](const ::testing::TestParamInfo<const char*>& p) {
+                           return std::string(p.param) == "drill-sim" ? "PGapController"
+                                                                      : "FuzzyServo";
+                         });
 
 // Every seed-004 block in one program on the simulated drill: Td detector → P gap controller →
 // wear compensation → Z, interpolators and position loops for X/Y, orbit expander, polarity

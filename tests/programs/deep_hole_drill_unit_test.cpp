@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <limits>
 #include <map>
 #include <string>
+#include <utility>
 
 #include "edm/programs/deep_hole_drill.hpp"
 #include "edm/programs/register.hpp"
@@ -168,6 +170,51 @@ TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
   EXPECT_EQ(r.state(), 2) << "wear makes the front shallower than the axis";
   EXPECT_LT(r.out<double>("depth_reached_mm"), 2.0);
   EXPECT_GT(r.out<double>("depth_reached_mm"), 1.95);
+}
+
+// A wired vz_servo_mm_s replaces the P law in DRILL (clamped to the gap child's −1 … +5 mm/s),
+// passes through the same wear compensation, and a broken (non-finite) value stops the feed.
+TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
+  Rig r(params());
+  rt::Output<double> servo;
+  r.in<double>("vz_servo_mm_s").connect(servo);
+  r.comp.set(false);
+  r.start.set(true);
+  r.sparks(20, 12.0);  // the P law would feed at −0.2 mm/s
+  servo.set(-0.3);     // the external servo says otherwise
+  for (int k = 0; k < 2; ++k) r.step();
+  ASSERT_EQ(r.state(), 1) << "approach is the sequence's own: the servo is not used";
+  EXPECT_DOUBLE_EQ(r.vz(), -0.5);
+  r.step();  // the third cycle with sparks: touch, and the first DRILL cycle
+  ASSERT_EQ(r.state(), 2);
+  EXPECT_DOUBLE_EQ(r.vz(), -0.3);
+  r.step();
+  EXPECT_NEAR(r.out<double>("gap.vz_mm_s"), -0.2, 1e-9) << "the P law still runs, observable";
+  servo.set(+0.7);  // back off
+  r.step();
+  EXPECT_DOUBLE_EQ(r.vz(), +0.7);
+  for (const auto& [cmd, want] : {std::pair{-3.0, -1.0}, std::pair{9.0, 5.0}}) {
+    servo.set(cmd);
+    EXPECT_EQ(r.drill.update(r.ctx), rt::BlockStatus::kOk);
+    EXPECT_DOUBLE_EQ(r.vz(), want) << "clamped to the gap child's limits";
+  }
+  servo.set(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(r.drill.update(r.ctx), rt::BlockStatus::kFault);
+  EXPECT_DOUBLE_EQ(r.vz(), 0.0) << "a broken servo signal stops the feed";
+  EXPECT_EQ(r.state(), 2);
+}
+
+TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
+  Rig r(params());
+  rt::Output<double> servo;
+  r.in<double>("vz_servo_mm_s").connect(servo);
+  r.start.set(true);
+  r.sparks(20, 12.0);
+  servo.set(-0.25);
+  for (int k = 0; k < 20; ++k) r.step();
+  ASSERT_EQ(r.state(), 2);
+  const double area = (1.1 * 1.1) / (1.0 - 0.09);
+  EXPECT_NEAR(r.vz(), -0.25 - 0.6 * area * 0.25, 1e-9);  // vz_in − Vd, vz_in = the servo's
 }
 
 TEST(DeepHoleDrill, SafeStateTurnsTheGeneratorOffAndBacksZOffWithoutFinishing) {

@@ -85,12 +85,17 @@ struct JobResult {
   double short_fraction{0.0};
 };
 
-JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::Vec3 start) {
+// Runs `program` on the machine of config/machines/<machine> (1 ms motion task, 10 ms supervisor)
+// until the job finishes or the machine faults; `on_cycle` sees the variables after every
+// motion cycle.
+template <class OnCycle>
+JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::Vec3 start,
+                  const std::string& machine, OnCycle&& on_cycle) {
   JobResult res;
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(seed);
   auto r = build_sim_machine(
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"), opts);
+      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/" + machine), opts);
   const auto issues = machining::check_program(program, r->tables(), start);
   EXPECT_TRUE(issues.empty()) << issues[0].message;
   EXPECT_EQ(r->job().load(program), rt::LoadResult::kOk);
@@ -111,6 +116,7 @@ JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::
     motion.run_cycle(t, clock);
     if (k % 10 == 0) supervisor.run_cycle(t, clock);
     if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    on_cycle(vars);
     if (vars.read("cnc.job.drill.state").value() == 2.0) {
       shorts += vars.read("io.n_short").value();
       for (const char* n :
@@ -136,6 +142,10 @@ JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::
   }
   EXPECT_EQ(r->machine().state(), rt::MachineState::kReady) << "the job stops the machine";
   return res;
+}
+
+JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::Vec3 start) {
+  return run_job(seed, program, start, "drill-sim.yaml", [](const auto&) {});
 }
 
 class JobSeeds : public ::testing::TestWithParam<int> {};
@@ -176,6 +186,40 @@ TEST(PartPrograms, DrillThenFinishExampleOnTheSimulatedMachine) {
   EXPECT_NEAR(j.r_min_mm, 0.60, 0.01);  // the hole axis is fixed at the first spark, while XY
                                         // may still settle by a few µm
   EXPECT_NEAR(j.r_max_mm, 0.60, 0.012);
+}
+
+// Seed 003's fuzzy LUT servo selected for the drilling blocks (config/machines/drill-fuzzy-sim.yaml
+// wires job.drill.vz_servo_mm_s): the same part program drills the hole to depth, and in every
+// DRILL cycle the command the wear compensator receives is the fuzzy servo's (clamped to the gap
+// limits), not the P law's.
+TEST(DrillFuzzyServo, SelectedByWiringItDrillsTheHoleOnTheFuzzyCommand) {
+  std::vector<MotionBlock> p = drill_then_finish(10.0, 0.6);
+  p.erase(p.begin() + 4, p.begin() + 7);  // drop the re-entry rapid, E2 and the orbit finish
+  std::int64_t drill_cycles = 0, mismatches = 0, differs_from_p = 0, backoffs = 0;
+  const JobResult j =
+      run_job(1, p, {0, 0, 0.1}, "drill-fuzzy-sim.yaml", [&](const rt::VariableRegistry& v) {
+        if (v.read("cnc.job.drill.state").value() != 2.0) return;
+        ++drill_cycles;
+        const double servo = std::clamp(v.read("cnc.dir.out").value(), -1.0, 5.0);
+        const double into_wear = v.read("cnc.job.drill.wear.vz_in_mm_s").value();
+        if (into_wear != servo) ++mismatches;
+        if (std::abs(v.read("cnc.job.drill.gap.vz_mm_s").value() - servo) > 0.05) ++differs_from_p;
+        if (servo > 0.0) ++backoffs;
+      });
+  std::printf(
+      "[edm_job] fuzzy servo: finished %d in %.1f s, depth %.4f mm, %lld drill cycles, "
+      "%lld backing off, %lld differ from the P law, shorts %.2f %%\n",
+      j.finished, j.time_s, j.depth_mm, static_cast<long long>(drill_cycles),
+      static_cast<long long>(backoffs), static_cast<long long>(differs_from_p),
+      100 * j.short_fraction);
+  ASSERT_TRUE(j.finished);
+  EXPECT_GT(drill_cycles, 1000);
+  EXPECT_EQ(mismatches, 0) << "DRILL feeds the external servo's command";
+  EXPECT_GT(differs_from_p, drill_cycles / 10) << "and it is not the P law's";
+  EXPECT_GT(backoffs, 0) << "the fuzzy servo backs off on shorts: it is closed-loop";
+  EXPECT_NEAR(j.depth_mm, 10.0, 0.1);
+  EXPECT_NEAR(j.z_end_mm, 5.0, 0.05);
+  EXPECT_LE(j.short_fraction, 0.05);
 }
 
 }  // namespace

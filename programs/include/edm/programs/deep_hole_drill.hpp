@@ -15,6 +15,12 @@
 //   1 APPROACH  generator on, vz = −approach_speed_mm_s until sparks are seen (td_count > 0) on
 //               touch_cycles consecutive cycles; then touch_z_mm = z_mm, wear_mm is reset → DRILL.
 //   2 DRILL     td → gap → wear → vz_cmd_mm_s (wear compensation only if enable_wear_comp).
+//               An external gap servo replaces gap's Vz when the input vz_servo_mm_s is wired
+//               (the config wires `<job>.drill.vz_servo_mm_s`, e.g. seed 003's fuzzy LUT servo):
+//               vz_servo_mm_s (Z up positive, like vz_cmd_mm_s) clamped to gap's
+//               [−v_feed_max_mm_s, +v_retract_max_mm_s] → wear → vz_cmd_mm_s. td and gap
+//               still run (their outputs stay observable). A non-finite vz_servo_mm_s is a
+//               broken signal: the feed stops (vz 0 into wear) and update() returns kFault.
 //               Hole depth estimate (the electrode front is z − accumulated wear):
 //                 depth_reached_mm = (touch_z_mm − z_mm) − (enable_wear_comp ? wear.wear_mm : 0)
 //                 (output wear_mm: that estimated electrode wear of this cycle)
@@ -124,7 +130,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<bool> enable_wear_comp_{true};
   rt::Input<double> tdr_us_;  // ≤ 0 (unwired): the tdr_us parameter
   rt::Input<bool> through_;
-  rt::Input<bool> hold_;  // a through hole: detect the breakthrough
+  rt::Input<bool> hold_;        // a through hole: detect the breakthrough
+  rt::Input<double> vz_servo_;  // wired: an external gap servo replaces gap's Vz in DRILL
   rt::Output<double> vz_cmd_mm_s_;
   rt::Output<bool> gen_on_;
   rt::Output<std::int64_t> state_;
@@ -138,9 +145,11 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<bool> c_wear_enable_{true};
   rt::Output<bool> c_reset_wear_;
   rt::Output<double> c_tdr_us_;
+  rt::Output<double> c_servo_vz_;  // gap's Vz or the external servo's → wear.vz_in_mm_s
   // Children's outputs read by the sequence.
   const rt::Output<double>* gap_vz_{nullptr};
   const rt::Output<double>* wear_vz_{nullptr};
+  double servo_v_min_{0.0}, servo_v_max_{0.0};  // gap's clamp, applied to the external servo
   const rt::Output<double>* wear_mm_{nullptr};
 
   State state_value_{State::kIdle};
