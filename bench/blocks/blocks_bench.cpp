@@ -19,6 +19,7 @@
 
 #include "edm/blocks/gain.hpp"
 #include "edm/blocks/integrator.hpp"
+#include "edm/blocks/jump_cycle.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/low_pass.hpp"
 #include "edm/blocks/moving_average.hpp"
@@ -200,6 +201,24 @@ void BM_Select(benchmark::State& state) {
             [&g](auto cycle) { g.set(((cycle >> 6) & 1) != 0); });
 }
 
+// JumpCycle with a short period (100 ms: 4 up, 5 down): the servo pass-through and the jump
+// branches both run, z fed from the table.
+void BM_JumpCycle(benchmark::State& state) {
+  JumpCycle block;
+  if (!start(state, block,
+             {.period = 100ms,
+              .up_time = 4ms,
+              .down_time = 5ms,
+              .up_speed_mm_s = 30.0,
+              .down_speed_mm_s = 30.0})) {
+    return;
+  }
+  rt::Output<double> source;
+  pin_of(block, "vz_in_mm_s").as_input<double>()->connect(source);
+  pin_of(block, "z_mm").as_input<double>()->connect(source);
+  run_block(state, block, source, pin_of(block, "vz_out_mm_s"), [](auto /*cycle*/) {});
+}
+
 // The realistic chain: five blocks, four wires, one task cycle each.
 void BM_Chain(benchmark::State& state) {
   SineSource sine;
@@ -244,6 +263,7 @@ BENCHMARK(BM_MovingAverage)->Arg(16)->Arg(4096);
 BENCHMARK(BM_SineSource);
 BENCHMARK(BM_Integrator);
 BENCHMARK(BM_Select);
+BENCHMARK(BM_JumpCycle);
 BENCHMARK(BM_Chain);
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "edm/blocks/grey_predictor_gm11.hpp"
 #include "edm/blocks/integrator.hpp"
 #include "edm/blocks/iterative_learning_control.hpp"
+#include "edm/blocks/jump_cycle.hpp"
 #include "edm/blocks/limiter.hpp"
 #include "edm/blocks/linear_interpolator.hpp"
 #include "edm/blocks/low_pass.hpp"
@@ -46,6 +47,8 @@ void register_builtin_blocks(rt::BlockRegistry& r) {
   r.add<LinearInterpolator>("LinearInterpolator", "seed 004 eq. 12-13, exact end point");
   r.add<CircularInterpolator>("CircularInterpolator", "seed 004 eq. 14-19, G02/G03, full circles");
   r.add<OrbitExpander>("OrbitExpander", "seed 004 eq. 20-21: radius += kr·mean Td per revolution");
+  // Die sinking: the periodic flushing jump (one jump cycle = one cycle of seed 002's ILC).
+  r.add<JumpCycle>("JumpCycle", "periodic electrode jump of die sinking; cycle edges, held z");
   // Seed 003: discharge-state statistics and the fuzzy servo lookup table.
   r.add<DischargeStateCounter>("DischargeStateCounter",
                                "seed 003: open/normal/short counts of the last 32 pulses, latched");

@@ -414,6 +414,15 @@ TEST(Allocations, NoneInsideCyclesOfTheWireMachineWithItsControllerSwitch) {
   EXPECT_EQ(r->variables().read("rupture.sel_u.active1"), 1.0);
 }
 
+TEST(Allocations, NoneInsideCyclesOfTheSinkMachineWithJumpsAndTheIlc) {
+  // JumpCycle, the integral controller's warm cycles, the ILC's learning at each jump edge and
+  // its take-over through the Select at the third jump (4.5 s).
+  auto r = build_shipped("sink-ilc-sim");
+  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
+  EXPECT_EQ(r->variables().read("gap.jump.jumps"), 3.0);
+  EXPECT_EQ(r->variables().read("gap.ilc.active"), 1.0) << "the ILC drives after the take-over";
+}
+
 TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
   auto r = build_shipped("finish-sim-program");  // polarity switch, then orbiting
   EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);

@@ -1,0 +1,138 @@
+#include "edm/blocks/jump_cycle.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edm/blocks/validation.hpp"
+#include "edm/runtime/machine.hpp"
+
+namespace edm::blocks {
+
+namespace {
+
+std::int64_t cycles_of(rt::Duration d, rt::Duration period) noexcept {
+  if (period <= rt::Duration::zero()) {
+    return 1;
+  }
+  return std::max<std::int64_t>(1, std::llround(rt::to_seconds(d) / rt::to_seconds(period)));
+}
+
+}  // namespace
+
+std::vector<rt::ParamError> JumpCycleParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  if (up_time <= rt::Duration::zero()) {
+    errs.push_back({"up_time", "must be > 0"});
+  }
+  if (down_time <= rt::Duration::zero()) {
+    errs.push_back({"down_time", "must be > 0"});
+  }
+  if (period <= up_time + down_time) {
+    errs.push_back(
+        {"period", "must be > up_time + down_time (the servo needs time between jumps)"});
+  }
+  rt::require_positive(errs, "up_speed_mm_s", up_speed_mm_s);
+  rt::require_positive(errs, "down_speed_mm_s", down_speed_mm_s);
+  return errs;
+}
+
+void JumpCycle::visit_pins(rt::PinVisitor& v) {
+  v.input("vz_in_mm_s", vz_in_, "mm/s");
+  v.input("z_mm", z_mm_, "mm");
+  v.input("enable", enable_);
+  v.output("vz_out_mm_s", vz_out_, "mm/s");
+  v.output("z_hold_mm", z_hold_, "mm");
+  v.output("jumping", jumping_);
+  v.output("cycle_start", cycle_start_);
+  v.output("jumps", jumps_);
+}
+
+std::vector<rt::ParamError> JumpCycle::configure(const rt::BlockSetup& setup) {
+  std::vector<rt::ParamError> errs;
+  require_task_period(errs, setup.period);
+  task_period_ = setup.period;
+  params_changed();
+  return errs;
+}
+
+void JumpCycle::params_changed() noexcept {
+  period_n_ = cycles_of(params_.period, task_period_);
+  up_n_ = cycles_of(params_.up_time, task_period_);
+  down_n_ = cycles_of(params_.down_time, task_period_);
+  period_n_ = std::max(period_n_, up_n_ + down_n_ + 1);  // rounding must not swallow the servo
+}
+
+void JumpCycle::reset() noexcept {
+  n_ = 0;
+  phase_ = -1;
+  jumping_.set(false);
+  cycle_start_.set(false);
+}
+
+void JumpCycle::activate() noexcept {
+  reset();
+  jumps_.set(0);
+  was_enabled_ = true;
+  was_safe_ = false;
+  const double v = vz_in_.get();
+  vz_out_.set(std::isfinite(v) ? v : 0.0);
+  const double z = z_mm_.get();
+  z_hold_.set(std::isfinite(z) ? z : 0.0);
+}
+
+void JumpCycle::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
+  reset();
+  vz_out_.set(0.0);
+}
+
+rt::BlockStatus JumpCycle::update(const rt::CycleContext& ctx) noexcept {
+  rt::BlockStatus status = rt::BlockStatus::kOk;
+  const bool safe = rt::is_safe_state(ctx.state);
+  const bool enabled = enable_.get() && !safe;
+  if (enabled && (!was_enabled_ || was_safe_)) {
+    n_ = 0;  // a whole period of servo before the first jump after (re-)enabling
+  }
+  was_enabled_ = enable_.get();
+  was_safe_ = safe;
+
+  cycle_start_.set(false);
+  if (safe) {
+    phase_ = -1;
+  } else if (phase_ < 0 && enabled) {
+    ++n_;
+    if (n_ >= period_n_) {
+      n_ = 0;
+      phase_ = 0;
+      cycle_start_.set(true);
+      jumps_.set(jumps_.get() + 1);
+    }
+  } else if (phase_ >= 0) {
+    ++n_;  // the period runs from one jump's start to the next
+  }
+
+  const bool jumping = phase_ >= 0 && phase_ < up_n_ + down_n_;
+  const double z = z_mm_.get();
+  if (!std::isfinite(z)) {
+    status = rt::BlockStatus::kFault;
+  } else if (!jumping || phase_ == 0) {
+    z_hold_.set(z);  // follows z, and holds its value of the jump's first cycle
+  }
+
+  if (jumping) {
+    vz_out_.set(phase_ < up_n_ ? params_.up_speed_mm_s : -params_.down_speed_mm_s);
+    jumping_.set(true);
+    ++phase_;
+    return status;
+  }
+  phase_ = -1;
+  jumping_.set(false);
+  const double v = vz_in_.get();
+  if (!std::isfinite(v)) {
+    vz_out_.set(0.0);
+    return rt::BlockStatus::kFault;
+  }
+  vz_out_.set(v);
+  return status;
+}
+
+}  // namespace edm::blocks
