@@ -124,8 +124,11 @@ std::vector<Scenario> make_scenarios(bool quick) {
     p.done_var = "cycle.drill.state";
     RunSpec off = p;
     off.edits.push_back({"drill.enable_wear_comp: true", "drill.enable_wear_comp: false"});
+    RunSpec fuzzy = p;  // seed 003's servo inside DeepHoleDrill (its vz_servo_mm_s input)
+    fuzzy.config = "config/bench/controllers/drill-fuzzy-wear.yaml";
     s.variants = {{"P + real-time wear compensation (eq. 8)", p},
-                  {"P without wear compensation", off}};
+                  {"P without wear compensation", off},
+                  {"fuzzy LUT servo (seed 003) + wear compensation (eq. 8)", fuzzy}};
     s.columns = {col("done", &Outcome::reached), col("depth error µm", &Outcome::depth_error_um, 0),
                  col("electrode used mm", &Outcome::electrode_used_mm),
                  col("cycle time s", &Outcome::time_s, 1)};
