@@ -2,14 +2,20 @@
 // Builds a Runtime for the programs' simulator tests: every built-in block and program type, the
 // runtime's drivers and the simulator driver (registries built once, shared by all tests).
 
+#include <gtest/gtest.h>
+
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "edm/blocks/register.hpp"
 #include "edm/programs/register.hpp"
+#include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
+#include "edm/runtime/scheduler.hpp"
 #include "edm/sim/sim_driver.hpp"
 
 namespace edm::test {
@@ -26,5 +32,34 @@ inline std::unique_ptr<rt::Runtime> build_sim_machine(const rt::Config& cfg,
   }();
   return rt::Runtime::build(cfg, registries.first, registries.second, options);
 }
+
+// A shipped machine (config/machines/<name>.yaml) powered on, every task on one virtual clock
+// (traces detached): `run_until(t)` runs all cycles released before t, `pin(name)` finds a
+// variable's pin (a test failure, and an empty PinRef, if there is none).
+struct VirtualMachine {
+  std::unique_ptr<rt::Runtime> runtime;
+  rt::VirtualClock clock;
+  std::unique_ptr<rt::VirtualScheduler> sched;
+
+  explicit VirtualMachine(const std::string& name, const rt::BuildOptions& options = {})
+      : runtime(build_sim_machine(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
+                                                        "/config/machines/" + name + ".yaml"),
+                                  options)) {
+    runtime->machine().command(rt::MachineCommand::kPowerOn);
+    std::vector<rt::Task*> tasks;
+    for (const auto& t : runtime->tasks()) {
+      t->detach_trace();
+      tasks.push_back(t.get());
+    }
+    sched = std::make_unique<rt::VirtualScheduler>(tasks, clock);
+  }
+  void run_until(rt::TimePoint t) { sched->run_until(t); }
+  rt::VariableRegistry& vars() { return runtime->variables(); }
+  rt::PinRef pin(const char* name) {
+    const rt::Variable* v = runtime->variables().find(name);
+    EXPECT_NE(v, nullptr) << name;
+    return v != nullptr ? v->pin : rt::PinRef{};
+  }
+};
 
 }  // namespace edm::test

@@ -52,23 +52,8 @@ class SinkIlcJump : public ::testing::TestWithParam<int> {};
 TEST_P(SinkIlcJump, the_ilc_takes_over_from_the_integral_controller_and_its_jitter_falls) {
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(GetParam());
-  auto r = build_sim_machine(
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/sink-ilc-sim.yaml"),
-      opts);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  std::vector<rt::Task*> tasks;
-  for (const auto& t : r->tasks()) {
-    t->detach_trace();
-    tasks.push_back(t.get());
-  }
-  rt::VirtualClock clock;
-  rt::VirtualScheduler sched(tasks, clock);
-  auto& vars = r->variables();
-  auto pin = [&](const char* name) {
-    const rt::Variable* v = vars.find(name);
-    EXPECT_NE(v, nullptr) << name;
-    return v != nullptr ? v->pin : rt::PinRef{};
-  };
+  VirtualMachine m("sink-ilc-sim", opts);
+  auto pin = [&](const char* name) { return m.pin(name); };
   const rt::PinRef z = pin("io.z_mm"), vz = pin("io.vz_cmd"), jumping = pin("gap.jump.jumping");
   const rt::PinRef active = pin("gap.ilc.active"), jumps = pin("gap.jump.jumps");
   const rt::PinRef shorts = pin("io.n_short"), opens = pin("io.n_open"),
@@ -80,8 +65,8 @@ TEST_P(SinkIlcJump, the_ilc_takes_over_from_the_integral_controller_and_its_jitt
   double n_short = 0, n_all = 0;
   bool was_jumping = false;
   for (std::int64_t k = 1; k <= 15'200; ++k) {  // 15.2 s: 10 whole jumps
-    sched.run_until(rt::TimePoint{1ms * k});
-    ASSERT_FALSE(rt::is_safe_state(r->machine().state())) << "at " << k << " ms";
+    m.run_until(rt::TimePoint{1ms * k});
+    ASSERT_FALSE(rt::is_safe_state(m.runtime->machine().state())) << "at " << k << " ms";
     const bool j = rt::read_pin_as_double(jumping) != 0.0;
     if (j && !was_jumping) {  // a jump starts: close the cycle before it
       cycles.push_back({rms_about_line(ts, zs) * 1000.0, rt::read_pin_as_double(active) != 0.0,

@@ -27,22 +27,9 @@ namespace {
 using namespace std::chrono_literals;
 
 TEST(WireStfpiSwitch, the_operator_switches_controller_and_fixed_settings_without_a_bump) {
-  auto r = build_sim_machine(
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/wire-stfpi-sim.yaml"));
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  std::vector<rt::Task*> tasks;
-  for (const auto& t : r->tasks()) {
-    t->detach_trace();
-    tasks.push_back(t.get());
-  }
-  rt::VirtualClock clock;
-  rt::VirtualScheduler sched(tasks, clock);
-  auto& vars = r->variables();
-  auto pin = [&](const char* name) {
-    const rt::Variable* v = vars.find(name);
-    EXPECT_NE(v, nullptr) << name;
-    return v != nullptr ? v->pin : rt::PinRef{};
-  };
+  VirtualMachine m("wire-stfpi-sim");
+  auto& vars = m.vars();
+  auto pin = [&](const char* name) { return m.pin(name); };
   const rt::PinRef applied_u = pin("io.arc_off_time_us"), applied_v = pin("io.servo_ref_v");
   const rt::PinRef pi_u = pin("rupture.pi.arc_off_time_us"), pi_v = pin("rupture.pi.servo_ref_v");
   const rt::PinRef broken = pin("io.wire_broken");
@@ -50,7 +37,7 @@ TEST(WireStfpiSwitch, the_operator_switches_controller_and_fixed_settings_withou
   std::int64_t k = 0;  // 40 ms samples of the rupture task
   auto step = [&] {
     ++k;
-    sched.run_until(rt::TimePoint{40ms * k});
+    m.run_until(rt::TimePoint{40ms * k});
     return std::pair{rt::read_pin_as_double(applied_u), rt::read_pin_as_double(applied_v)};
   };
   auto [u, v] = step();
