@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/sim/random.hpp"
+
 namespace edm::sim {
 
 std::optional<ThicknessProfile> ThicknessProfile::make(std::string_view text, std::string* error) {
@@ -26,6 +28,15 @@ double wire_break_current_a(double ibk_ref_a, double thickness_mm, double flush_
 double WireBreakMonitor::rate_per_s(double rab) const noexcept {
   const double x = std::min((rab - rab_ref_) / rab_width_, 50.0);  // e^50: breaks at once anyway
   return std::exp(x) / (static_cast<double>(rab_mean_ns_) * 1e-9);
+}
+
+double wire_break_threshold(std::uint64_t seed, int shape) noexcept {
+  const int k = std::clamp(shape, 1, kMaxWireBreakShape);
+  double sum = 0.0;
+  for (int i = 0; i < k; ++i) {
+    sum -= std::log1p(-uniform(seed, Stream::kWireBreak, static_cast<std::uint64_t>(i)));
+  }
+  return sum / static_cast<double>(k);
 }
 
 bool WireBreakMonitor::update(std::int64_t dt_ns, double mean_current_a, double break_current_a,

@@ -98,6 +98,8 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("wire_break_rab_ms", wire_break_rab_ms, "ms", "... the mean time to break is this");
   v.param("wire_break_rab_width", wire_break_rab_width, "1", "hazard x e per this Rab above");
   v.param("wire_break_rab_tau_ms", wire_break_rab_tau_ms, "ms", "hazard acts on Rab lagged by");
+  v.param("wire_break_rab_shape", wire_break_rab_shape, "1",
+          "k: tolerated damage ~ Gamma(k, 1/k), integer 1..64");
   v.param("wire_kerf_debris_per_mm", wire_kerf_debris_per_mm, "1/mm",
           "kerf debris c_k added per mm of cut (0 = no kerf debris)");
   v.param("wire_kerf_flush_s", wire_kerf_flush_s, "s", "tau_k of the kerf debris at H = 10 mm");
@@ -266,6 +268,13 @@ std::vector<rt::ParamError> SimParams::validate() const {
   require_range(e, "jump_eps", jump_eps, 0.0, 1.0);
   require_range(e, "wire_flush_floor", wire_flush_floor, 0.0, 1.0);
   require_range(e, "wire_break_rab", wire_break_rab, 0.0, 1.0);
+  require_range(e, "wire_break_rab_shape", wire_break_rab_shape, 1.0,
+                static_cast<double>(kMaxWireBreakShape));
+  if (std::isfinite(wire_break_rab_shape) &&
+      wire_break_rab_shape != std::floor(wire_break_rab_shape)) {
+    e.push_back({"wire_break_rab_shape", "must be a whole number (got " +
+                                             std::to_string(wire_break_rab_shape) + ")"});
+  }
   require_range(e, "wire_hole_flush_factor", wire_hole_flush_factor, 0.0, 1.0);
   require_range(e, "axis_step_us", axis_step_us, 1.0, 50.0);
   if (removal_mm3_per_j == 0.0 && crater_ref_um3 == 0.0) {
@@ -363,6 +372,9 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.wire_break_rab = 0.75;
     p.wire_break_rab_ms = 10000.0;
     p.wire_break_rab_width = 0.02;
+    // A wire of some strength scatter rather than a memoryless one: the tolerated damage is
+    // Gamma(4, 1/4) (CV 0.5), so a run is not broken by a 1-in-300 tiny threshold at a safe Rab.
+    p.wire_break_rab_shape = 4.0;
     return p;
   }
   return std::nullopt;

@@ -79,7 +79,8 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   wire_monitor_ = WireBreakMonitor(to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab,
                                    to_ns(p.wire_break_rab_ms * 1e3), p.wire_break_rab_width,
                                    to_ns(p.wire_break_rab_tau_ms * 1e3),
-                                   -std::log1p(-uniform(seed_, Stream::kWireBreak, 0)));
+                                   wire_break_threshold(
+                                       seed_, static_cast<int>(p.wire_break_rab_shape)));
   publish();
 }
 

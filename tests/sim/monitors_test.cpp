@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "edm/sim/axis.hpp"
+#include "edm/sim/random.hpp"
 
 namespace edm::sim {
 namespace {
@@ -80,6 +81,45 @@ TEST(SimWire, rab_hazard_acts_on_the_lagged_rab) {
   for (int i = 0; i < 1000 && !m.broken(); ++i) m.update(kMs, 0.0, 3.0, 1.0);
   EXPECT_TRUE(m.broken());
   EXPECT_GE(m.hazard(), m.threshold());
+}
+
+// The tolerated damage: shape 1 is the Exp(1) variate at index 0 of the wire-break stream
+// (the draw before the shape existed, so shape-1 runs are unchanged); shape k is Gamma(k, 1/k):
+// mean 1, CV 1/√k, and a lower tail that vanishes as (k x)^k / k! — checked over 20 000 seeds
+// against the Gamma distribution's own figures.
+TEST(SimWire, break_threshold_is_gamma_of_the_shape) {
+  for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+    EXPECT_DOUBLE_EQ(wire_break_threshold(seed, 1),
+                     -std::log1p(-uniform(seed, Stream::kWireBreak, 0)));
+  }
+  constexpr int kSeeds = 20000;
+  for (const int k : {1, 4, 9}) {
+    double sum = 0.0, ss = 0.0;
+    int below = 0;  // thresholds under 0.05
+    for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+      const double x = wire_break_threshold(seed, k);
+      ASSERT_GT(x, 0.0);
+      sum += x;
+      ss += x * x;
+      below += x < 0.05 ? 1 : 0;
+    }
+    const double mean = sum / kSeeds;
+    const double sd = std::sqrt(ss / kSeeds - mean * mean);
+    const double cv = 1.0 / std::sqrt(static_cast<double>(k));
+    EXPECT_NEAR(mean, 1.0, 4.0 * cv / std::sqrt(static_cast<double>(kSeeds))) << "k " << k;
+    EXPECT_NEAR(sd, cv, 0.03 * cv) << "k " << k;
+    // P(X < 0.05) = 1 − e^(−0.05 k) Σ_{i<k} (0.05 k)^i / i!
+    double term = 1.0, cdf_sum = 0.0;
+    for (int i = 0; i < k; ++i) {
+      cdf_sum += term;
+      term *= 0.05 * k / (i + 1);
+    }
+    const double p = 1.0 - std::exp(-0.05 * k) * cdf_sum;
+    const double tol = 4.0 * std::sqrt(p * (1.0 - p) / kSeeds) + 1.0 / kSeeds;
+    EXPECT_NEAR(static_cast<double>(below) / kSeeds, p, tol) << "k " << k;
+  }
+  EXPECT_DOUBLE_EQ(wire_break_threshold(3, 0), wire_break_threshold(3, 1));  // clamped
+  EXPECT_DOUBLE_EQ(wire_break_threshold(3, 1000), wire_break_threshold(3, kMaxWireBreakShape));
 }
 
 TEST(SimRab, window_slides) {

@@ -73,6 +73,19 @@ TEST(SimParams, validate_names_the_bad_fields) {
   EXPECT_FALSE(has_error(errs, "default_on_time_us"));
 }
 
+TEST(SimParams, wire_break_shape_must_be_a_whole_number_in_range) {
+  for (const double bad : {0.0, 2.5, 65.0, -1.0, std::nan("")}) {
+    SimParams p;
+    p.wire_break_rab_shape = bad;
+    EXPECT_TRUE(has_error(p.validate(), "wire_break_rab_shape")) << bad;
+  }
+  for (const double good : {1.0, 4.0, 64.0}) {
+    SimParams p;
+    p.wire_break_rab_shape = good;
+    EXPECT_FALSE(has_error(p.validate(), "wire_break_rab_shape")) << good;
+  }
+}
+
 TEST(SimParams, thickness_profile_parses_and_rejects_precisely) {
   std::string why;
   const auto ok = parse_thickness_profile("0:10, 20:60,40:10", &why);

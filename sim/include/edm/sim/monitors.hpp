@@ -32,6 +32,12 @@ class ThicknessProfile {
 /// I_BK = I_BK,ref (H / 10 mm)^0.5 f (§6.4, Sato: sub-linear in H, lower with poor flushing).
 double wire_break_current_a(double ibk_ref_a, double thickness_mm, double flush_f) noexcept;
 
+/// The damage the wire tolerates in this run: Gamma(shape, 1/shape) (mean 1, CV 1/√shape), the
+/// mean of `shape` Exp(1) variates drawn from the seed's wire-break stream at indices
+/// 0 … shape − 1; shape 1 is the Exp(1) variate at index 0. shape is clamped to
+/// 1 … kMaxWireBreakShape. Pure.
+double wire_break_threshold(std::uint64_t seed, int shape) noexcept;
+
 /// Latches "broken" on either of two rupture mechanisms (docs/simulator.md §7):
 ///  - mean energy (Sato): Ī > I_BK has held for current_ns;
 ///  - abnormal discharges (seed 000, Liao: Rab is the precursor of rupture): a hazard
@@ -39,8 +45,9 @@ double wire_break_current_a(double ibk_ref_a, double thickness_mm, double flush_
 ///    rab_tau_ns (the wire's heat memory: one noisy window does not break it), so the mean time
 ///    to break at
 ///    Rab = rab_ref is rab_mean_ns and it falls e-fold every rab_width above. The wire breaks when
-///    ∫λ dt reaches `threshold`, an Exp(1) variate the plant draws from its seed — exact whatever
-///    the update steps, and the same for every controller (common random numbers).
+///    ∫λ dt reaches `threshold`, the tolerated damage the plant draws from its seed
+///    (wire_break_threshold) — exact whatever the update steps, and the same for every
+///    controller (common random numbers).
 class WireBreakMonitor {
  public:
   WireBreakMonitor() = default;

@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/3";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/4";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
@@ -124,6 +124,9 @@ struct SimParams {
   double wire_break_rab_ms{100.0};    // ... the mean time to break is this, and it falls ...
   double wire_break_rab_width{0.02};  // ... e-fold for every this much Rab above [bk]
   double wire_break_rab_tau_ms{200.0};  // the hazard acts on Rab through this lag [bk]
+  // The damage ∫λ dt the wire tolerates: Gamma(k, 1/k), mean 1, CV 1/√k, drawn once per run.
+  // k = 1 is Exp(1) (memoryless); a larger k is a wire of less scattered strength. Integer.
+  double wire_break_rab_shape{1.0};
   // Kerf debris c_k: the debris the flushing must carry out along the kerf (height H), slow
   // against the gap's own c. Each mm of cut adds wire_kerf_debris_per_mm; it is flushed with
   // τ_k = wire_kerf_flush_s (H/10 mm)^wire_kerf_flush_exp / (F_eff min(1, (g/g_ref)³)).
@@ -166,6 +169,9 @@ struct ThicknessStep {
 /// Parses "0:10,20:60,40:10" (ascending lengths starting at 0, thicknesses > 0, at most
 /// kMaxThicknessSteps steps). On error returns nullopt and says why in *error. Non-RT.
 inline constexpr std::size_t kMaxThicknessSteps = 16;
+
+/// Largest wire_break_rab_shape (the threshold sums this many Exp(1) draws at construction).
+inline constexpr int kMaxWireBreakShape = 64;
 std::optional<std::vector<ThicknessStep>> parse_thickness_profile(std::string_view text,
                                                                   std::string* error);
 

@@ -21,7 +21,7 @@ enum class Stream : std::uint64_t {
   kDebrisShort = 4,     // debris-bridge short yes/no
   kRemovalScatter = 5,  // crater volume scatter (normal, two uniforms per pulse)
   kSite = 6,            // discharge site when the wall bins compete (orbit)
-  kWireBreak = 7,       // WEDM: the Exp(1) threshold of the abnormal-discharge rupture hazard
+  kWireBreak = 7,       // WEDM: the tolerated damage of the abnormal-discharge rupture hazard
 };
 
 inline constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
