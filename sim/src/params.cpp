@@ -272,8 +272,8 @@ std::vector<rt::ParamError> SimParams::validate() const {
                 static_cast<double>(kMaxWireBreakShape));
   if (std::isfinite(wire_break_rab_shape) &&
       wire_break_rab_shape != std::floor(wire_break_rab_shape)) {
-    e.push_back({"wire_break_rab_shape", "must be a whole number (got " +
-                                             std::to_string(wire_break_rab_shape) + ")"});
+    e.push_back({"wire_break_rab_shape",
+                 "must be a whole number (got " + std::to_string(wire_break_rab_shape) + ")"});
   }
   require_range(e, "wire_hole_flush_factor", wire_hole_flush_factor, 0.0, 1.0);
   require_range(e, "axis_step_us", axis_step_us, 1.0, 50.0);

@@ -1,8 +1,8 @@
 #include "edm/sim/monitors.hpp"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 #include "edm/sim/axis.hpp"
 #include "edm/sim/random.hpp"
