@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "cli_number.hpp"
 #include "edm/blocks/kg_design.hpp"
 
 namespace {
@@ -42,14 +43,7 @@ int bad(const std::string& msg) {
   return kExitBadInput;
 }
 
-std::optional<double> parse_number(std::string_view text) {
-  const std::string s(text);
-  if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
+using edm::apps::parse_number;
 
 std::string format_poly(std::span<const double> p) {
   std::string out = "[";

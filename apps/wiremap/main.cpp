@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "cli_number.hpp"
 #include "edm/sim/plant.hpp"
 
 namespace {
@@ -37,14 +38,7 @@ int bad(const std::string& msg) {
   return kExitBadInput;
 }
 
-std::optional<double> parse_number(std::string_view text) {
-  const std::string s(text);
-  if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end != s.c_str() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
+using edm::apps::parse_number;
 
 struct Cell {
   double rab{0.0};           // mean of the 40 ms Rab, sampled every 40 ms
