@@ -354,7 +354,7 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.tool_kind = "wire";
     p.electrode_length_mm = 1e6;  // the spool
     p.flush_tau0_ms = 5.0;
-    p.flush_gap_ref_um = 25.0;
+    p.flush_gap_ref_um = 10.0;  // WEDM works at 5-15 µm (edm-sim-params/5; was the drill's 25)
     p.a_max_mm_s2 = 300.0;
     p.servo_gain_mm_s_per_v = 0.05;
     p.wire_thickness_profile = "0:10,20:60,40:10";
@@ -364,8 +364,20 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     // the kerf debris makes Rab climb over seconds with aggressive settings and thick work, and
     // the wire breaks within about a second once the lagged Rab is above ≈ 0.8; at 0.6 the
     // mean time to break is ≈ 5 h.
-    p.arc_k_c = 0.8;
-    p.wire_kerf_debris_per_mm = 0.5;
+    // Calibrated against seed 000's Figs. 2-3 (edm-sim-params/5, docs/simulator.md §10d): an
+    // abnormal pulse makes the next one likely abnormal until the gap recovers over ≈ 20 µs,
+    // so the arc-off time (Table 1: 9…50 µs) moves Rab about as much as the servo voltage;
+    // the abnormal pulses of a closing gap are arcs (which still remove) before debris shorts,
+    // so the cut speed rises with Rab up to ≈ 0.6-0.8.
+    p.deion_us = 20.0;
+    p.arc_k_t = 0.8;
+    p.arc_k_c = 1.5;
+    p.debris_c0 = 0.5;
+    p.wire_kerf_debris_per_mm = 0.2;
+    // The faster pulse train (arc chains at short arc-off times) runs Ī ≈ 1.5-2 A at H = 10 mm;
+    // 4.5 A at H = 10 mm keeps the mean-energy limit above that with full flushing, below it
+    // when the flush escapes through a hole (f = 0.44) at aggressive settings. [bk]
+    p.wire_ibk_ref_a = 4.5;
     p.wire_kerf_flush_s = 2.0;
     p.wire_kerf_flush_exp = 1.5;
     p.wire_hole_flush_factor = 0.2;

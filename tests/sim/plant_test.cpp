@@ -354,6 +354,8 @@ TEST(SimPlant, pulse_k_sees_the_same_variates_under_any_controller) {
 TEST(SimPlant, wire_breaks_on_excess_mean_current_only) {
   auto wire = *SimParams::preset("wire");
   wire.wire_break_rab_ms = 1e15;  // the abnormal-discharge hazard off: this is the current law
+  wire.arc_k_t = 0.0;  // no arc chains after a short off time: the pulse rate is set by t_off
+  wire.wire_ibk_ref_a = 3.0;  // the figures below are for I_BK = 3 A at H = 10 mm
   {
     Plant p(wire, 10);  // default t_off 80 µs: Ī ≈ 60 A x 3 µs / 100 µs ≈ 1.8 A < 3 A
     p.hold_gap(10.0);
@@ -457,11 +459,11 @@ TEST(SimPlant, wire_flushing_drops_while_the_nozzle_is_over_the_internal_hole) {
   const auto wire = *SimParams::preset("wire");  // hole 45 … 47 mm, nozzle radius 3 mm
   const double r = wire.wire_nozzle_radius_mm;
   Plant p(wire, 23);
-  for (const auto& [s, f] : std::vector<std::pair<double, double>>{
-           {45.0 - r - 0.1, 1.0},
-           {45.0 - r + 0.1, wire.wire_hole_flush_factor},
-           {47.0 + r - 0.1, wire.wire_hole_flush_factor},
-           {47.0 + r + 0.1, 1.0}}) {
+  for (const auto& [s, f] :
+       std::vector<std::pair<double, double>>{{45.0 - r - 0.1, 1.0},
+                                              {45.0 - r + 0.1, wire.wire_hole_flush_factor},
+                                              {47.0 + r - 0.1, wire.wire_hole_flush_factor},
+                                              {47.0 + r + 0.1, 1.0}}) {
     p.set_depth_mm(s);
     EXPECT_DOUBLE_EQ(p.state().flush_effective, f) << "cut " << s << " mm";
   }

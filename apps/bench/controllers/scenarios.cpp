@@ -262,14 +262,14 @@ std::vector<Scenario> make_scenarios(bool quick) {
   const std::string u0 = "open_voltage_v: 110, ";
   const std::vector<WireCase> cases = {
       {"B6a", "wire, case 1: improper settings (H = 50 mm)", u0 + "wire_thickness_profile: '0:50'",
-       30.0, 9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
-      {"B6b", "wire, case 2: thick work (H = 100 mm)", u0 + "wire_thickness_profile: '0:100'", 30.0,
-       9.0, 2.0, 0.06, 0.03, 0.6, 45.0},
+       35.0, 13.0, 2.0, 0.06, 0.03, 0.6, 45.0},
+      {"B6b", "wire, case 2: thick work (H = 100 mm)", u0 + "wire_thickness_profile: '0:100'", 40.0,
+       15.0, 2.0, 0.06, 0.03, 0.6, 45.0},
       {"B6c", "wire, case 3: thickness step 10 → 30 mm at 3 mm of cut",
-       u0 + "wire_thickness_profile: '0:10,3:30'", 40.0, 20.0, 2.0, 0.08, 0.16, 0.42, 10.0},
+       u0 + "wire_thickness_profile: '0:10,3:30'", 40.0, 20.0, 2.0, 0.08, 0.16, 0.42, 45.0},
       {"B6d", "wire, case 4: internal hole at 6 … 7 mm of cut (H = 10 mm)",
-       u0 + "wire_thickness_profile: '0:10', wire_hole_from_mm: 6, wire_hole_to_mm: 7", 40.0, 20.0,
-       3.0, 0.07, 0.14, 0.42, 10.0},
+       u0 + "wire_thickness_profile: '0:10', wire_hole_from_mm: 6, wire_hole_to_mm: 7", 45.0, 35.0,
+       3.0, 0.07, 0.14, 0.42, 45.0},
   };
   for (const WireCase& c : cases) {
     Scenario s;

@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/4";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/5";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
