@@ -257,8 +257,11 @@ std::vector<Scenario> make_scenarios(bool quick) {
   // case 3: a 20 mm step up); case 4's part is H = 10 mm with a 1 mm hole 6 mm into the cut
   // (the flushing nozzle, radius 3 mm, is over it from 3 mm on). Every case runs with the
   // paper's 110 V ignition voltage, so Table 1's 30…70 V servo range spans the gap. Fixed
-  // settings: the aggressive corner of Table 1 (9 µs, 30 V) for the "improper settings" of
-  // cases 1-2; settings that hold on the thin/unholed part (20 µs, 40 V) for cases 3-4.
+  // settings (also the controller's initial ones): Table 4's arc-off time and servo voltage
+  // (docs/simulator.md §10d) for cases 1, 2 and 4; for case 3 20 µs / 40 V, because Table 4's
+  // 30 µs holds the 30 mm part on this simulator (so it would not show the paper's break).
+  // Rab is scored after 45 s in every case: the kerf debris settles over 3 τ_k after the start
+  // or the step (τ_k = 10 s at 30 mm, 22 s at 50 mm).
   const std::string u0 = "open_voltage_v: 110, ";
   const std::vector<WireCase> cases = {
       {"B6a", "wire, case 1: improper settings (H = 50 mm)", u0 + "wire_thickness_profile: '0:50'",
