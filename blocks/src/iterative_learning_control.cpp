@@ -20,7 +20,7 @@ std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
   const std::pair<const char*, double> all[] = {
       {"p0", p0},           {"k_delta", k_delta}, {"q_pole", q_pole},       {"lambda1", lambda1},
       {"lambda2", lambda2}, {"lambda3", lambda3}, {"u_initial", u_initial}, {"u_min", u_min},
-      {"u_max", u_max}};
+      {"u_max", u_max},     {"e_max", e_max}};
   for (const auto& [name, value] : all) {
     rt::require_finite(errs, name, value);
   }
@@ -38,6 +38,7 @@ std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
   rt::require_range(errs, "lambda1", lambda1, -kPole, kPole);
   rt::require_range(errs, "lambda2", lambda2, -kPole, kPole);
   rt::require_range(errs, "lambda3", lambda3, -kPole, kPole);
+  rt::require_non_negative(errs, "e_max", e_max);
   rt::require_ordered(errs, "u_min", u_min, "u_max", u_max);
   if (errs.empty()) {
     rt::require_range(errs, "u_initial", u_initial, u_min, u_max);
@@ -173,7 +174,7 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   }
   const bool learning = enable_.get();
   if (idx_ >= 0) {
-    last_e_ = ref - y;
+    last_e_ = p.e_max > 0.0 ? std::clamp(ref - y, -p.e_max, p.e_max) : ref - y;
     e_[static_cast<std::size_t>(idx_)] = last_e_;
   }
   const bool boundary = rising || (p.auto_cycle && (idx_ < 0 || idx_ == n - 1));

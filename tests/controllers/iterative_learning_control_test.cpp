@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -213,10 +214,14 @@ TEST(IterativeLearningControl, with_a_real_axis_and_q_filter_the_learning_conver
 // records it as u_j with e_j, and at the end of cycle W outputs u_j+1 = Q·(u_j + L·e_j). The
 // expected cycle is computed here from the lifted matrices of the paper (Q's first column
 // 1 − Σ q, Q(i, m) = q_{i−m} below the diagonal), not from the block's recursion.
-TEST(IterativeLearningControl, warm_start_learns_the_first_cycle_from_the_recorded_one) {
+// One recorded cycle of random positions and voltages, then the first learnt cycle against
+// Q·(u_0 + L·e_0) computed here from the lifted matrices; with e_max > 0 the errors the block
+// learns from are clamped to ±e_max (the range where y = kδ·δ + b holds).
+void check_warm_start_first_cycle(double e_max) {
   constexpr int kN = 12;
   auto p = params(kN, 0.4, 2.0, 0.3, 0.6, 0.5, 0.2);
   p.warm_cycles = 1;
+  p.e_max = e_max;
   BlockHarness<IterativeLearningControl> h;
   ASSERT_TRUE(h.start(p).empty());
   auto& y = h.source<double>("y");
@@ -240,7 +245,8 @@ TEST(IterativeLearningControl, warm_start_learns_the_first_cycle_from_the_record
     u_rec[static_cast<std::size_t>(k)] = t;
     const double yk = volt(rng);
     y.set(yk);
-    e_rec[static_cast<std::size_t>(k)] = 1.0 - yk;
+    e_rec[static_cast<std::size_t>(k)] =
+        e_max > 0.0 ? std::clamp(1.0 - yk, -e_max, e_max) : 1.0 - yk;
   }
   // Expected u_1 = Q·(u_0 + L·e_0), x = 0 (one warm cycle gives no advance per cycle).
   const auto g = IterativeLearningControl::gains(p);
@@ -269,6 +275,22 @@ TEST(IterativeLearningControl, warm_start_learns_the_first_cycle_from_the_record
     EXPECT_NEAR(h.out("u"), expected[static_cast<std::size_t>(k)], 1e-12) << "sample " << k;
   }
   EXPECT_EQ(h.out<std::int64_t>("cycles"), 1);
+}
+
+TEST(IterativeLearningControl, warm_start_learns_the_first_cycle_from_the_recorded_one) {
+  check_warm_start_first_cycle(0.0);
+}
+
+// Errors in (−1, 1), clamped to ±0.4: about 60 % of the samples are clamped.
+TEST(IterativeLearningControl, e_max_clamps_the_error_learnt_from) {
+  check_warm_start_first_cycle(0.4);
+  IterativeLearningControlParams p;
+  for (const double bad : {-1.0, std::nan("")}) {
+    p.e_max = bad;
+    bool named = false;
+    for (const auto& e : p.validate()) named = named || e.field == "e_max";
+    EXPECT_TRUE(named) << bad;
+  }
 }
 
 // With W ≥ 2 the forward motion continues at the other controller's last advance per cycle:

@@ -60,6 +60,7 @@ struct IterativeLearningControlParams {
   double u_max{1e9};
   bool auto_cycle{false};       // the cycle ends every N samples without cycle_start
   std::int64_t warm_cycles{0};  // cycles another controller runs while u is recorded from track
+  double e_max{0.0};            // > 0: each sample's error is clamped to ±e_max (0: off)
 
   void visit(rt::ParamVisitor& v) {
     v.param("n_samples", n_samples, "samples", "samples per cycle N (2..65536), load time only");
@@ -75,6 +76,8 @@ struct IterativeLearningControlParams {
     v.param("auto_cycle", auto_cycle, "", "a cycle ends every n_samples without cycle_start");
     v.param("warm_cycles", warm_cycles, "cycles",
             "complete cycles recorded from `track` before this block takes over (0: none)");
+    v.param("e_max", e_max, "",
+            "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b holds");
   }
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
