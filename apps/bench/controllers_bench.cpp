@@ -44,7 +44,7 @@ bool identical(const Outcome& a, const Outcome& b) {
       return false;
     }
   }
-  return a.jitter_per_cycle_um == b.jitter_per_cycle_um;
+  return a.jitter_per_cycle_um == b.jitter_per_cycle_um && a.rab_per_s == b.rab_per_s;
 }
 
 int usage() {

@@ -92,6 +92,7 @@ struct Outcome {
   double peak_arc_pct{0.0};    // max arc % (transient + stable) of a window
   double stalls{0.0};          // whole seconds after the drop with < 5 µm of true depth gained
   std::vector<double> jitter_per_cycle_um;
+  std::vector<double> rab_per_s;  // wire: 1 s means of io.rab from the start to the end or break
 
   /// Every scalar, named (CSV columns; B7 compares them bit for bit).
   [[nodiscard]] std::vector<std::pair<const char*, double>> fields() const;
@@ -120,6 +121,7 @@ struct Scenario {
   std::vector<Column> columns;
   std::size_t plot_column{0};  // the column of the bar plot
   bool plot_jitter{false};     // also plot jitter per cycle against the cycle number
+  bool plot_rab{false};        // also plot the first seed's Rab (1 s means) against time
 };
 
 /// The scenarios; `quick` shortens runs (the seed count is the caller's).

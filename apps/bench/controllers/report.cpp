@@ -121,11 +121,34 @@ std::string write_plot(const std::string& dir, const ScenarioResult& r) {
       dat << '\n';
     }
   }
+  // The first seed's run per controller, Rab against time (seed 000's Figs. 9-12); a broken
+  // wire's line ends at the break.
+  double rab_ref = 0.0;
+  if (s.plot_rab) {
+    auto dat = open_out(dir + "/" + s.id + "-rab.dat");
+    dat << "# t s, then Rab (1 s mean) of the first seed per controller; NaN after a break\n";
+    std::size_t secs = 0;
+    for (const auto& runs : r.outcomes) {
+      if (!runs.empty()) {
+        secs = std::max(secs, runs.front().rab_per_s.size());
+      }
+    }
+    for (std::size_t k = 0; k < secs; ++k) {
+      dat << k + 1;
+      for (const auto& runs : r.outcomes) {
+        const bool have = !runs.empty() && k < runs.front().rab_per_s.size();
+        dat << ' ' << (have ? runs.front().rab_per_s[k] : std::nan(""));
+      }
+      dat << '\n';
+    }
+    rab_ref = s.variants.empty() ? 0.0 : s.variants.front().spec.rab_ref;
+  }
+  const bool two = s.plot_jitter || s.plot_rab;
   {
     auto gp = open_out(dir + "/" + s.id + ".gp");
-    gp << "set terminal pngcairo size 1100," << (s.plot_jitter ? 900 : 480)
-       << " noenhanced\nset output '" << s.id << ".png'\nset rmargin 18\n";
-    if (s.plot_jitter) {
+    gp << "set terminal pngcairo size 1100," << (two ? 900 : 480) << " noenhanced\nset output '"
+       << s.id << ".png'\nset rmargin 18\n";
+    if (two) {
       gp << "set multiplot layout 2,1\n";
     }
     gp << "set title \"" << s.id << ": " << s.title << "\"\nset ylabel \"" << c.header
@@ -139,6 +162,17 @@ std::string write_plot(const std::string& dir, const ScenarioResult& r) {
       for (std::size_t v = 0; v < s.variants.size(); ++v) {
         gp << (v ? ", " : "") << "'" << s.id << "-jitter.dat' using 1:" << v + 2 << " title \""
            << s.variants[v].name << "\"";
+      }
+      gp << "\nunset multiplot\n";
+    }
+    if (s.plot_rab) {
+      gp << "set title \"Rab, 1 s means, first seed (set point " << rab_ref
+         << " dashed)\"\nset xlabel \"t s\"\nset ylabel \"Rab\"\nset xtics norotate\n"
+         << "set yrange [0:1]\nset style data lines\nplot " << rab_ref
+         << " dt 2 lc rgb 'black' notitle";
+      for (std::size_t v = 0; v < s.variants.size(); ++v) {
+        gp << ", '" << s.id << "-rab.dat' using 1:" << v + 2 << " title \"" << s.variants[v].name
+           << "\"";
       }
       gp << "\nunset multiplot\n";
     }

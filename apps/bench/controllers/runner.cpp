@@ -235,6 +235,7 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   double electrode0 = -1.0;
   bool vz_high = false, reached = false;
   double rab_sum = 0, rab_n = 0, rab_sec = 0, rab_sec_n = 0, rab_err_ss = 0, rab_err_n = 0;
+  double rab_all_sec = 0;  // this second's sum of io.rab, for rab_per_s
   double sec_open = 0, sec_pulses = 0;
   LineFit fit;
   std::int64_t k = 0;
@@ -318,6 +319,13 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     }
     if (rt::read_pin_as_double(wire_load) > 0.9) {
       o.overload_s += 1e-3;
+    }
+    if (spec.rab_ref > 0 && o.wire_broken == 0.0) {
+      rab_all_sec += rt::read_pin_as_double(rab);
+      if (k % 1000 == 0) {
+        o.rab_per_s.push_back(rab_all_sec / 1000.0);
+        rab_all_sec = 0.0;
+      }
     }
     if (spec.rab_ref > 0 && t_s > spec.transient_s && o.wire_broken == 0.0) {
       const double x = rt::read_pin_as_double(rab);

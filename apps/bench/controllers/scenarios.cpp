@@ -291,6 +291,7 @@ std::vector<Scenario> make_scenarios(bool quick) {
                  col("Rab below ref max", &Outcome::rab_below_max, 3),
                  col("time Ī > 0.9 I_BK s", &Outcome::overload_s, 2)};
     s.plot_column = 0;
+    s.plot_rab = true;
     out.push_back(std::move(s));
   }
   return out;
