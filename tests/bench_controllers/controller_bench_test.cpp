@@ -38,6 +38,7 @@ void expect_bitwise_equal(const Outcome& a, const Outcome& b) {
         << fa[i].first << ": " << fa[i].second << " vs " << fb[i].second;
   }
   EXPECT_EQ(a.jitter_per_cycle_um, b.jitter_per_cycle_um);
+  EXPECT_EQ(a.rab_per_s, b.rab_per_s);
 }
 
 TEST(ControllerBench, B7SameSeedGivesIdenticalFiguresAnotherSeedDoesNot) {
