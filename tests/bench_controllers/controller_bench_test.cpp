@@ -163,12 +163,15 @@ TEST(ControllerBench, B5StrTracksItsReferenceAndKeepsArcsAtTheBaselinesLevel) {
   const Outcome str = run(kRoot, b5.variants[1].spec);
   EXPECT_TRUE(std::isnan(servo.loop_err_rms)) << "the servo has no y_v loop";
   ASSERT_FALSE(std::isnan(str.loop_err_rms));
-  EXPECT_NEAR(str.loop_y_mean, str.loop_ref_mean, 0.1);
+  EXPECT_NEAR(str.loop_y_mean, str.loop_ref_mean, 0.04) << "no bias from the approach";
   EXPECT_LT(str.loop_err_rms, 0.1);
   EXPECT_GT(str.loop_ref_mean, 0.9) << "the reference decision found the gap good";
   EXPECT_LE(str.ratio_sarc_pct, 2.0 * servo.ratio_sarc_pct + 0.005);
   EXPECT_LE(str.ratio_tarc_pct, 1.5 * servo.ratio_tarc_pct);
-  EXPECT_GT(str.mrr_mm3_min, servo.mrr_mm3_min);
+  // Held through the jump and the approach, it removes about as much as the servo (quick runs:
+  // a few per cent more; 45 s runs: a few per cent less, docs/benchmarks.md B5).
+  EXPECT_GT(str.mrr_mm3_min, 0.9 * servo.mrr_mm3_min);
+  EXPECT_LT(str.jitter_um, 0.5 * servo.jitter_um) << "Us is not disturbed by the approach";
 }
 
 // The paper's comparison (Fig. 1): the ILC learning from the integral controller (the voltage

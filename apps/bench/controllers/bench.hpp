@@ -39,12 +39,13 @@ struct RunSpec {
   std::string jump_cycle_var;   // non-empty (B5 ILC): forced 1 for the first ms of each jump
   std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
   double jump_hold_value{0.0};
-  std::string jump_track_var;    // non-empty: forced to io.z_mm at the jump's start while forced
-  std::string loop_y_var;        // non-empty (B5 STR): a loop's output y, scored against ...
-  std::string loop_ref_var;      // ... its reference, every ms outside the jumps and settling
-  double wall_growth_mm{0.0};    // > 0 (B4): wall radius target = initial bin radius + this
-  double flush_drop_mm{0.0};     // > 0 (B3): disturbance figures from this true depth on
-  double window_end_state{0.0};  // > 0 (B3): ... until done_var reaches this (RETRACT)
+  double jump_hold_extra_ms{0.0};  // the hold lasts this much past the forced jump (approach)
+  std::string jump_track_var;      // non-empty: forced to io.z_mm at the jump's start while forced
+  std::string loop_y_var;          // non-empty (B5 STR): a loop's output y, scored against ...
+  std::string loop_ref_var;        // ... its reference, every ms outside the jumps and settling
+  double wall_growth_mm{0.0};      // > 0 (B4): wall radius target = initial bin radius + this
+  double flush_drop_mm{0.0};       // > 0 (B3): disturbance figures from this true depth on
+  double window_end_state{0.0};    // > 0 (B3): ... until done_var reaches this (RETRACT)
 };
 
 /// Outcomes of one run (PLANT-MODEL §5, as far as the simulator exposes them).

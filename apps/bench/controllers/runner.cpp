@@ -263,13 +263,17 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
         force(spec.jump_cycle_var, 0.0);
       } else if (phase == kJumpUpMs) {
         vars.force("io.vz_cmd", -30.0);
-      } else if (phase == kJumpUpMs + kJumpDownMs) {
+      }
+      if (phase == kJumpUpMs + kJumpDownMs) {
         vars.unforce("io.vz_cmd");
-        for (const std::string* name : {&spec.jump_hold_var, &spec.jump_track_var}) {
-          if (!name->empty()) {
-            vars.unforce(*name);
-          }
+        if (!spec.jump_track_var.empty()) {
+          vars.unforce(spec.jump_track_var);
         }
+      }
+      if (phase == kJumpUpMs + kJumpDownMs +
+                       static_cast<std::int64_t>(std::llround(spec.jump_hold_extra_ms)) &&
+          !spec.jump_hold_var.empty()) {
+        vars.unforce(spec.jump_hold_var);
       }
     }
     sched.run_until(rt::TimePoint{1ms * k});

@@ -222,6 +222,7 @@ std::vector<Scenario> make_scenarios(bool quick) {
     str.loop_ref_var = "adapt.str.y_rv";
     str.jump_hold_var = "adapt.str.enable";
     str.jump_hold_value = 0.0;
+    str.jump_hold_extra_ms = 200.0;
     RunSpec ilc = v;
     ilc.config = "config/bench/controllers/sink-ilc.yaml";
     ilc.jump_cycle_var = "gap.ilc.cycle_start";
