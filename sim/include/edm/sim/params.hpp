@@ -120,9 +120,9 @@ struct SimParams {
   double wire_ibk_ref_a{3.0};                  // I_BK at H = 10 mm and f = 1 [bk]
   double wire_flush_floor{0.3};                // f = floor + (1 - floor) F_eff [bk]
   double wire_break_current_ms{5.0};           // break if Ī > I_BK this long
-  double wire_break_rab{0.5};         // abnormal-discharge rupture: at this Rab ...
-  double wire_break_rab_ms{100.0};    // ... the mean time to break is this, and it falls ...
-  double wire_break_rab_width{0.02};  // ... e-fold for every this much Rab above [bk]
+  double wire_break_rab{0.5};                  // abnormal-discharge rupture: at this Rab ...
+  double wire_break_rab_ms{100.0};      // ... the mean time to break is this, and it falls ...
+  double wire_break_rab_width{0.02};    // ... e-fold for every this much Rab above [bk]
   double wire_break_rab_tau_ms{200.0};  // the hazard acts on Rab through this lag [bk]
   // The damage ∫λ dt the wire tolerates: Gamma(k, 1/k), mean 1, CV 1/√k, drawn once per run.
   // k = 1 is Exp(1) (memoryless); a larger k is a wire of less scattered strength. Integer.
@@ -139,7 +139,7 @@ struct SimParams {
   // multiplied by wire_hole_flush_factor. [bk]
   double wire_nozzle_radius_mm{3.0};
   double wire_hole_flush_factor{1.0};
-  double mean_current_ema_ms{10.0};            // Ī time constant
+  double mean_current_ema_ms{10.0};  // Ī time constant
 
   // --- Sensors (§6.2 step 8) ---
   double rab_window_ms{40.0};
