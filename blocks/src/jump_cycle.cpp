@@ -27,9 +27,13 @@ std::vector<rt::ParamError> JumpCycleParams::validate() const {
   if (down_time <= rt::Duration::zero()) {
     errs.push_back({"down_time", "must be > 0"});
   }
-  if (period <= up_time + down_time) {
-    errs.push_back(
-        {"period", "must be > up_time + down_time (the servo needs time between jumps)"});
+  if (settle_time < rt::Duration::zero()) {
+    errs.push_back({"settle_time", "must be >= 0"});
+  }
+  if (period <= up_time + down_time + std::max(settle_time, rt::Duration::zero())) {
+    errs.push_back({"period",
+                    "must be > up_time + down_time + settle_time (the servo needs time between "
+                    "jumps)"});
   }
   rt::require_positive(errs, "up_speed_mm_s", up_speed_mm_s);
   rt::require_positive(errs, "down_speed_mm_s", down_speed_mm_s);
@@ -43,6 +47,8 @@ void JumpCycle::visit_pins(rt::PinVisitor& v) {
   v.output("vz_out_mm_s", vz_out_, "mm/s");
   v.output("z_hold_mm", z_hold_, "mm");
   v.output("jumping", jumping_);
+  v.output("settling", settling_);
+  v.output("servo_part", servo_part_);
   v.output("cycle_start", cycle_start_);
   v.output("jumps", jumps_);
 }
@@ -59,13 +65,19 @@ void JumpCycle::params_changed() noexcept {
   period_n_ = cycles_of(params_.period, task_period_);
   up_n_ = cycles_of(params_.up_time, task_period_);
   down_n_ = cycles_of(params_.down_time, task_period_);
-  period_n_ = std::max(period_n_, up_n_ + down_n_ + 1);  // rounding must not swallow the servo
+  settle_n_ =
+      params_.settle_time > rt::Duration::zero() ? cycles_of(params_.settle_time, task_period_) : 0;
+  // Rounding must not swallow the servo.
+  period_n_ = std::max(period_n_, up_n_ + down_n_ + settle_n_ + 1);
 }
 
 void JumpCycle::reset() noexcept {
   n_ = 0;
   phase_ = -1;
+  settle_left_ = 0;
   jumping_.set(false);
+  settling_.set(false);
+  servo_part_.set(true);
   cycle_start_.set(false);
 }
 
@@ -121,11 +133,20 @@ rt::BlockStatus JumpCycle::update(const rt::CycleContext& ctx) noexcept {
   if (jumping) {
     vz_out_.set(phase_ < up_n_ ? params_.up_speed_mm_s : -params_.down_speed_mm_s);
     jumping_.set(true);
+    settling_.set(true);
+    servo_part_.set(false);
     ++phase_;
     return status;
   }
+  if (phase_ >= 0) {
+    settle_left_ = settle_n_;  // the jump ended: the approach begins
+  }
   phase_ = -1;
   jumping_.set(false);
+  const bool settling = settle_left_ > 0 && !safe;
+  settle_left_ = settling ? settle_left_ - 1 : 0;
+  settling_.set(settling);
+  servo_part_.set(!settling);
   const double v = vz_in_.get();
   if (!std::isfinite(v)) {
     vz_out_.set(0.0);

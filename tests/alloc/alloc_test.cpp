@@ -423,6 +423,13 @@ TEST(Allocations, NoneInsideCyclesOfTheSinkMachineWithJumpsAndTheIlc) {
   EXPECT_EQ(r->variables().read("gap.ilc.active"), 1.0) << "the ILC drives after the take-over";
 }
 
+TEST(Allocations, NoneInsideCyclesOfTheSinkMachineWithJumpsAndTheStr) {
+  // JumpCycle holding the STR through each jump and its approach (two jumps in 3.5 s).
+  auto r = build_shipped("sink-str-jump-sim");
+  EXPECT_EQ(allocations_in_cycles(*r, 3500), 0u);
+  EXPECT_EQ(r->variables().read("ratios.jump.jumps"), 2.0);
+}
+
 TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
   auto r = build_shipped("finish-sim-program");  // polarity switch, then orbiting
   EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);

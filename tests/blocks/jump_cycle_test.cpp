@@ -51,6 +51,32 @@ TEST(JumpCycleTest, jumps_every_period_up_then_down_then_passes_the_servo) {
   EXPECT_EQ(starts, 3);
 }
 
+// settling = jumping, then S = settle_time cycles more (the approach); 0 → settling = jumping.
+// A safe state ends it at once.
+TEST(JumpCycleTest, settling_covers_the_jump_and_the_approach_after_it) {
+  for (const int settle : {0, 20}) {
+    SCOPED_TRACE(settle);
+    JumpCycleParams p = small();
+    p.settle_time = std::chrono::milliseconds(settle);
+    BlockHarness<JumpCycle> h(1ms);
+    ASSERT_TRUE(h.start(p).empty());
+    for (int k = 1; k <= 250; ++k) {
+      ASSERT_EQ(h.step(), BlockStatus::kOk);
+      const int since = k >= 100 ? (k - 100) % 100 : -1;
+      const bool jumping = since >= 0 && since < 9;
+      ASSERT_EQ(h.out<bool>("jumping"), jumping) << "cycle " << k;
+      ASSERT_EQ(h.out<bool>("settling"), since >= 0 && since < 9 + settle) << "cycle " << k;
+      ASSERT_EQ(h.out<bool>("servo_part"), !h.out<bool>("settling")) << "cycle " << k;
+    }
+    // Inside the approach of the third jump (k = 300 starts it; 300 + 9 + 5 is mid-approach):
+    for (int k = 251; k <= 314; ++k) h.step();
+    EXPECT_EQ(h.out<bool>("settling"), settle > 0);
+    h.block().enter_safe_state({rt::MachineState::kFault, rt::AlarmCode::kNone});
+    EXPECT_FALSE(h.out<bool>("settling"));
+    EXPECT_TRUE(h.out<bool>("servo_part"));
+  }
+}
+
 TEST(JumpCycleTest, z_hold_follows_z_and_holds_the_jump_start_through_the_jump) {
   BlockHarness<JumpCycle> h(1ms);
   ASSERT_TRUE(h.start(small()).empty());
@@ -145,6 +171,14 @@ TEST(JumpCycleTest, bad_parameters_are_refused) {
   p = small();
   p.up_speed_mm_s = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(p.validate().empty());
+  p = small();
+  p.settle_time = -1ms;
+  EXPECT_FALSE(p.validate().empty());
+  p = small();
+  p.settle_time = 91ms;  // up + down + settle = period: no time for the servo
+  EXPECT_FALSE(p.validate().empty());
+  p.settle_time = 90ms;
+  EXPECT_TRUE(p.validate().empty());
   EXPECT_TRUE(small().validate().empty());
 }
 

@@ -15,10 +15,14 @@
 //   cycle = one ILC cycle); jumps counts them;
 //   z_hold_mm = z_mm, held at its value of the jump's first cycle while jumping (what the
 //   electrode position was before the jump: the ILC warm start's `track` must not learn the jump).
+//   settling = jumping, or within S = settle_time cycles after the jump (the approach, while the
+//   servo closes the gap again: its open pulses are not the machining's); S = 0: = jumping.
+//   servo_part = not settling (wire a controller's `enable` to it).
 //
 // Wire io.vz_cmd from vz_out_mm_s. Samples taken while `jumping` are not the servo's: hold a
-// controller's measurement through a Select (g = jumping) or its `enable` (STR). `enable` false
-// starts no jump and resets n (a running jump finishes). A safe state aborts a running jump
+// controller's measurement through a Select (g = jumping); samples taken while `settling` are
+// not the machining's either: hold the STR's `enable` with it (docs/benchmarks.md, B5). `enable`
+// false starts no jump and resets n (a running jump finishes). A safe state aborts a running jump
 // (vz_out = 0 in enter_safe_state); update() in a safe state starts no jump and passes vz_in.
 // A non-finite vz_in outside a jump → vz_out = 0, kFault (a jump runs on: it does not read
 // vz_in); a non-finite z_mm → z_hold_mm held, kFault.
@@ -39,6 +43,7 @@ struct JumpCycleParams {
   rt::Duration down_time{std::chrono::milliseconds(50)};  // > 0
   double up_speed_mm_s{30.0};                             // [mm/s] > 0
   double down_speed_mm_s{30.0};                           // [mm/s] > 0
+  rt::Duration settle_time{};  // >= 0; `settling` stays true this long after the jump
 
   void visit(rt::ParamVisitor& v) {
     v.param("period", period, "s", "time from one jump's start to the next (> up + down time)");
@@ -46,6 +51,8 @@ struct JumpCycleParams {
     v.param("down_time", down_time, "s", "time it comes back down (> 0)");
     v.param("up_speed_mm_s", up_speed_mm_s, "mm/s", "rising speed (> 0)");
     v.param("down_speed_mm_s", down_speed_mm_s, "mm/s", "lowering speed (> 0)");
+    v.param("settle_time", settle_time, "s",
+            "`settling` stays true this long after the jump (the approach; >= 0)");
   }
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
@@ -71,12 +78,13 @@ class JumpCycle final : public rt::BlockWithParams<JumpCycleParams> {
   rt::Input<double> vz_in_, z_mm_;
   rt::Input<bool> enable_{true};
   rt::Output<double> vz_out_, z_hold_;
-  rt::Output<bool> jumping_, cycle_start_;
+  rt::Output<bool> jumping_, settling_, servo_part_, cycle_start_;
   rt::Output<std::int64_t> jumps_;
   rt::Duration task_period_{};
-  std::int64_t period_n_{1}, up_n_{1}, down_n_{1};
-  std::int64_t n_{0};       // cycles since enabled
-  std::int64_t phase_{-1};  // cycles since the running jump started, −1: no jump
+  std::int64_t period_n_{1}, up_n_{1}, down_n_{1}, settle_n_{0};
+  std::int64_t settle_left_{0};  // cycles of `settling` left after the last jump
+  std::int64_t n_{0};            // cycles since enabled
+  std::int64_t phase_{-1};       // cycles since the running jump started, −1: no jump
   bool was_enabled_{true};
   bool was_safe_{false};
 };
