@@ -76,11 +76,10 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   jump_low_z_mm_ = axes_[2].position_mm();
   axis_step_ns_ = std::max<std::int64_t>(1, to_ns(p.axis_step_us));
   rab_ = RabWindow(to_ns(p.rab_window_ms * 1e3));
-  wire_monitor_ = WireBreakMonitor(to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab,
-                                   to_ns(p.wire_break_rab_ms * 1e3), p.wire_break_rab_width,
-                                   to_ns(p.wire_break_rab_tau_ms * 1e3),
-                                   wire_break_threshold(
-                                       seed_, static_cast<int>(p.wire_break_rab_shape)));
+  wire_monitor_ = WireBreakMonitor(
+      to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab, to_ns(p.wire_break_rab_ms * 1e3),
+      p.wire_break_rab_width, to_ns(p.wire_break_rab_tau_ms * 1e3),
+      wire_break_threshold(seed_, static_cast<int>(p.wire_break_rab_shape)));
   publish();
 }
 
