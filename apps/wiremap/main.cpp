@@ -2,7 +2,7 @@
 // voltage (columns) of seed 000's actuator ranges (Table 1: 9…50 µs, 30…70 V), the simulator
 // cuts a part of thickness H with the machine's own gap-voltage servo, and the steady Rab and
 // cut speed after a settling time are printed as a Markdown table. Rupture is switched off, so
-// every cell is measured over the same time. docs/simulator.md §7 ("Static map").
+// every cell is measured over the same time. docs/simulator.md §10d.
 // Exit codes: 0 ok, 2 bad arguments.
 
 #include <chrono>
