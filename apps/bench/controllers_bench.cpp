@@ -1,10 +1,11 @@
 // edm-bench-controllers: the controller benchmark of issue 7 (`./edm bench controllers`).
 //
-//   edm-bench-controllers [--quick] [--seeds N] [--jobs N] [--only ID[,ID…]] [--root DIR]
-//                         [--out DIR]
+//   edm-bench-controllers [--quick] [--seeds N] [--first-seed S] [--jobs N] [--only ID[,ID…]]
+//                         [--root DIR] [--out DIR]
 //
 // Every scenario × controller × seed runs on the virtual clock (deterministic, as fast as the
-// CPU allows), seeds 1 … N for every controller (common random numbers, PLANT-MODEL §6.6), runs
+// CPU allows), seeds 1 … N for every controller (common random numbers, PLANT-MODEL §6.6;
+// --first-seed S runs S … S + N − 1 instead, for studies off the benchmark's seeds), runs
 // spread over --jobs threads. Writes <out>/controllers.md (the tables), <out>/<id>.csv and
 // <out>/<id>.png (gnuplot) and prints the tables. B7 runs two configs twice with one seed and
 // compares every figure bit for bit. Exit: 0 ok, 1 a run failed or B7 differed, 2 bad usage.
@@ -49,8 +50,8 @@ bool identical(const Outcome& a, const Outcome& b) {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: edm-bench-controllers [--quick] [--seeds N] [--jobs N] [--only ID,...] "
-               "[--root DIR] [--out DIR]\n");
+               "usage: edm-bench-controllers [--quick] [--seeds N] [--first-seed S] [--jobs N] "
+               "[--only ID,...] [--root DIR] [--out DIR]\n");
   return 2;
 }
 
@@ -59,6 +60,7 @@ int usage() {
 int main(int argc, char** argv) {
   bool quick = false;
   int n_seeds = -1;
+  long long first_seed = 1;  // the benchmark's seeds are 1 … N; others for studies off them
   unsigned jobs = std::max(1U, std::thread::hardware_concurrency());
   std::string root = EDM_SOURCE_DIR;
   std::string out_dir;
@@ -70,6 +72,8 @@ int main(int argc, char** argv) {
       quick = true;
     } else if (a == "--seeds") {
       n_seeds = std::atoi(next().c_str());
+    } else if (a == "--first-seed") {
+      first_seed = std::atoll(next().c_str());
     } else if (a == "--jobs") {
       jobs = static_cast<unsigned>(std::max(1, std::atoi(next().c_str())));
     } else if (a == "--root") {
@@ -85,7 +89,7 @@ int main(int argc, char** argv) {
   if (n_seeds < 0) {
     n_seeds = quick ? 5 : 20;
   }
-  if (n_seeds < 1) {
+  if (n_seeds < 1 || first_seed < 1) {
     return usage();
   }
   if (out_dir.empty()) {
@@ -100,8 +104,8 @@ int main(int argc, char** argv) {
                   [&](const auto& s) { return only.find("," + s.id + ",") == std::string::npos; });
   }
   std::vector<std::uint64_t> seeds;
-  for (int i = 1; i <= n_seeds; ++i) {
-    seeds.push_back(static_cast<std::uint64_t>(i));
+  for (int i = 0; i < n_seeds; ++i) {
+    seeds.push_back(static_cast<std::uint64_t>(first_seed + i));
   }
   std::vector<edm::bench::ScenarioResult> results(scenarios.size());
   std::vector<Job> all;
@@ -144,7 +148,8 @@ int main(int argc, char** argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   std::ostringstream md;
-  md << "# Controller benchmark (" << (quick ? "--quick" : "full") << ", seeds 1…" << n_seeds
+  md << "# Controller benchmark (" << (quick ? "--quick" : "full") << ", seeds " << seeds.front()
+     << "…" << seeds.back()
      << ", " << jobs << " threads, " << std::to_string(static_cast<int>(wall_s)) << " s wall)\n\n";
   for (const auto& r : results) {
     md << edm::bench::markdown_table(r) << '\n';

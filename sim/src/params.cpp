@@ -1,7 +1,9 @@
 #include "edm/sim/params.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace edm::sim {
@@ -107,6 +109,16 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("wire_nozzle_radius_mm", wire_nozzle_radius_mm, "mm", "flushing nozzle radius");
   v.param("wire_hole_flush_factor", wire_hole_flush_factor, "1",
           "F_eff x this while the nozzle overlaps the internal hole");
+  v.param("wire_cavity_from_mm", wire_cavity_from_mm, "mm", "internal cavity starts at this length");
+  v.param("wire_cavity_to_mm", wire_cavity_to_mm, "mm", "internal cavity ends (far wall) here");
+  v.param("wire_cavity_height_mm", wire_cavity_height_mm, "mm",
+          "void height of the cavity, centred in H (< H over the cavity)");
+  v.param("wire_cavity_flush_factor", wire_cavity_flush_factor, "1",
+          "flush of the wire's centre part at the cavity's far wall");
+  v.param("wire_cavity_flush_mm", wire_cavity_flush_mm, "mm",
+          "that flush loss fades e-fold per this much cut past the far wall");
+  v.param("wire_cavity_debris", wire_cavity_debris, "1",
+          "debris of the cavity's stagnant dielectric, met at the far wall (0..1)");
   v.param("mean_current_ema_ms", mean_current_ema_ms, "ms", "time constant of mean current");
   v.param("rab_window_ms", rab_window_ms, "ms", "Rab window");
   v.param("mean_voltage_tau_ms", mean_voltage_tau_ms, "ms", "U_av filter time constant");
@@ -257,7 +269,9 @@ std::vector<rt::ParamError> SimParams::validate() const {
                       {"wire_hole_from_mm", wire_hole_from_mm},
                       {"wire_kerf_debris_per_mm", wire_kerf_debris_per_mm},
                       {"wire_kerf_flush_exp", wire_kerf_flush_exp},
-                      {"wire_nozzle_radius_mm", wire_nozzle_radius_mm}}) {
+                      {"wire_nozzle_radius_mm", wire_nozzle_radius_mm},
+                      {"wire_cavity_from_mm", wire_cavity_from_mm},
+                      {"wire_cavity_height_mm", wire_cavity_height_mm}}) {
     require_non_negative(e, n, v);
   }
   require_range(e, "debris_c0", debris_c0, 0.0, 1.0);
@@ -276,6 +290,9 @@ std::vector<rt::ParamError> SimParams::validate() const {
                  "must be a whole number (got " + std::to_string(wire_break_rab_shape) + ")"});
   }
   require_range(e, "wire_hole_flush_factor", wire_hole_flush_factor, 0.0, 1.0);
+  require_range(e, "wire_cavity_flush_factor", wire_cavity_flush_factor, 0.0, 1.0);
+  require_positive(e, "wire_cavity_flush_mm", wire_cavity_flush_mm);
+  require_range(e, "wire_cavity_debris", wire_cavity_debris, 0.0, 1.0);
   require_range(e, "axis_step_us", axis_step_us, 1.0, 50.0);
   if (removal_mm3_per_j == 0.0 && crater_ref_um3 == 0.0) {
     e.push_back({"removal_mm3_per_j", "removal_mm3_per_j or crater_ref_um3 must be > 0"});
@@ -298,11 +315,30 @@ std::vector<rt::ParamError> SimParams::validate() const {
   } else if (tool_kind == "wire") {
     require_positive(e, "wire_d_mm", wire_d_mm);
     std::string why;
-    if (!parse_thickness_profile(wire_thickness_profile, &why)) {
+    const auto steps = parse_thickness_profile(wire_thickness_profile, &why);
+    if (!steps) {
       e.push_back({"wire_thickness_profile", why});
     }
     rt::require_ordered(e, "wire_hole_from_mm", wire_hole_from_mm, "wire_hole_to_mm",
                         wire_hole_to_mm);
+    rt::require_ordered(e, "wire_cavity_from_mm", wire_cavity_from_mm, "wire_cavity_to_mm",
+                        wire_cavity_to_mm);
+    if (steps && wire_cavity_to_mm > wire_cavity_from_mm && wire_cavity_height_mm > 0.0) {
+      // The slabs above and below the cavity must keep some material: h_c < H(s) over it.
+      double h_min = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < steps->size(); ++i) {
+        const double next = i + 1 < steps->size() ? (*steps)[i + 1].from_mm
+                                                  : std::numeric_limits<double>::infinity();
+        if ((*steps)[i].from_mm < wire_cavity_to_mm && next > wire_cavity_from_mm) {
+          h_min = std::min(h_min, (*steps)[i].thickness_mm);
+        }
+      }
+      if (!(wire_cavity_height_mm < h_min)) {
+        e.push_back({"wire_cavity_height_mm",
+                     "must be < the part thickness over the cavity (" + std::to_string(h_min) +
+                         " mm; got " + std::to_string(wire_cavity_height_mm) + ")"});
+      }
+    }
   } else {
     e.push_back({"tool_kind", "must be 'tube', 'block' or 'wire' (got '" + tool_kind + "')"});
   }
@@ -381,6 +417,11 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.wire_kerf_flush_s = 2.0;
     p.wire_kerf_flush_exp = 1.5;
     p.wire_hole_flush_factor = 0.2;
+    // A cavity's far wall: the centre part of the wire sees the flush escaping into the cavity
+    // behind it, as much as through a hole under the nozzle, fading over ≈ ℓ_z of cut. [bk]
+    p.wire_cavity_flush_factor = 0.2;
+    p.wire_cavity_flush_mm = 1.0;
+    p.wire_cavity_debris = 1.0;  // stagnant: as loaded as the kerf debris can be
     p.wire_break_rab = 0.75;
     p.wire_break_rab_ms = 10000.0;
     p.wire_break_rab_width = 0.02;

@@ -120,7 +120,7 @@ double Plant::gap_volume_mm3(double gap_um) const noexcept {
     case Tool::kBlock:
       return area_front_mm2_ * g + side_area_mm2_ * p.side_gap_mm;
     case Tool::kWire: {
-      const double h = profile_.thickness_mm(depth_mm());
+      const double h = cut_thickness_mm();
       return (p.wire_d_mm + 2.0 * g) * h * g + 2.0 * h * p.near_tip_zone_mm * g;
     }
   }
@@ -136,7 +136,22 @@ double Plant::flush_effective() const noexcept {
       depth_mm() - p.wire_nozzle_radius_mm < p.wire_hole_to_mm) {
     drop *= p.wire_hole_flush_factor;  // the flush escapes through the hole under the nozzle
   }
+  const double past_wall = depth_mm() - p.wire_cavity_to_mm;
+  if (tool_ == Tool::kWire && p.wire_cavity_to_mm > p.wire_cavity_from_mm && past_wall >= 0.0) {
+    // The centre part (h_c of H) past a cavity's far wall: its flush escapes into the cavity.
+    const double centre =
+        std::min(1.0, p.wire_cavity_height_mm / profile_.thickness_mm(depth_mm()));
+    drop *= 1.0 - centre * (1.0 - p.wire_cavity_flush_factor) *
+                      std::exp(-past_wall / p.wire_cavity_flush_mm);
+  }
   return p.flush_factor * std::clamp(cmd_.flushing_strength, 0.0, 1.0) * drop;
+}
+
+double Plant::cut_thickness_mm() const noexcept {
+  const double s = depth_mm();
+  const auto& p = params_;
+  const bool in_cavity = s >= p.wire_cavity_from_mm && s < p.wire_cavity_to_mm;
+  return profile_.thickness_mm(s) - (in_cavity ? p.wire_cavity_height_mm : 0.0);
 }
 
 void Plant::set_commands(const PlantCommands& c) noexcept {
@@ -181,7 +196,7 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
   if (tool_ == Tool::kWire && state_.kerf_debris > 0.0) {
     const auto& p = params_;
     const double tau = p.wire_kerf_flush_s *
-                       std::pow(profile_.thickness_mm(depth_mm()) / 10.0, p.wire_kerf_flush_exp);
+                       std::pow(cut_thickness_mm() / 10.0, p.wire_kerf_flush_exp);
     const double r = std::clamp(gap / p.flush_gap_ref_um, 0.0, 1.0);
     state_.kerf_debris *= std::exp(-flush_effective() * r * r * r * dt / tau);
   }
@@ -237,7 +252,7 @@ void Plant::update_wire(std::int64_t t_ns) noexcept {
   if (tool_ != Tool::kWire || state_.wire_broken) return;
   const double f = params_.wire_flush_floor + (1.0 - params_.wire_flush_floor) * flush_effective();
   const double ibk =
-      wire_break_current_a(params_.wire_ibk_ref_a, profile_.thickness_mm(depth_mm()), f);
+      wire_break_current_a(params_.wire_ibk_ref_a, cut_thickness_mm(), f);
   state_.wire_load = current_sum_a_ / ibk;
   if (wire_monitor_.update(dt, current_sum_a_, ibk, rab_.rab(t_ns))) {
     state_.wire_broken = true;
@@ -251,12 +266,17 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
   state_.wear_mm3 += wear_mm3;
   const double v_gap = gap_volume_mm3(gap_um);
   if (tool_ == Tool::kWire) {
-    const double h = profile_.thickness_mm(depth_mm());
+    const double h = cut_thickness_mm();
     const double kerf = p.wire_d_mm + 2.0 * std::max(gap_um, 0.0) * 1e-3;  // k = D + 2g
     const double ds = volume_mm3 / (kerf * h);
     state_.kerf_debris = std::min(1.0, state_.kerf_debris + p.wire_kerf_debris_per_mm * ds);
     double s = depth_mm() + ds;
     if (s >= p.wire_hole_from_mm && s < p.wire_hole_to_mm) s = p.wire_hole_to_mm;  // no material
+    if (p.wire_cavity_to_mm > p.wire_cavity_from_mm && depth_mm() < p.wire_cavity_to_mm &&
+        s >= p.wire_cavity_to_mm) {  // the centre part meets the cavity's stagnant dielectric
+      const double centre = std::min(1.0, p.wire_cavity_height_mm / profile_.thickness_mm(s));
+      state_.kerf_debris = std::min(1.0, state_.kerf_debris + centre * p.wire_cavity_debris);
+    }
     hole_bottom_mm_ = -s;
   } else {
     hole_started_ = true;

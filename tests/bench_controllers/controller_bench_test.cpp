@@ -206,15 +206,17 @@ TEST(ControllerBench, B5IlcLearningFromTheIntegralControllerLowersItsJitterOverT
 namespace edm::bench {
 namespace {
 
-// B6, seed 000's four cases at full length (120 s), one seed that is not among the 20 benchmark
-// seeds: without control the wire breaks in every case; with the self-tuning fuzzy controller
-// and grey predictor (Table 5's row per case) it does not, and after the transient Rab's 1 s
-// means stay within ±0.1 of the set point in cases 2 and 3 (case 1 is at the edge of the band
-// over 20 seeds, case 4 below it after the hole: docs/benchmarks.md, B6). Without the predictor
-// case 1 breaks as without control: the paper's argument for the predictor.
+// B6, seed 000's four cases at full length (120 s; case 4 240 s), and B6e (flushing lost under
+// the nozzle, then back), on one seed that is not among the 20 benchmark seeds: without
+// control the wire breaks in every case (in case 4 at the cavity's far wall, not before); with
+// the self-tuning fuzzy controller and grey predictor (Table 5's row per case) it does not, and
+// Rab's 1 s means come into ±0.1 of the set point and stay there to the end of the run (in
+// cases 2 and 3 already in the scoring window after 45 s; case 1 is at the edge of the band
+// over 20 seeds, and case 4 takes ≈ 80 s after the wall: docs/benchmarks.md, B6). Without the
+// predictor case 1 breaks as without control: the paper's argument for the predictor.
 TEST(ControllerBench, B6SelfTuningFuzzyKeepsTheWireWhereFixedSettingsBreakIt) {
   const auto all = make_scenarios(/*quick=*/false);
-  for (const char* id : {"B6a", "B6b", "B6c", "B6d"}) {
+  for (const char* id : {"B6a", "B6b", "B6c", "B6d", "B6e"}) {
     SCOPED_TRACE(id);
     const Scenario& s = scenario(all, id);
     ASSERT_EQ(s.variants.at(0).name, "no control (fixed settings)");
@@ -228,16 +230,20 @@ TEST(ControllerBench, B6SelfTuningFuzzyKeepsTheWireWhereFixedSettingsBreakIt) {
     EXPECT_LT(of.break_time_s, 60.0);
     EXPECT_EQ(oc.wire_broken, 0.0) << "broke at " << oc.break_time_s << " s";
     EXPECT_GT(oc.depth_mm, 1.0) << "it still cuts";
+    EXPECT_LT(oc.rab_in_band_s, stfpi.limit_s - 60.0) << "Rab settles into ±0.1 for the last minute";
     const std::string which = id;
     if (which == "B6b" || which == "B6c") {
-      EXPECT_LE(oc.rab_above_max, 0.1);
-      EXPECT_LE(oc.rab_below_max, 0.1);
+      EXPECT_LE(oc.rab_above_max, kRabBand);
+      EXPECT_LE(oc.rab_below_max, kRabBand);
     }
     if (which == "B6a") {
       ASSERT_EQ(s.variants.at(2).name, "self-tuning fuzzy PI, no predictor");
       RunSpec nogrey = s.variants[2].spec;
       nogrey.seed = 101;
       EXPECT_EQ(run(kRoot, nogrey).wire_broken, 1.0);
+    }
+    if (which == "B6d") {
+      EXPECT_GT(of.break_time_s, 40.0) << "the fixed settings hold the 30 mm part up to the wall";
     }
   }
 }

@@ -109,5 +109,30 @@ TEST(SimParams, thickness_profile_parses_and_rejects_precisely) {
   ASSERT_TRUE(has_error(errs, "wire_thickness_profile"));
 }
 
+// A cavity must lie inside the part: from ≤ to, and its void shorter than the thinnest part of
+// the profile it overlaps (the slabs above and below keep material).
+TEST(SimParams, wire_cavity_is_checked_against_the_profile) {
+  auto wire = *SimParams::preset("wire");
+  wire.wire_thickness_profile = "0:30,8:12,20:30";
+  wire.wire_cavity_from_mm = 5.0;
+  wire.wire_cavity_to_mm = 10.0;
+  wire.wire_cavity_height_mm = 11.9;
+  EXPECT_FALSE(has_error(wire.validate(), "wire_cavity_height_mm"));
+  wire.wire_cavity_height_mm = 12.0;  // as tall as the 12 mm section from 8 mm on
+  const auto errs = wire.validate();
+  ASSERT_TRUE(has_error(errs, "wire_cavity_height_mm"));
+  wire.wire_cavity_from_mm = 2.0;  // the cavity ends before the thin section: 12 mm fits
+  wire.wire_cavity_to_mm = 8.0;
+  EXPECT_FALSE(has_error(wire.validate(), "wire_cavity_height_mm"));
+  wire.wire_cavity_from_mm = 9.0;  // from > to
+  EXPECT_TRUE(has_error(wire.validate(), "wire_cavity_to_mm"));
+  wire.wire_cavity_from_mm = 2.0;
+  wire.wire_cavity_flush_mm = 0.0;
+  EXPECT_TRUE(has_error(wire.validate(), "wire_cavity_flush_mm"));
+  wire.wire_cavity_flush_mm = 1.0;
+  wire.wire_cavity_flush_factor = 1.5;
+  EXPECT_TRUE(has_error(wire.validate(), "wire_cavity_flush_factor"));
+}
+
 }  // namespace
 }  // namespace edm::sim

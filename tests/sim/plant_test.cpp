@@ -469,6 +469,62 @@ TEST(SimPlant, wire_flushing_drops_while_the_nozzle_is_over_the_internal_hole) {
   }
 }
 
+// Seed 000's case 4: a cavity keeps the nozzles' flush but not the centre part's. F_eff is 1
+// up to the far wall (in the cavity too: the slabs' kerf is flushed), then
+// 1 − (h_c/H)(1 − f_c) e^(−(s − s_to)/λ).
+TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_recovers) {
+  auto wire = *SimParams::preset("wire");
+  wire.wire_hole_from_mm = wire.wire_hole_to_mm = 0.0;
+  wire.wire_thickness_profile = "0:30";
+  wire.wire_cavity_from_mm = 5.0;
+  wire.wire_cavity_to_mm = 10.0;
+  wire.wire_cavity_height_mm = 12.0;
+  wire.wire_cavity_flush_factor = 0.2;
+  wire.wire_cavity_flush_mm = 0.8;
+  Plant p(wire, 24);
+  const double loss = 12.0 / 30.0 * (1.0 - 0.2);
+  for (const auto& [s, f] : std::vector<std::pair<double, double>>{
+           {4.9, 1.0},
+           {7.0, 1.0},
+           {9.999, 1.0},
+           {10.0, 1.0 - loss},
+           {10.8, 1.0 - loss * std::exp(-1.0)},
+           {12.4, 1.0 - loss * std::exp(-3.0)}}) {
+    p.set_depth_mm(s);
+    EXPECT_NEAR(p.state().flush_effective, f, 1e-12) << "cut " << s << " mm";
+  }
+}
+
+// Over the cavity the wire cuts only the slabs, H − h_c: the kerf debris there flushes with
+// τ_k of that thickness, and past the far wall with τ_k of H again (at full flush, far away).
+TEST(SimPlant, wire_cuts_only_the_slabs_over_a_cavity) {
+  auto wire = *SimParams::preset("wire");
+  wire.wire_hole_from_mm = wire.wire_hole_to_mm = 0.0;
+  wire.wire_thickness_profile = "0:40";
+  wire.wire_cavity_from_mm = 5.0;
+  wire.wire_cavity_to_mm = 10.0;
+  wire.wire_cavity_height_mm = 30.0;
+  for (const auto& [s, h] : std::vector<std::pair<double, double>>{{7.0, 10.0}, {60.0, 40.0}}) {
+    Plant p(wire, 25);
+    p.hold_gap(15.0);
+    auto cmd = generator_on();
+    cmd.flushing_on = false;
+    p.set_commands(cmd);
+    run_ms(p, 300);
+    p.set_depth_mm(s);
+    p.hold_gap(wire.flush_gap_ref_um + 5.0);
+    cmd.generator_on = false;
+    cmd.flushing_on = true;
+    p.set_commands(cmd);
+    const double c0 = p.state().kerf_debris;
+    ASSERT_GT(c0, 0.0);
+    run_ms(p, 1000);
+    ASSERT_DOUBLE_EQ(p.state().flush_effective, 1.0) << "cut " << s << " mm";
+    const double tau = wire.wire_kerf_flush_s * std::pow(h / 10.0, wire.wire_kerf_flush_exp);
+    EXPECT_NEAR(p.state().kerf_debris / c0, std::exp(-1.0 / tau), 1e-3) << "cut " << s << " mm";
+  }
+}
+
 // The calibration seed 000's benchmark (B6) rests on, with the paper's 110 V ignition voltage
 // on 50 mm work: the machine's own voltage servo at the aggressive corner of Table 1 (9 µs
 // arc-off, 30 V) breaks the wire within seconds on every seed; at the gentle corner (50 µs,

@@ -48,6 +48,9 @@ struct RunSpec {
   double window_end_state{0.0};    // > 0 (B3): ... until done_var reaches this (RETRACT)
 };
 
+/// Seed 000's acceptance band: Rab within ±0.1 of its set point after the transient.
+inline constexpr double kRabBand = 0.1;
+
 /// Outcomes of one run (PLANT-MODEL §5, as far as the simulator exposes them).
 struct Outcome {
   double time_s{0.0};           // simulated time run [s]
@@ -69,6 +72,10 @@ struct Outcome {
   double rab_err_rms{0.0};    // RMS of (1 s mean Rab − ref) after the transient
   double rab_above_max{0.0};  // max (1 s mean Rab − ref) after the transient (rupture side)
   double rab_below_max{0.0};  // max (ref − 1 s mean Rab) after the transient (speed lost)
+  // The time from which every 1 s mean of Rab (seconds with sparks) stays within ±kRabBand of
+  // the set point to the end of the run [s]: how long the transients lasted. The time limit
+  // when the last second is out of the band or the wire broke.
+  double rab_in_band_s{0.0};
   double overload_s{0.0};     // time with Ī > 0.9 I_BK [s] (simulator truth)
   // Five-state time ratios [%] (sink): normal (spark), transient arc, stable arc, short, open.
   double ratio_normal_pct{0.0};

@@ -117,6 +117,7 @@ std::vector<std::pair<const char*, double>> Outcome::fields() const {
           {"rab_err_rms", rab_err_rms},
           {"rab_above_max", rab_above_max},
           {"rab_below_max", rab_below_max},
+          {"rab_in_band_s", rab_in_band_s},
           {"overload_s", overload_s},
           {"ratio_normal_pct", ratio_normal_pct},
           {"ratio_tarc_pct", ratio_tarc_pct},
@@ -236,6 +237,8 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   bool vz_high = false, reached = false;
   double rab_sum = 0, rab_n = 0, rab_sec = 0, rab_sec_n = 0, rab_err_ss = 0, rab_err_n = 0;
   double rab_all_sec = 0;  // this second's sum of io.rab, for rab_per_s
+  double all_sec_open = 0, all_sec_pulses = 0;  // this second's pulses, for rab_in_band_s
+  double last_out_of_band_s = 0;                // end of the last second out of the band
   double sec_open = 0, sec_pulses = 0;
   LineFit fit;
   std::int64_t k = 0;
@@ -326,9 +329,15 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     }
     if (spec.rab_ref > 0 && o.wire_broken == 0.0) {
       rab_all_sec += rt::read_pin_as_double(rab);
+      all_sec_open += c[0];
+      all_sec_pulses += c[0] + c[1] + c[2] + c[3] + c[4];
       if (k % 1000 == 0) {
-        o.rab_per_s.push_back(rab_all_sec / 1000.0);
-        rab_all_sec = 0.0;
+        const double mean = rab_all_sec / 1000.0;
+        o.rab_per_s.push_back(mean);
+        if (all_sec_open <= 0.5 * all_sec_pulses && std::fabs(mean - spec.rab_ref) > kRabBand) {
+          last_out_of_band_s = t_s;
+        }
+        rab_all_sec = all_sec_open = all_sec_pulses = 0.0;
       }
     }
     if (spec.rab_ref > 0 && t_s > spec.transient_s && o.wire_broken == 0.0) {
@@ -413,6 +422,9 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   if (o.wire_broken == 0.0) {
     o.break_time_s = spec.limit_s;
   }
+  o.rab_in_band_s =
+      o.wire_broken != 0.0 || last_out_of_band_s > spec.limit_s - 0.5 ? spec.limit_s
+                                                                         : last_out_of_band_s;
   o.rab_mean = rab_n > 0 ? rab_sum / rab_n : 0.0;
   if (loop_n > 0) {
     o.loop_y_mean = loop_y_sum / loop_n;

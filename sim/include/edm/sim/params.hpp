@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/5";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/6";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
@@ -139,6 +139,20 @@ struct SimParams {
   // multiplied by wire_hole_flush_factor. [bk]
   double wire_nozzle_radius_mm{3.0};
   double wire_hole_flush_factor{1.0};
+  // An internal cavity in the part's cross-section (seed 000's case 4, Fig. 8d): over
+  // [wire_cavity_from_mm, wire_cavity_to_mm) of cut the centre wire_cavity_height_mm of the
+  // thickness is void, so the cut thickness is H(s) − h_c. Past the far wall the centre part of
+  // the wire is poorly flushed (the paper: "the upper and lower flushing pressure can be
+  // maintained ... the centre part of wire undergoes poor flushing"): F_eff is multiplied by
+  // 1 − (h_c/H)(1 − wire_cavity_flush_factor) e^(−(s − s_to)/wire_cavity_flush_mm), and as
+  // the cut crosses the far wall the cavity's stagnant dielectric (debris
+  // wire_cavity_debris) enters the centre part's kerf: c_k += (h_c/H) wire_cavity_debris. [bk]
+  double wire_cavity_from_mm{0.0};
+  double wire_cavity_to_mm{0.0};  // equal to from = none
+  double wire_cavity_height_mm{0.0};
+  double wire_cavity_flush_factor{1.0};
+  double wire_cavity_flush_mm{1.0};
+  double wire_cavity_debris{0.0};
   double mean_current_ema_ms{10.0};  // Ī time constant
 
   // --- Sensors (§6.2 step 8) ---

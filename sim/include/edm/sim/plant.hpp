@@ -116,6 +116,8 @@ class Plant {
   [[nodiscard]] double wall_gap_um(std::size_t j) const noexcept;
   [[nodiscard]] double gap_volume_mm3(double gap_um) const noexcept;
   [[nodiscard]] double flush_effective() const noexcept;
+  /// Wire: the thickness being cut here, H(s) less an internal cavity's void height.
+  [[nodiscard]] double cut_thickness_mm() const noexcept;
   void account(std::int64_t until_ns) noexcept;
   void step_axes(std::int64_t t_ns) noexcept;
   /// Tube: before any erosion the hole's axis follows the electrode's XY; once the tip is
