@@ -22,11 +22,11 @@ struct WireCase {
   double servo_ref_v, arc_off_us;
   double ol, ku, kv, rab_ref;
   double transient_s;  // Rab error is scored after this
-  double limit_s;      // length of a full run (quick runs: 30 s)
+  double limit_s;      // length of a full run (quick runs: a quarter of it)
 };
 
 std::vector<Variant> wire_variants(const WireCase& c, bool quick) {
-  const double limit_s = quick ? 30.0 : c.limit_s;
+  const double limit_s = quick ? c.limit_s / 4.0 : c.limit_s;
   auto fmt = [](double x) {
     std::string s = std::to_string(x);
     s.erase(s.find_last_not_of('0') + 1);
@@ -39,7 +39,7 @@ std::vector<Variant> wire_variants(const WireCase& c, bool quick) {
   base.io_extra = c.io_extra;
   base.limit_s = limit_s;
   base.rab_ref = c.rab_ref;
-  base.transient_s = std::min(c.transient_s, limit_s * 2.0 / 3.0);  // quick runs: 20 s
+  base.transient_s = std::min(c.transient_s, limit_s * 2.0 / 3.0);  // quick: 20 s, B6d-e 40 s
   RunSpec fixed = base;
   fixed.config = "config/bench/controllers/wire-fixed.yaml";
   fixed.edits = {{"io.servo_ref_v: 40.0", "io.servo_ref_v: " + fmt(c.servo_ref_v)},
