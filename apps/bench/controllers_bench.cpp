@@ -149,8 +149,8 @@ int main(int argc, char** argv) {
 
   std::ostringstream md;
   md << "# Controller benchmark (" << (quick ? "--quick" : "full") << ", seeds " << seeds.front()
-     << "…" << seeds.back()
-     << ", " << jobs << " threads, " << std::to_string(static_cast<int>(wall_s)) << " s wall)\n\n";
+     << "…" << seeds.back() << ", " << jobs << " threads, "
+     << std::to_string(static_cast<int>(wall_s)) << " s wall)\n\n";
   for (const auto& r : results) {
     md << edm::bench::markdown_table(r) << '\n';
     edm::bench::write_csv(out_dir, r, seeds);

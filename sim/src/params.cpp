@@ -109,7 +109,8 @@ void SimParams::visit(rt::ParamVisitor& v) {
   v.param("wire_nozzle_radius_mm", wire_nozzle_radius_mm, "mm", "flushing nozzle radius");
   v.param("wire_hole_flush_factor", wire_hole_flush_factor, "1",
           "F_eff x this while the nozzle overlaps the internal hole");
-  v.param("wire_cavity_from_mm", wire_cavity_from_mm, "mm", "internal cavity starts at this length");
+  v.param("wire_cavity_from_mm", wire_cavity_from_mm, "mm",
+          "internal cavity starts at this length");
   v.param("wire_cavity_to_mm", wire_cavity_to_mm, "mm", "internal cavity ends (far wall) here");
   v.param("wire_cavity_height_mm", wire_cavity_height_mm, "mm",
           "void height of the cavity, centred in H (< H over the cavity)");
@@ -334,9 +335,9 @@ std::vector<rt::ParamError> SimParams::validate() const {
         }
       }
       if (!(wire_cavity_height_mm < h_min)) {
-        e.push_back({"wire_cavity_height_mm",
-                     "must be < the part thickness over the cavity (" + std::to_string(h_min) +
-                         " mm; got " + std::to_string(wire_cavity_height_mm) + ")"});
+        e.push_back({"wire_cavity_height_mm", "must be < the part thickness over the cavity (" +
+                                                  std::to_string(h_min) + " mm; got " +
+                                                  std::to_string(wire_cavity_height_mm) + ")"});
       }
     }
   } else {

@@ -195,8 +195,8 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
                                       model_.flush_rate_per_s(gap, h_flush, flush_effective()), dt);
   if (tool_ == Tool::kWire && state_.kerf_debris > 0.0) {
     const auto& p = params_;
-    const double tau = p.wire_kerf_flush_s *
-                       std::pow(cut_thickness_mm() / 10.0, p.wire_kerf_flush_exp);
+    const double tau =
+        p.wire_kerf_flush_s * std::pow(cut_thickness_mm() / 10.0, p.wire_kerf_flush_exp);
     const double r = std::clamp(gap / p.flush_gap_ref_um, 0.0, 1.0);
     state_.kerf_debris *= std::exp(-flush_effective() * r * r * r * dt / tau);
   }
@@ -251,8 +251,7 @@ void Plant::update_wire(std::int64_t t_ns) noexcept {
   current_sum_a_ *= std::exp(-static_cast<double>(dt) / (params_.mean_current_ema_ms * 1e6));
   if (tool_ != Tool::kWire || state_.wire_broken) return;
   const double f = params_.wire_flush_floor + (1.0 - params_.wire_flush_floor) * flush_effective();
-  const double ibk =
-      wire_break_current_a(params_.wire_ibk_ref_a, cut_thickness_mm(), f);
+  const double ibk = wire_break_current_a(params_.wire_ibk_ref_a, cut_thickness_mm(), f);
   state_.wire_load = current_sum_a_ / ibk;
   if (wire_monitor_.update(dt, current_sum_a_, ibk, rab_.rab(t_ns))) {
     state_.wire_broken = true;

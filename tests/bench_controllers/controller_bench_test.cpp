@@ -230,7 +230,8 @@ TEST(ControllerBench, B6SelfTuningFuzzyKeepsTheWireWhereFixedSettingsBreakIt) {
     EXPECT_LT(of.break_time_s, 60.0);
     EXPECT_EQ(oc.wire_broken, 0.0) << "broke at " << oc.break_time_s << " s";
     EXPECT_GT(oc.depth_mm, 1.0) << "it still cuts";
-    EXPECT_LT(oc.rab_in_band_s, stfpi.limit_s - 60.0) << "Rab settles into ±0.1 for the last minute";
+    EXPECT_LT(oc.rab_in_band_s, stfpi.limit_s - 60.0)
+        << "Rab settles into ±0.1 for the last minute";
     const std::string which = id;
     if (which == "B6b" || which == "B6c") {
       EXPECT_LE(oc.rab_above_max, kRabBand);

@@ -483,13 +483,13 @@ TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_r
   wire.wire_cavity_flush_mm = 0.8;
   Plant p(wire, 24);
   const double loss = 12.0 / 30.0 * (1.0 - 0.2);
-  for (const auto& [s, f] : std::vector<std::pair<double, double>>{
-           {4.9, 1.0},
-           {7.0, 1.0},
-           {9.999, 1.0},
-           {10.0, 1.0 - loss},
-           {10.8, 1.0 - loss * std::exp(-1.0)},
-           {12.4, 1.0 - loss * std::exp(-3.0)}}) {
+  for (const auto& [s, f] :
+       std::vector<std::pair<double, double>>{{4.9, 1.0},
+                                              {7.0, 1.0},
+                                              {9.999, 1.0},
+                                              {10.0, 1.0 - loss},
+                                              {10.8, 1.0 - loss * std::exp(-1.0)},
+                                              {12.4, 1.0 - loss * std::exp(-3.0)}}) {
     p.set_depth_mm(s);
     EXPECT_NEAR(p.state().flush_effective, f, 1e-12) << "cut " << s << " mm";
   }

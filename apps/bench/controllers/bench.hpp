@@ -76,7 +76,7 @@ struct Outcome {
   // the set point to the end of the run [s]: how long the transients lasted. The time limit
   // when the last second is out of the band or the wire broke.
   double rab_in_band_s{0.0};
-  double overload_s{0.0};     // time with Ī > 0.9 I_BK [s] (simulator truth)
+  double overload_s{0.0};  // time with Ī > 0.9 I_BK [s] (simulator truth)
   // Five-state time ratios [%] (sink): normal (spark), transient arc, stable arc, short, open.
   double ratio_normal_pct{0.0};
   double ratio_tarc_pct{0.0};

@@ -236,7 +236,7 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   double electrode0 = -1.0;
   bool vz_high = false, reached = false;
   double rab_sum = 0, rab_n = 0, rab_sec = 0, rab_sec_n = 0, rab_err_ss = 0, rab_err_n = 0;
-  double rab_all_sec = 0;  // this second's sum of io.rab, for rab_per_s
+  double rab_all_sec = 0;                       // this second's sum of io.rab, for rab_per_s
   double all_sec_open = 0, all_sec_pulses = 0;  // this second's pulses, for rab_in_band_s
   double last_out_of_band_s = 0;                // end of the last second out of the band
   double sec_open = 0, sec_pulses = 0;
@@ -422,9 +422,9 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   if (o.wire_broken == 0.0) {
     o.break_time_s = spec.limit_s;
   }
-  o.rab_in_band_s =
-      o.wire_broken != 0.0 || last_out_of_band_s > spec.limit_s - 0.5 ? spec.limit_s
-                                                                         : last_out_of_band_s;
+  o.rab_in_band_s = o.wire_broken != 0.0 || last_out_of_band_s > spec.limit_s - 0.5
+                        ? spec.limit_s
+                        : last_out_of_band_s;
   o.rab_mean = rab_n > 0 ? rab_sum / rab_n : 0.0;
   if (loop_n > 0) {
     o.loop_y_mean = loop_y_sum / loop_n;
