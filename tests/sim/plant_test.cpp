@@ -472,13 +472,20 @@ TEST(SimPlant, wire_flushing_drops_while_the_nozzle_is_over_the_internal_hole) {
 // Seed 000's case 4: a cavity keeps the nozzles' flush but not the centre part's. F_eff is 1
 // up to the far wall (in the cavity too: the slabs' kerf is flushed), then
 // 1 − (h_c/H)(1 − f_c) e^(−(s − s_to)/λ).
-TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_recovers) {
+// The wire preset on a part of thickness h with a cavity h_c tall over [5, 10) mm of cut and no
+// through-hole.
+SimParams wire_with_cavity(double h, double h_c) {
   auto wire = *SimParams::preset("wire");
   wire.wire_hole_from_mm = wire.wire_hole_to_mm = 0.0;
-  wire.wire_thickness_profile = "0:30";
+  wire.wire_thickness_profile = "0:" + std::to_string(h);
   wire.wire_cavity_from_mm = 5.0;
   wire.wire_cavity_to_mm = 10.0;
-  wire.wire_cavity_height_mm = 12.0;
+  wire.wire_cavity_height_mm = h_c;
+  return wire;
+}
+
+TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_recovers) {
+  auto wire = wire_with_cavity(30.0, 12.0);
   wire.wire_cavity_flush_factor = 0.2;
   wire.wire_cavity_flush_mm = 0.8;
   Plant p(wire, 24);
@@ -498,12 +505,7 @@ TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_r
 // Over the cavity the wire cuts only the slabs, H − h_c: the kerf debris there flushes with
 // τ_k of that thickness, and past the far wall with τ_k of H again (at full flush, far away).
 TEST(SimPlant, wire_cuts_only_the_slabs_over_a_cavity) {
-  auto wire = *SimParams::preset("wire");
-  wire.wire_hole_from_mm = wire.wire_hole_to_mm = 0.0;
-  wire.wire_thickness_profile = "0:40";
-  wire.wire_cavity_from_mm = 5.0;
-  wire.wire_cavity_to_mm = 10.0;
-  wire.wire_cavity_height_mm = 30.0;
+  const auto wire = wire_with_cavity(40.0, 30.0);
   for (const auto& [s, h] : std::vector<std::pair<double, double>>{{7.0, 10.0}, {60.0, 40.0}}) {
     Plant p(wire, 25);
     p.hold_gap(15.0);
@@ -523,6 +525,35 @@ TEST(SimPlant, wire_cuts_only_the_slabs_over_a_cavity) {
     const double tau = wire.wire_kerf_flush_s * std::pow(h / 10.0, wire.wire_kerf_flush_exp);
     EXPECT_NEAR(p.state().kerf_debris / c0, std::exp(-1.0 / tau), 1e-3) << "cut " << s << " mm";
   }
+}
+
+// Crossing the far wall, the centre part meets the cavity's stagnant dielectric once: without
+// flushing the kerf debris grows by κ_k per mm of cut (the slabs' and the wall's) plus
+// (h_c/H)·c_cav, and no more on the next millimetre.
+TEST(SimPlant, wire_meets_the_cavity_debris_once_at_the_far_wall) {
+  auto wire = wire_with_cavity(30.0, 12.0);
+  wire.wire_cavity_debris = 0.5;
+  Plant p(wire, 26);
+  auto cmd = generator_on();
+  cmd.flushing_on = false;
+  p.set_depth_mm(wire.wire_cavity_to_mm - 0.002);
+  p.hold_gap(15.0);
+  p.set_commands(cmd);
+  const double c0 = p.state().kerf_debris;
+  const double s0 = p.state().depth_mm;
+  for (int ms = 0; ms < 5000 && p.state().depth_mm < wire.wire_cavity_to_mm + 0.002; ++ms) {
+    run_ms(p, 1);
+  }
+  ASSERT_GE(p.state().depth_mm, wire.wire_cavity_to_mm + 0.002) << "the cut crossed the wall";
+  const double jump =
+      p.state().kerf_debris - c0 - wire.wire_kerf_debris_per_mm * (p.state().depth_mm - s0);
+  EXPECT_NEAR(jump, 12.0 / 30.0 * 0.5, 1e-9);
+  const double c1 = p.state().kerf_debris;
+  const double s1 = p.state().depth_mm;
+  run_ms(p, 50);
+  ASSERT_LT(p.state().kerf_debris, 1.0);
+  EXPECT_NEAR(p.state().kerf_debris - c1, wire.wire_kerf_debris_per_mm * (p.state().depth_mm - s1),
+              1e-9);
 }
 
 // The calibration seed 000's benchmark (B6) rests on, with the paper's 110 V ignition voltage
