@@ -6,6 +6,7 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -433,25 +434,38 @@ TEST(SimPlant, wire_kerf_debris_is_kappa_per_mm_of_cut_without_flushing) {
 
 // ... and with flushing (gap ≥ g_ref, no sparks) it decays as exp(−t/τ_k),
 // τ_k = wire_kerf_flush_s (H/10 mm)^wire_kerf_flush_exp.
+// Cuts 300 ms without flushing (kerf debris builds), moves the cut to `at_mm` if given, then
+// flushes 1 s at a gap ≥ g_ref with the generator off: c_k(1 s)/c_k(0), 0 if none was built.
+double kerf_debris_left_after_1s_of_flushing(const SimParams& wire, std::uint64_t seed,
+                                             std::optional<double> at_mm = std::nullopt) {
+  Plant p(wire, seed);
+  p.hold_gap(15.0);
+  auto cmd = generator_on();
+  cmd.flushing_on = false;
+  p.set_commands(cmd);
+  run_ms(p, 300);
+  if (at_mm) p.set_depth_mm(*at_mm);
+  p.hold_gap(wire.flush_gap_ref_um + 5.0);
+  cmd.generator_on = false;
+  cmd.flushing_on = true;
+  p.set_commands(cmd);
+  const double c0 = p.state().kerf_debris;
+  run_ms(p, 1000);
+  EXPECT_DOUBLE_EQ(p.state().flush_effective, 1.0);
+  return c0 > 0.0 ? p.state().kerf_debris / c0 : 0.0;
+}
+
+double kerf_tau_s(const SimParams& wire, double h_mm) {
+  return wire.wire_kerf_flush_s * std::pow(h_mm / 10.0, wire.wire_kerf_flush_exp);
+}
+
 TEST(SimPlant, wire_kerf_debris_flushes_with_tau_growing_with_thickness) {
   for (const double h : {10.0, 40.0}) {
     auto wire = *SimParams::preset("wire");
     wire.wire_thickness_profile = "0:" + std::to_string(h);
-    Plant p(wire, 22);
-    p.hold_gap(15.0);
-    auto cmd = generator_on();
-    cmd.flushing_on = false;
-    p.set_commands(cmd);
-    run_ms(p, 300);
-    p.hold_gap(wire.flush_gap_ref_um + 5.0);
-    cmd.generator_on = false;
-    cmd.flushing_on = true;
-    p.set_commands(cmd);
-    const double c0 = p.state().kerf_debris;
-    ASSERT_GT(c0, 0.0);
-    run_ms(p, 1000);
-    const double tau = wire.wire_kerf_flush_s * std::pow(h / 10.0, wire.wire_kerf_flush_exp);
-    EXPECT_NEAR(p.state().kerf_debris / c0, std::exp(-1.0 / tau), 1e-3) << "H " << h;
+    EXPECT_NEAR(kerf_debris_left_after_1s_of_flushing(wire, 22),
+                std::exp(-1.0 / kerf_tau_s(wire, h)), 1e-3)
+        << "H " << h;
   }
 }
 
@@ -507,23 +521,9 @@ TEST(SimPlant, wire_flushing_of_the_centre_part_drops_at_a_cavity_far_wall_and_r
 TEST(SimPlant, wire_cuts_only_the_slabs_over_a_cavity) {
   const auto wire = wire_with_cavity(40.0, 30.0);
   for (const auto& [s, h] : std::vector<std::pair<double, double>>{{7.0, 10.0}, {60.0, 40.0}}) {
-    Plant p(wire, 25);
-    p.hold_gap(15.0);
-    auto cmd = generator_on();
-    cmd.flushing_on = false;
-    p.set_commands(cmd);
-    run_ms(p, 300);
-    p.set_depth_mm(s);
-    p.hold_gap(wire.flush_gap_ref_um + 5.0);
-    cmd.generator_on = false;
-    cmd.flushing_on = true;
-    p.set_commands(cmd);
-    const double c0 = p.state().kerf_debris;
-    ASSERT_GT(c0, 0.0);
-    run_ms(p, 1000);
-    ASSERT_DOUBLE_EQ(p.state().flush_effective, 1.0) << "cut " << s << " mm";
-    const double tau = wire.wire_kerf_flush_s * std::pow(h / 10.0, wire.wire_kerf_flush_exp);
-    EXPECT_NEAR(p.state().kerf_debris / c0, std::exp(-1.0 / tau), 1e-3) << "cut " << s << " mm";
+    EXPECT_NEAR(kerf_debris_left_after_1s_of_flushing(wire, 25, s),
+                std::exp(-1.0 / kerf_tau_s(wire, h)), 1e-3)
+        << "cut " << s << " mm";
   }
 }
 
