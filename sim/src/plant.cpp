@@ -139,12 +139,14 @@ double Plant::flush_effective() const noexcept {
   const double past_wall = depth_mm() - p.wire_cavity_to_mm;
   if (tool_ == Tool::kWire && p.wire_cavity_to_mm > p.wire_cavity_from_mm && past_wall >= 0.0) {
     // The centre part (h_c of H) past a cavity's far wall: its flush escapes into the cavity.
-    const double centre =
-        std::min(1.0, p.wire_cavity_height_mm / profile_.thickness_mm(depth_mm()));
-    drop *= 1.0 - centre * (1.0 - p.wire_cavity_flush_factor) *
+    drop *= 1.0 - cavity_centre_fraction(depth_mm()) * (1.0 - p.wire_cavity_flush_factor) *
                       std::exp(-past_wall / p.wire_cavity_flush_mm);
   }
   return p.flush_factor * std::clamp(cmd_.flushing_strength, 0.0, 1.0) * drop;
+}
+
+double Plant::cavity_centre_fraction(double cut_mm) const noexcept {
+  return std::min(1.0, params_.wire_cavity_height_mm / profile_.thickness_mm(cut_mm));
 }
 
 double Plant::cut_thickness_mm() const noexcept {
@@ -273,8 +275,8 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
     if (s >= p.wire_hole_from_mm && s < p.wire_hole_to_mm) s = p.wire_hole_to_mm;  // no material
     if (p.wire_cavity_to_mm > p.wire_cavity_from_mm && depth_mm() < p.wire_cavity_to_mm &&
         s >= p.wire_cavity_to_mm) {  // the centre part meets the cavity's stagnant dielectric
-      const double centre = std::min(1.0, p.wire_cavity_height_mm / profile_.thickness_mm(s));
-      state_.kerf_debris = std::min(1.0, state_.kerf_debris + centre * p.wire_cavity_debris);
+      state_.kerf_debris =
+          std::min(1.0, state_.kerf_debris + cavity_centre_fraction(s) * p.wire_cavity_debris);
     }
     hole_bottom_mm_ = -s;
   } else {

@@ -35,7 +35,7 @@ struct RunSpec {
   double jump_period_s{0.0};    // > 0: forced jump (io.vz_cmd) every period (B5)
   double td_ref_us{0.0};        // > 0: RMS(Td − td_ref) over cycles with ignited pulses
   double rab_ref{0.0};          // > 0: Rab error against this set point (1 s means)
-  double transient_s{0.0};      // Rab error only after this time [s]
+  double transient_s{0.0};      // Rab error only after this time [s] (whole seconds from it on)
   std::string jump_cycle_var;   // non-empty (B5 ILC): forced 1 for the first ms of each jump
   std::string jump_hold_var;    // non-empty: forced to jump_hold_value while the jump is forced
   double jump_hold_value{0.0};

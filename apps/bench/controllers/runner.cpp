@@ -235,11 +235,11 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
   double td_ss = 0, td_n = 0;
   double electrode0 = -1.0;
   bool vz_high = false, reached = false;
-  double rab_sum = 0, rab_n = 0, rab_sec = 0, rab_sec_n = 0, rab_err_ss = 0, rab_err_n = 0;
-  double rab_all_sec = 0;                       // this second's sum of io.rab, for rab_per_s
-  double all_sec_open = 0, all_sec_pulses = 0;  // this second's pulses, for rab_in_band_s
-  double last_out_of_band_s = 0;                // end of the last second out of the band
-  double sec_open = 0, sec_pulses = 0;
+  // Wire: io.rab after the transient (per ms, for rab_mean) and per whole second of the run.
+  const auto transient_ms = static_cast<std::int64_t>(std::llround(spec.transient_s * 1000.0));
+  double rab_sum = 0, rab_n = 0, rab_err_ss = 0, rab_err_n = 0;
+  double rab_sec = 0, sec_open = 0, sec_pulses = 0;  // this second's sums
+  double last_out_of_band_s = 0;                     // end of the last second out of the band
   LineFit fit;
   std::int64_t k = 0;
   std::int64_t end_ms = limit_ms;
@@ -328,37 +328,32 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
       o.overload_s += 1e-3;
     }
     if (spec.rab_ref > 0 && o.wire_broken == 0.0) {
-      rab_all_sec += rt::read_pin_as_double(rab);
-      all_sec_open += c[0];
-      all_sec_pulses += c[0] + c[1] + c[2] + c[3] + c[4];
-      if (k % 1000 == 0) {
-        const double mean = rab_all_sec / 1000.0;
-        o.rab_per_s.push_back(mean);
-        if (all_sec_open <= 0.5 * all_sec_pulses && std::fabs(mean - spec.rab_ref) > kRabBand) {
-          last_out_of_band_s = t_s;
-        }
-        rab_all_sec = all_sec_open = all_sec_pulses = 0.0;
-      }
-    }
-    if (spec.rab_ref > 0 && t_s > spec.transient_s && o.wire_broken == 0.0) {
       const double x = rt::read_pin_as_double(rab);
-      rab_sum += x;
-      rab_n += 1;
+      if (k > transient_ms) {
+        rab_sum += x;
+        rab_n += 1;
+      }
       rab_sec += x;
-      rab_sec_n += 1;
       sec_open += c[0];
       sec_pulses += c[0] + c[1] + c[2] + c[3] + c[4];
-      if (rab_sec_n >= 1000) {
-        // Scored only while the wire cuts: a second with most pulses open (crossing an
-        // internal hole, or backed off the work) has no sparks for Rab to measure.
+      if (k % 1000 == 0) {  // a whole second: its mean Rab
+        const double mean = rab_sec / 1000.0;
+        o.rab_per_s.push_back(mean);
+        // Scored only while the wire cuts: a second with most pulses open (crossing a
+        // through-hole, or backed off the work) has no sparks for Rab to measure.
         if (sec_open <= 0.5 * sec_pulses) {
-          const double e = rab_sec / rab_sec_n - spec.rab_ref;
-          rab_err_ss += e * e;
-          rab_err_n += 1;
-          o.rab_above_max = std::max(o.rab_above_max, e);
-          o.rab_below_max = std::max(o.rab_below_max, -e);
+          const double e = mean - spec.rab_ref;
+          if (std::fabs(e) > kRabBand) {
+            last_out_of_band_s = t_s;
+          }
+          if (k - 1000 >= transient_ms) {  // the whole second after the transient
+            rab_err_ss += e * e;
+            rab_err_n += 1;
+            o.rab_above_max = std::max(o.rab_above_max, e);
+            o.rab_below_max = std::max(o.rab_below_max, -e);
+          }
         }
-        rab_sec = rab_sec_n = sec_open = sec_pulses = 0;
+        rab_sec = sec_open = sec_pulses = 0.0;
       }
     }
     const bool cutting = !has_done || spec.window_end_state <= 0 ||

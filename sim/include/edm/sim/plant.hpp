@@ -118,6 +118,8 @@ class Plant {
   [[nodiscard]] double flush_effective() const noexcept;
   /// Wire: the thickness being cut here, H(s) less an internal cavity's void height.
   [[nodiscard]] double cut_thickness_mm() const noexcept;
+  /// Wire: h_c / H(s), the share of the wire's length in a cavity's centre part (≤ 1).
+  [[nodiscard]] double cavity_centre_fraction(double cut_mm) const noexcept;
   void account(std::int64_t until_ns) noexcept;
   void step_axes(std::int64_t t_ns) noexcept;
   /// Tube: before any erosion the hole's axis follows the electrode's XY; once the tip is
