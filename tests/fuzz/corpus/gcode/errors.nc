@@ -1,0 +1,6 @@
+G01 X1 F
+G99
+E999
+G02 X1 I
+(unclosed comment
+X1 X2
