@@ -1,0 +1,584 @@
+// edm-bench-soak: the demo job in a loop on the real clock while 16 seeded random clients
+// connect, subscribe, stall, disconnect and send garbage (issue 17; docs/benchmarks.md "Soak").
+//   1. Baseline: edmplc + the job loop for --baseline-minutes, nobody else connected.
+//   2. Soak: a fresh edmplc + the job loop for --minutes, with the hostile clients.
+// Each phase samples edmplc's VmRSS and open fds every second and takes its --stats-out at SIGINT.
+// Exit: 0 all criteria PASS, 1 a criterion failed (or edmplc crashed), 2 bad arguments.
+#include <arpa/inet.h>
+#include <fmt/core.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "soak_hostile.hpp"
+#include "soak_job.hpp"
+#include "soak_plc.hpp"
+#include "subprocess.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace soak = edm::bench::soak;
+using edm::bench::read_file;
+using edm::bench::run_child;
+using Json = nlohmann::json;
+using namespace std::chrono_literals;
+
+constexpr int kHostileClients = 16;
+constexpr long kRssKillKb = 2L << 20;  // 2 GiB: a runaway edmplc must not take the machine down
+constexpr double kRssMarginFraction = 0.10;  // "flat": end ≤ ref + max(10 %, 8 MiB)
+constexpr long kRssMarginKb = 8L << 10;
+constexpr int kFdMargin = 2;  // "flat": quiesced end fds ≤ quiesced start fds + 2
+
+struct Options {
+  std::string root{"."};
+  double minutes{30};
+  double baseline_minutes{-1};  // default min(minutes, 5)
+  std::uint64_t seed{1};
+  int max_stall_s{60};
+};
+
+struct JobRecord {
+  int index{0};
+  double start_s{0}, wall_s{0};
+  int busy_retries{0};
+  std::string error;  // edmhmi did not exit 0 / no report
+  soak::JobFigures fig;
+};
+
+struct TaskStats {
+  std::string name;
+  std::uint64_t cycles{0}, overruns{0};
+  double p99_us{0}, max_us{0};
+};
+
+struct Phase {
+  std::string name;
+  std::vector<JobRecord> jobs;
+  std::vector<soak::ProcSample> samples;
+  std::optional<std::size_t> ref;   // the first sample after the first job
+  soak::ProcSample start_q, end_q;  // quiesced: nobody connected
+  std::string crash;                // how edmplc ended if it was not our SIGINT
+  double crash_t_s{-1};
+  bool answered_at_end{false}, clean_stop{false}, rss_killed{false};
+  std::vector<TaskStats> tasks;
+  double seconds{0};
+};
+
+std::uint16_t free_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+/// Pins (trace.start candidates) and all names (var.read), from var.list over a raw socket.
+void list_vars(std::uint16_t port, std::vector<std::string>& pins, std::vector<std::string>& all) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(port);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  timeval tv{5, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
+    const std::string req =
+        "{\"id\":1,\"op\":\"hello\",\"protocol\":1}\n{\"id\":2,\"op\":\"var.list\"}\n";
+    [[maybe_unused]] const auto n = ::send(fd, req.data(), req.size(), MSG_NOSIGNAL);
+    std::string in;
+    char buf[65536];
+    for (ssize_t got; (got = ::recv(fd, buf, sizeof buf, 0)) > 0;) {
+      in.append(buf, static_cast<std::size_t>(got));
+      const auto at = in.find("\"id\":2");
+      if (at != std::string::npos && in.find('\n', at) != std::string::npos) {
+        break;
+      }
+    }
+    std::istringstream lines(in);
+    for (std::string line; std::getline(lines, line);) {
+      const Json j = Json::parse(line, nullptr, false);
+      if (j.is_object() && j.value("id", 0) == 2 && j.contains("vars")) {
+        for (const auto& v : j["vars"]) {
+          all.push_back(v.value("name", ""));
+          const std::string kind = v.value("kind", "");
+          if (kind == "input" || kind == "output") {
+            pins.push_back(all.back());
+          }
+        }
+      }
+    }
+  }
+  ::close(fd);
+}
+
+std::vector<TaskStats> read_stats(const fs::path& path) {
+  std::vector<TaskStats> out;
+  const Json j = Json::parse(read_file(path), nullptr, false);
+  if (j.is_discarded() || !j.contains("tasks")) {
+    return out;
+  }
+  for (const auto& t : j["tasks"]) {
+    out.push_back({t.value("name", ""), t.value("cycles", std::uint64_t{0}),
+                   t.value("overruns", std::uint64_t{0}), t["latency_us"].value("p99", 0.0),
+                   t["latency_us"].value("max", 0.0)});
+  }
+  return out;
+}
+
+class Runner {
+ public:
+  Runner(Options o, fs::path out) : o_(std::move(o)), out_(std::move(out)) {
+    edmplc_ = (fs::path(o_.root) / "build/bin/edmplc").string();
+    edmhmi_ = (fs::path(o_.root) / "build/bin/edmhmi").string();
+  }
+
+  bool prepare() {
+    std::string err;
+    const std::string cfg =
+        soak::soak_config(read_file(fs::path(o_.root) / "config/machines/drill-sim.yaml"), err);
+    demo_ = read_file(fs::path(o_.root) / "examples/parts/demo.nc");
+    if (cfg.empty() || demo_.empty()) {
+      fmt::print(stderr, "edm-bench-soak: {}\n", err.empty() ? "cannot read demo.nc" : err);
+      return false;
+    }
+    config_ = out_ / "drill-sim-soak.yaml";
+    std::ofstream(config_) << cfg;
+    return true;
+  }
+
+  Phase run_phase(const std::string& name, double minutes, bool hostile) {
+    Phase ph;
+    ph.name = name;
+    const fs::path dir = out_ / name;
+    fs::create_directories(dir);
+    const std::uint16_t port = free_port();
+    soak::PlcProcess plc;
+    const auto t0 = soak::Clock::now();
+    auto since = [t0] { return std::chrono::duration<double>(soak::Clock::now() - t0).count(); };
+    fmt::print("[{}] edmplc --config {} --clock real --bridge-port {} ({} min{})\n", name,
+               config_.string(), port, minutes, hostile ? ", 16 hostile clients" : "");
+    std::fflush(stdout);
+    const std::string started =
+        plc.start({edmplc_, "--config", config_.string(), "--clock", "real", "--bridge-port",
+                   std::to_string(port), "--stats-out", (dir / "stats.json").string()},
+                  dir / "edmplc.log");
+    if (!started.empty() || !wait_bridge(port, plc, dir)) {
+      ph.crash = started.empty() ? "bridge did not come up: " + plc.exit_text() : started;
+      return ph;
+    }
+    ph.start_q = soak::sample_proc(plc.pid()).value_or(soak::ProcSample{});
+    std::vector<std::string> pins, vars;
+    list_vars(port, pins, vars);
+
+    // The sampler: 1 Hz /proc readings; a dead edmplc ends the phase (SIGTERM to ourselves makes
+    // run_child() stop the running edmhmi).
+    std::atomic<bool> stop_sampler{false}, plc_dead{false};
+    std::mutex samples_mutex;
+    std::thread sampler([&] {
+      while (!stop_sampler.load()) {
+        const auto s = soak::sample_proc(plc.pid());
+        if (!s || s->zombie) {
+          ph.crash_t_s = since();
+          plc_dead = true;
+          ::kill(::getpid(), SIGTERM);
+          return;
+        }
+        {
+          std::lock_guard lock(samples_mutex);
+          ph.samples.push_back(*s);
+          ph.samples.back().t_s = since();
+        }
+        if (s->rss_kb > kRssKillKb) {
+          ph.rss_killed = true;
+          ::kill(plc.pid(), SIGKILL);
+        }
+        std::this_thread::sleep_for(1s);  // a 1 Hz sampling period, not a wait for an event
+      }
+    });
+
+    soak::ActionLog log((dir / "hostile.log").string(), t0);
+    std::atomic<bool> stop_clients{false};
+    std::vector<std::thread> clients;
+    if (hostile) {
+      fmt::print(
+          "[{}] hostile clients: seed {} (client i: mt19937_64(seed * 1000003 + i)); "
+          "{} pins for trace.start\n",
+          name, o_.seed, pins.size());
+      for (int i = 0; i < kHostileClients; ++i) {
+        soak::HostileOptions ho{i,    o_.seed * 1000003ULL + static_cast<std::uint64_t>(i),
+                                port, pins,
+                                vars, std::chrono::seconds(o_.max_stall_s)};
+        clients.emplace_back(
+            [ho, &log, &stop_clients] { soak::run_hostile(ho, log, stop_clients); });
+      }
+    }
+
+    double worn_mm = 0;
+    const double end_s = minutes * 60.0;
+    for (int k = 0; since() < end_s && !plc_dead.load(); ++k) {
+      JobRecord j = run_job(ph.name, dir, port, k, worn_mm, since);
+      if (j.fig.electrode_left_mm) {
+        worn_mm = soak::kSoakElectrodeMm - *j.fig.electrode_left_mm;
+      }
+      const bool interrupted = j.error == "interrupted";
+      ph.jobs.push_back(std::move(j));
+      if (!ph.ref) {
+        std::lock_guard lock(samples_mutex);
+        ph.ref = ph.samples.size();  // the next sample is the first after job 1
+      }
+      if (interrupted) {
+        break;
+      }
+    }
+    stop_clients = true;
+    for (auto& c : clients) {
+      c.join();
+    }
+    std::this_thread::sleep_for(3s);  // let edmplc notice the closed sockets before the reading
+    stop_sampler = true;
+    sampler.join();
+    ph.seconds = since();
+    if (!plc_dead.load() && plc.running()) {
+      ph.end_q = soak::sample_proc(plc.pid()).value_or(soak::ProcSample{});
+      const auto st = run_child({edmhmi_, "--port", std::to_string(port), "status"},
+                                dir / "status.err", std::nullopt, 20s);
+      ph.answered_at_end = st.exit_code == 0;
+      std::ofstream(dir / "status-at-end.txt") << st.out;
+      ph.clean_stop = plc.stop(30s);
+      if (!ph.clean_stop) {
+        ph.crash = "did not stop cleanly on SIGINT: " + plc.exit_text();
+      }
+    } else {
+      plc.running();
+      ph.crash = (ph.rss_killed ? "killed by the soak (VmRSS over 2 GiB); " : "") + plc.exit_text();
+      report_crash(ph, log);
+    }
+    ph.tasks = read_stats(dir / "stats.json");
+    if (hostile) {
+      std::ofstream counts(dir / "hostile-actions.txt");
+      for (const auto& [kind, n] : log.counts()) {
+        counts << kind << " " << n << "\n";
+      }
+    }
+    return ph;
+  }
+
+ private:
+  bool wait_bridge(std::uint16_t port, soak::PlcProcess& plc, const fs::path& dir) {
+    for (int i = 0; i < 100 && plc.running(); ++i) {
+      const auto r = run_child({edmhmi_, "--port", std::to_string(port), "status"},
+                               dir / "status.err", std::nullopt, 10s);
+      if (r.exit_code == 0) {
+        return true;
+      }
+      std::this_thread::sleep_for(100ms);  // a separate process is starting: poll it
+    }
+    return false;
+  }
+
+  template <class Since>
+  JobRecord run_job(const std::string& name, const fs::path& dir, std::uint16_t port, int k,
+                    double worn_mm, Since since) {
+    JobRecord j;
+    j.index = k + 1;
+    j.start_s = since();
+    std::string err;
+    const fs::path part = dir / fmt::format("job-{:03d}.nc", k + 1);
+    std::ofstream(part) << soak::job_program(demo_, k, worn_mm, err);
+    for (;;) {
+      const fs::path err_path = dir / fmt::format("job-{:03d}.err", k + 1);
+      const auto r = run_child({edmhmi_, "--port", std::to_string(port), "run", part.string()},
+                               err_path, std::nullopt, 30min);
+      std::ofstream(dir / fmt::format("job-{:03d}.txt", k + 1)) << r.out;
+      const std::string stderr_text = read_file(err_path);
+      if (r.out.find("job report:") == std::string::npos &&
+          stderr_text.find("busy") != std::string::npos && j.busy_retries < 40) {
+        ++j.busy_retries;  // every session slot taken: an operator retries, as a user would
+        std::this_thread::sleep_for(3s);
+        continue;
+      }
+      j.fig = soak::parse_report(r.out);
+      j.error = r.error.empty() && r.exit_code != 0 ? fmt::format("edmhmi exit {}", r.exit_code)
+                                                    : r.error;
+      break;
+    }
+    j.wall_s = since() - j.start_s;
+    const auto f = j.fig;
+    fmt::print(
+        "[{}] job {:2d} at {:7.1f} s: {} in {:.0f} s, depth {} / {} mm, measured {} mm{}{}{}\n",
+        name, j.index, j.start_s, f.outcome.empty() ? "no report" : f.outcome, j.wall_s,
+        f.reached_mm ? fmt::format("{:.4f}", *f.reached_mm) : "n/a",
+        f.program_mm ? fmt::format("{:.4f}", *f.program_mm) : "n/a",
+        f.measured_mm ? fmt::format("{:.4f}", *f.measured_mm) : "n/a",
+        f.at_depth() ? "  AT DEPTH" : "  NOT AT DEPTH",
+        j.busy_retries > 0 ? fmt::format(" (operator refused busy {}x)", j.busy_retries) : "",
+        j.error.empty() ? "" : " [" + j.error + "]");
+    std::fflush(stdout);
+    if (!f.outcome.empty() && f.outcome != "finished") {  // a fault: clear it for the next job
+      run_child({edmhmi_, "--port", std::to_string(port), "reset"}, dir / "reset.err", std::nullopt,
+                20s);
+    }
+    return j;
+  }
+
+  static void report_crash(const Phase& ph, const soak::ActionLog& log) {
+    fmt::print("[{}] EDMPLC DIED at {:.1f} s: {}\n", ph.name, ph.crash_t_s, ph.crash);
+    const auto tail = log.between(ph.crash_t_s - 5.0, ph.crash_t_s + 0.5);
+    fmt::print("[{}] hostile actions in the 5 s before it ({}; the whole log: {}/hostile.log):\n",
+               ph.name, tail.size(), ph.name);
+    for (std::size_t i = tail.size() > 40 ? tail.size() - 40 : 0; i < tail.size(); ++i) {
+      fmt::print("    {}\n", tail[i]);
+    }
+  }
+
+  Options o_;
+  fs::path out_;
+  fs::path config_;
+  std::string edmplc_, edmhmi_, demo_;
+};
+
+struct MemFigures {
+  long rss_start_kb{0}, rss_ref_kb{0}, rss_end_kb{0}, rss_max_kb{0};
+  int fd_start{0}, fd_ref{0}, fd_end{0}, fd_max{0};
+};
+
+MemFigures mem_figures(const Phase& ph) {
+  MemFigures m;
+  m.rss_start_kb = ph.start_q.rss_kb;
+  m.fd_start = ph.start_q.fds;
+  m.rss_end_kb = ph.end_q.rss_kb;
+  m.fd_end = ph.end_q.fds;
+  for (const auto& s : ph.samples) {
+    m.rss_max_kb = std::max(m.rss_max_kb, s.rss_kb);
+    m.fd_max = std::max(m.fd_max, s.fds);
+  }
+  if (ph.ref && *ph.ref < ph.samples.size()) {
+    m.rss_ref_kb = ph.samples[*ph.ref].rss_kb;
+    m.fd_ref = ph.samples[*ph.ref].fds;
+  }
+  return m;
+}
+
+std::size_t jobs_at_depth(const Phase& ph) {
+  return static_cast<std::size_t>(std::count_if(
+      ph.jobs.begin(), ph.jobs.end(), [](const JobRecord& j) { return j.fig.at_depth(); }));
+}
+
+std::string mib(long kb) { return fmt::format("{:.1f}", static_cast<double>(kb) / 1024.0); }
+
+void write_samples(const fs::path& path, const Phase& ph) {
+  std::ofstream csv(path);
+  csv << "t_s,rss_kb,fds\n";
+  for (const auto& s : ph.samples) {
+    csv << fmt::format("{:.1f},{},{}\n", s.t_s, s.rss_kb, s.fds);
+  }
+}
+
+int usage() {
+  fmt::print(stderr,
+             "usage: edm-bench-soak [--root DIR] [--minutes N] [--baseline-minutes M] [--seed S] "
+             "[--max-stall-s S]\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) {
+      return usage();
+    }
+    const std::string v = argv[++i];
+    try {
+      if (a == "--root") {
+        o.root = v;
+      } else if (a == "--minutes") {
+        o.minutes = std::stod(v);
+      } else if (a == "--baseline-minutes") {
+        o.baseline_minutes = std::stod(v);
+      } else if (a == "--seed") {
+        o.seed = std::stoull(v);
+      } else if (a == "--max-stall-s") {
+        o.max_stall_s = std::stoi(v);
+      } else {
+        return usage();
+      }
+    } catch (const std::exception&) {
+      return usage();
+    }
+  }
+  if (o.baseline_minutes < 0) {
+    o.baseline_minutes = std::min(o.minutes, 5.0);
+  }
+  const fs::path out = fs::path(o.root) / "out/bench/soak";
+  fs::create_directories(out);
+  edm::bench::install_stop_handlers();
+  fmt::print("edm-bench-soak: seed {}, {} min soak after a {} min idle baseline; output {}\n",
+             o.seed, o.minutes, o.baseline_minutes, out.string());
+  Runner runner(o, out);
+  if (!runner.prepare()) {
+    return 2;
+  }
+  Phase base = runner.run_phase("baseline", o.baseline_minutes, false);
+  Phase soak_ph;
+  soak_ph.name = "soak";
+  if (base.crash.empty()) {
+    soak_ph = runner.run_phase("soak", o.minutes, true);
+  } else {
+    fmt::print("baseline failed ({}): the soak was not run\n", base.crash);
+  }
+  write_samples(out / "baseline-samples.csv", base);
+  write_samples(out / "soak-samples.csv", soak_ph);
+
+  // Verdicts.
+  const MemFigures bm = mem_figures(base), sm = mem_figures(soak_ph);
+  const bool alive = soak_ph.crash.empty() && soak_ph.answered_at_end && soak_ph.clean_stop;
+  const bool depths = !soak_ph.jobs.empty() && jobs_at_depth(soak_ph) == soak_ph.jobs.size();
+  const long rss_limit =
+      sm.rss_ref_kb + std::max(kRssMarginKb, static_cast<long>(kRssMarginFraction *
+                                                               static_cast<double>(sm.rss_ref_kb)));
+  const bool rss_flat = alive && sm.rss_ref_kb > 0 && sm.rss_end_kb <= rss_limit;
+  const bool fd_flat = alive && sm.fd_end <= sm.fd_start + kFdMargin;
+  bool overruns_ok = alive && !soak_ph.tasks.empty() && soak_ph.tasks.size() == base.tasks.size();
+  for (std::size_t i = 0; overruns_ok && i < soak_ph.tasks.size(); ++i) {
+    const auto& b = base.tasks[i];
+    const auto& s = soak_ph.tasks[i];
+    // The baseline's overrun rate scaled to the soak's cycles, rounded up.
+    const double allowed =
+        b.cycles > 0 ? std::ceil(static_cast<double>(b.overruns) * static_cast<double>(s.cycles) /
+                                 static_cast<double>(b.cycles))
+                     : 0.0;
+    overruns_ok = static_cast<double>(s.overruns) <= allowed;
+  }
+  const bool pass = alive && depths && rss_flat && fd_flat && overruns_ok;
+
+  auto pf = [](bool ok) { return ok ? "PASS" : "FAIL"; };
+  fmt::print("\nsoak summary (seed {}, {} hostile clients; jobs: demo.nc on a new hole each)\n",
+             o.seed, kHostileClients);
+  fmt::print("  {:<34} {:>14} {:>14}\n", "", "baseline", "soak");
+  auto line = [](const std::string& what, const std::string& b, const std::string& s) {
+    fmt::print("  {:<34} {:>14} {:>14}\n", what, b, s);
+  };
+  line("duration s", fmt::format("{:.0f}", base.seconds), fmt::format("{:.0f}", soak_ph.seconds));
+  line("jobs run / at depth", fmt::format("{} / {}", base.jobs.size(), jobs_at_depth(base)),
+       fmt::format("{} / {}", soak_ph.jobs.size(), jobs_at_depth(soak_ph)));
+  line("VmRSS MiB start (idle)", mib(bm.rss_start_kb), mib(sm.rss_start_kb));
+  line("VmRSS MiB after job 1", mib(bm.rss_ref_kb), mib(sm.rss_ref_kb));
+  line("VmRSS MiB end (quiesced)", mib(bm.rss_end_kb), mib(sm.rss_end_kb));
+  line("VmRSS MiB max", mib(bm.rss_max_kb), mib(sm.rss_max_kb));
+  line("open fds start (idle)", std::to_string(bm.fd_start), std::to_string(sm.fd_start));
+  line("open fds after job 1", std::to_string(bm.fd_ref), std::to_string(sm.fd_ref));
+  line("open fds end (quiesced)", std::to_string(bm.fd_end), std::to_string(sm.fd_end));
+  line("open fds max", std::to_string(bm.fd_max), std::to_string(sm.fd_max));
+  for (std::size_t i = 0; i < std::max(base.tasks.size(), soak_ph.tasks.size()); ++i) {
+    const TaskStats b = i < base.tasks.size() ? base.tasks[i] : TaskStats{};
+    const TaskStats s = i < soak_ph.tasks.size() ? soak_ph.tasks[i] : TaskStats{};
+    const std::string n = b.name.empty() ? s.name : b.name;
+    line(n + " cycles", std::to_string(b.cycles), std::to_string(s.cycles));
+    line(n + " overruns", std::to_string(b.overruns), std::to_string(s.overruns));
+    line(n + " latency p99 / max us", fmt::format("{:.0f} / {:.0f}", b.p99_us, b.max_us),
+         fmt::format("{:.0f} / {:.0f}", s.p99_us, s.max_us));
+  }
+  line("edmplc end", base.crash.empty() ? "clean" : "FAILED",
+       soak_ph.crash.empty() ? "clean" : "FAILED");
+  if (!soak_ph.crash.empty()) {
+    fmt::print("  soak edmplc: {} (at {:.1f} s)\n", soak_ph.crash, soak_ph.crash_t_s);
+  }
+  fmt::print("  {} alive at the end, answered, stopped cleanly on SIGINT\n", pf(alive));
+  fmt::print(
+      "  {} every job reached its depth (|reached - program| and |measured - program| <= "
+      "{} mm)\n",
+      pf(depths), soak::kDepthToleranceMm);
+  fmt::print("  {} VmRSS flat: end {} MiB <= after job 1 {} MiB + max(10 %, 8 MiB) = {} MiB\n",
+             pf(rss_flat), mib(sm.rss_end_kb), mib(sm.rss_ref_kb), mib(rss_limit));
+  fmt::print("  {} fds flat: end {} <= start {} + {} (both with nobody connected)\n", pf(fd_flat),
+             sm.fd_end, sm.fd_start, kFdMargin);
+  fmt::print("  {} RT overruns within the baseline's rate (scaled to the soak's cycles)\n",
+             pf(overruns_ok));
+  fmt::print("  {} soak (seed {})\n", pf(pass), o.seed);
+
+  // JSON + CSV.
+  auto phase_json = [](const Phase& ph, const MemFigures& m) {
+    Json j{
+        {"seconds", ph.seconds},
+        {"end", ph.crash.empty() ? "clean" : ph.crash},
+        {"crash_t_s", ph.crash_t_s},
+        {"answered_at_end", ph.answered_at_end},
+        {"clean_stop", ph.clean_stop},
+        {"rss_kb",
+         {{"start", m.rss_start_kb},
+          {"after_job_1", m.rss_ref_kb},
+          {"end", m.rss_end_kb},
+          {"max", m.rss_max_kb}}},
+        {"fds",
+         {{"start", m.fd_start}, {"after_job_1", m.fd_ref}, {"end", m.fd_end}, {"max", m.fd_max}}}};
+    for (const auto& t : ph.tasks) {
+      j["tasks"].push_back({{"name", t.name},
+                            {"cycles", t.cycles},
+                            {"overruns", t.overruns},
+                            {"latency_p99_us", t.p99_us},
+                            {"latency_max_us", t.max_us}});
+    }
+    for (const auto& jr : ph.jobs) {
+      j["jobs"].push_back({{"job", jr.index},
+                           {"start_s", jr.start_s},
+                           {"wall_s", jr.wall_s},
+                           {"outcome", jr.fig.outcome},
+                           {"reached_mm", jr.fig.reached_mm.value_or(NAN)},
+                           {"program_mm", jr.fig.program_mm.value_or(NAN)},
+                           {"measured_mm", jr.fig.measured_mm.value_or(NAN)},
+                           {"at_depth", jr.fig.at_depth()},
+                           {"busy_retries", jr.busy_retries},
+                           {"error", jr.error}});
+    }
+    return j;
+  };
+  const Json summary{{"seed", o.seed},
+                     {"minutes", o.minutes},
+                     {"baseline_minutes", o.baseline_minutes},
+                     {"hostile_clients", kHostileClients},
+                     {"baseline", phase_json(base, bm)},
+                     {"soak", phase_json(soak_ph, sm)},
+                     {"verdict",
+                      {{"alive", alive},
+                       {"depths", depths},
+                       {"rss_flat", rss_flat},
+                       {"fd_flat", fd_flat},
+                       {"overruns", overruns_ok},
+                       {"pass", pass}}}};
+  std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
+  std::ofstream jobs(out / "jobs.csv");
+  jobs
+      << "phase,job,start_s,wall_s,outcome,reached_mm,program_mm,measured_mm,at_depth,busy_retries,"
+         "error\n";
+  for (const Phase* ph : {&base, &soak_ph}) {
+    for (const auto& j : ph->jobs) {
+      jobs << fmt::format("{},{},{:.1f},{:.1f},\"{}\",{:.4f},{:.4f},{:.4f},{},{},\"{}\"\n",
+                          ph->name, j.index, j.start_s, j.wall_s, j.fig.outcome,
+                          j.fig.reached_mm.value_or(NAN), j.fig.program_mm.value_or(NAN),
+                          j.fig.measured_mm.value_or(NAN), j.fig.at_depth() ? 1 : 0, j.busy_retries,
+                          j.error);
+    }
+  }
+  fmt::print(
+      "  written: {}/summary.json, jobs.csv, *-samples.csv, <phase>/hostile.log, "
+      "<phase>/edmplc.log\n",
+      out.string());
+  return pass ? 0 : 1;
+}

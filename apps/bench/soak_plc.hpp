@@ -1,0 +1,53 @@
+#pragma once
+// edmplc as a long-running child of edm-bench-soak: started in the background (run_child() of
+// subprocess.hpp waits for its child, so it serves the short edmhmi runs instead), its resident
+// memory and open descriptors sampled from /proc, stopped with SIGINT as a user stops it.
+// Non-RT. Thread-safety: start/poll/stop from one thread; sample_proc() from any.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace edm::bench::soak {
+
+struct ProcSample {
+  double t_s{0};       // since the phase began
+  long rss_kb{0};      // VmRSS
+  int fds{0};          // entries of /proc/<pid>/fd
+  bool zombie{false};  // exited, not yet reaped
+};
+
+/// One reading of /proc/<pid>; nullopt when the process is gone.
+std::optional<ProcSample> sample_proc(pid_t pid);
+
+class PlcProcess {
+ public:
+  PlcProcess() = default;
+  PlcProcess(const PlcProcess&) = delete;
+  PlcProcess& operator=(const PlcProcess&) = delete;
+  ~PlcProcess();
+
+  /// fork + exec args[0] (absolute path) with stdout and stderr into `log`. Empty on success.
+  std::string start(const std::vector<std::string>& args, const std::filesystem::path& log);
+  [[nodiscard]] pid_t pid() const { return pid_; }
+  /// Reaps it if it has exited; true while it runs.
+  bool running();
+  /// SIGINT, then waits up to `limit` (then SIGKILL). True if it exited 0 by itself.
+  bool stop(std::chrono::seconds limit);
+  /// "exit code N" / "killed by signal N (name)" once reaped; empty while running.
+  [[nodiscard]] std::string exit_text() const;
+  [[nodiscard]] bool exited_cleanly() const { return reaped_ && exit_code_ == 0; }
+
+ private:
+  void record(int status);
+  pid_t pid_{-1};
+  bool reaped_{false};
+  int exit_code_{-1};
+  int signal_{0};
+};
+
+}  // namespace edm::bench::soak
