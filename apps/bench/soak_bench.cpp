@@ -17,6 +17,8 @@
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include "soak_hostile.hpp"
@@ -45,6 +47,7 @@ struct Options {
   double baseline_minutes{-1};  // default min(minutes, 5)
   std::uint64_t seed{1};
   int max_stall_s{60};
+  std::set<std::string, std::less<>> skip;  // hostile action kinds left out (--skip a,b)
 };
 
 struct JobRecord {
@@ -219,9 +222,10 @@ class Runner {
           "{} pins for trace.start\n",
           name, o_.seed, pins.size());
       for (int i = 0; i < kHostileClients; ++i) {
-        soak::HostileOptions ho{i,    o_.seed * 1000003ULL + static_cast<std::uint64_t>(i),
-                                port, pins,
-                                vars, std::chrono::seconds(o_.max_stall_s)};
+        soak::HostileOptions ho{i,      o_.seed * 1000003ULL + static_cast<std::uint64_t>(i),
+                                port,   pins,
+                                vars,   std::chrono::seconds(o_.max_stall_s),
+                                o_.skip};
         clients.emplace_back(
             [ho, &log, &stop_clients] { soak::run_hostile(ho, log, stop_clients); });
       }
@@ -391,7 +395,11 @@ void write_samples(const fs::path& path, const Phase& ph) {
 int usage() {
   fmt::print(stderr,
              "usage: edm-bench-soak [--root DIR] [--minutes N] [--baseline-minutes M] [--seed S] "
-             "[--max-stall-s S]\n");
+             "[--max-stall-s S] [--skip KIND,...]\n"
+             "  KIND: read_only subscribe unsubscribe trace_start trace_stop stall drain "
+             "garbage_bytes bad_json\n"
+             "        deep_nesting long_line pipelined half_line close rst blank_line no_hello "
+             "wrong_token\n");
   return 2;
 }
 
@@ -414,6 +422,11 @@ int main(int argc, char** argv) {
         o.baseline_minutes = std::stod(v);
       } else if (a == "--seed") {
         o.seed = std::stoull(v);
+      } else if (a == "--skip") {
+        std::istringstream kinds(v);
+        for (std::string k; std::getline(kinds, k, ',');) {
+          o.skip.insert(k);
+        }
       } else if (a == "--max-stall-s") {
         o.max_stall_s = std::stoi(v);
       } else {
@@ -429,8 +442,13 @@ int main(int argc, char** argv) {
   const fs::path out = fs::path(o.root) / "out/bench/soak";
   fs::create_directories(out);
   edm::bench::install_stop_handlers();
-  fmt::print("edm-bench-soak: seed {}, {} min soak after a {} min idle baseline; output {}\n",
-             o.seed, o.minutes, o.baseline_minutes, out.string());
+  std::string skipped;
+  for (const auto& k : o.skip) {
+    skipped += (skipped.empty() ? "" : ",") + k;
+  }
+  fmt::print("edm-bench-soak: seed {}, {} min soak after a {} min idle baseline; output {}{}\n",
+             o.seed, o.minutes, o.baseline_minutes, out.string(),
+             skipped.empty() ? "" : "; hostile kinds skipped: " + skipped);
   Runner runner(o, out);
   if (!runner.prepare()) {
     return 2;
@@ -550,6 +568,7 @@ int main(int argc, char** argv) {
     return j;
   };
   const Json summary{{"seed", o.seed},
+                     {"skip", o.skip},
                      {"minutes", o.minutes},
                      {"baseline_minutes", o.baseline_minutes},
                      {"hostile_clients", kHostileClients},

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,9 @@ struct HostileOptions {
   std::vector<std::string> pins;  // trace.start candidates (from var.list)
   std::vector<std::string> vars;  // var.read candidates
   std::chrono::seconds max_stall{60};
+  /// Action kinds this client never does (see kind_of() in soak_hostile.cpp; plus no_hello and
+  /// wrong_token for the connect step): to find which behaviour breaks edmplc.
+  std::set<std::string, std::less<>> skip;
 };
 
 /// Runs the client's random walk until `stop` is set (returns within ~1 s of it).
