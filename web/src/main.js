@@ -1,0 +1,208 @@
+// The operator's screen (docs/web.md). State lives in edmhmi serve and edmplc; this page only
+// shows it and sends commands, so a reload, a sleeping tablet or a second browser changes nothing.
+import './style.css';
+import { Connection } from './connection.js';
+import { Charts } from './charts.js';
+import { Editor } from './editor.js';
+import { Toolpath } from './toolpath.js';
+import { renderAlarms, renderStats, VarPanel, renderOperatorFunctions } from './panels.js';
+
+const $ = (id) => document.getElementById(id);
+const STALE_MS = 1000;
+const t0 = performance.now();
+
+const ui = {
+  role: null,
+  alarms: [],
+  lastStatusAt: 0,
+  status: null,
+  job: null,
+  firstRender: null,
+};
+window.edm = ui; // read by the end-to-end tests (first render time, state)
+
+const charts = new Charts();
+const editor = new Editor($('editor'));
+const toolpath = new Toolpath($('tp-xy'), $('tp-xz'));
+
+function confirmDialog(text) {
+  const d = $('confirm');
+  $('confirm-text').textContent = text;
+  d.showModal();
+  return new Promise((resolve) => {
+    d.onclose = () => resolve(d.returnValue === 'ok');
+  });
+}
+
+const conn = new Connection({
+  state: (s) => { $('conn').textContent = s; },
+  loginFailed: (message) => {
+    $('app').hidden = true;
+    $('login').hidden = false;
+    $('login-error').textContent = `log-in refused: ${message}`;
+  },
+  welcome: (m) => {
+    ui.role = m.role;
+    document.body.dataset.role = m.role;
+    $('login').hidden = true;
+    $('app').hidden = false;
+    $('role').textContent = m.role;
+    $('machine-name').textContent = m.machine?.name ?? '?';
+    editor.readOnly = m.role !== 'operator';
+    charts.setup(m.series || []);
+    renderOperatorFunctions(m.caps);
+    ui.alarms = m.alarms || [];
+    renderAlarms(ui.alarms, m.role === 'operator');
+    vars.isOperator = m.role === 'operator';
+    vars.renderWatch();
+    showJob(m.job, true);
+    if (m.status && Object.keys(m.status).length) showStatus(m.status, false);
+    refreshStats();
+    if (ui.firstRender === null) {
+      requestAnimationFrame(() => { ui.firstRender = performance.now() - t0; });
+    }
+  },
+  frame: (f) => {
+    if (f.status) showStatus(f.status, true);
+    if (f.rows) charts.push(f.rows);
+    if (f.alarms) {
+      ui.alarms = ui.alarms.concat(f.alarms).slice(-200);
+      renderAlarms(ui.alarms, ui.role === 'operator');
+    }
+    if (f.bridge === false) $('conn').textContent = 'edmhmi online, edmplc unreachable';
+  },
+  alarms: (a) => { ui.alarms = a; renderAlarms(a, ui.role === 'operator'); },
+  job: (j) => showJob(j, false),
+});
+const vars = new VarPanel(conn, confirmDialog);
+
+function statusVar(s, suffix) {
+  const v = s.vars || {};
+  for (const k of Object.keys(v)) if (k === suffix || k.endsWith(`.${suffix}`)) return v[k];
+  return undefined;
+}
+const fmt = (v, d = 3) => (typeof v === 'number' && Number.isFinite(v) ? v.toFixed(d) : '—');
+
+function showStatus(s, fresh) {
+  ui.status = s;
+  if (fresh) ui.lastStatusAt = performance.now();
+  $('state').textContent = s.state;
+  $('state').dataset.state = s.state;
+  const x = statusVar(s, 'io.x_mm'); const y = statusVar(s, 'io.y_mm'); const z = statusVar(s, 'io.z_mm');
+  $('dro-x').textContent = fmt(x); $('dro-y').textContent = fmt(y); $('dro-z').textContent = fmt(z);
+  $('val-depth').textContent = `${fmt(statusVar(s, 'io.depth_mm'))} mm`;
+  $('val-electrode').textContent = `${fmt(statusVar(s, 'io.electrode_mm'), 2)} mm`;
+  const job = s.job || {};
+  $('job-outcome').textContent = job.outcome ?? '—';
+  $('job-block').textContent = job.blocks ? `${Math.min(job.block + 1, job.blocks)} / ${job.blocks}` : '—';
+  $('job-line').textContent = job.line || '—';
+  const t = statusVar(s, 'job_time_s');
+  $('job-time').textContent = typeof t === 'number' ? `${t.toFixed(1)} s` : '—';
+  $('job-progress').value = job.blocks ? (job.outcome === 'finished' ? 1 : job.block / job.blocks) : 0;
+  if (x !== undefined) toolpath.setPosition([x ?? 0, y ?? 0, z ?? 0]);
+  updateButtons();
+  if (job.outcome === 'finished' || job.outcome === 'aborted') {
+    if (ui.job && ui.job.started && !ui.job.report && !ui.reportAsked) {
+      ui.reportAsked = true;
+      conn.cmd('job').then((r) => { ui.reportAsked = false; if (r.ok) showJob(r.body, false); });
+    }
+  }
+}
+
+function showJob(j, initial) {
+  ui.job = j;
+  if (!j) return;
+  $('job-part').textContent = j.part || 'none';
+  toolpath.setPath(j.toolpath || []);
+  if (initial && j.text && !editor.text) { editor.text = j.text; $('part-name').value = j.part; }
+  $('job-report').hidden = !j.report;
+  $('job-report').textContent = j.report ? j.report.text : '';
+}
+
+function updateButtons() {
+  const st = ui.status?.state;
+  const loaded = ui.job && ui.job.blocks > 0;
+  $('btn-start').disabled = !(st === 'READY' && loaded);
+  $('btn-hold').disabled = st !== 'RUNNING';
+  $('btn-resume').disabled = st !== 'HOLD';
+  $('btn-stop').disabled = !(st === 'RUNNING' || st === 'HOLD');
+  $('btn-reset').disabled = !(st === 'ESTOP' || st === 'FAULT');
+  $('btn-upload').disabled = st === 'RUNNING' || st === 'HOLD';
+}
+
+// Stale: no status from the machine for more than a second (server gone, edmplc gone, network).
+setInterval(() => {
+  const stale = ui.role !== null && performance.now() - ui.lastStatusAt > STALE_MS;
+  $('stale').hidden = !stale;
+  document.body.classList.toggle('is-stale', stale);
+}, 200);
+
+async function machine(op, question) {
+  if (question && !(await confirmDialog(question))) return;
+  const r = await conn.cmd(op);
+  if (!r.ok) flash(`${op}: ${r.code}: ${r.message}`);
+}
+function flash(text) { $('check-result').textContent = text; }
+
+$('btn-start').onclick = () => machine('start', `Start ${ui.job?.part ?? 'the program'} on ${$('machine-name').textContent}? The axes will move and the generator will fire.`);
+$('btn-hold').onclick = () => machine('cycle.hold');
+$('btn-resume').onclick = () => machine('cycle.resume', 'Resume the job?');
+$('btn-stop').onclick = () => machine('cycle.stop', 'Stop the job? It cannot be resumed from here.');
+$('btn-reset').onclick = () => machine('reset', 'Reset the machine out of its safe state? Make sure the cause is cleared.');
+$('btn-estop').onclick = () => machine('estop'); // never behind a confirmation
+$('btn-ack').onclick = async () => {
+  const seq = ui.alarms.reduce((m, a) => Math.max(m, a.seq || 0), 0);
+  await conn.cmd('ack', { seq });
+};
+
+function showCheck(r) {
+  const errs = r.errors || [];
+  editor.setErrors(errs);
+  $('check-errors').replaceChildren(...errs.map((e) => {
+    const li = document.createElement('li');
+    li.textContent = `${$('part-name').value}:${e.line}:${e.col}: ${e.message}`;
+    li.dataset.line = e.line;
+    li.onclick = () => editor.goto(e.line);
+    return li;
+  }));
+}
+$('btn-check').onclick = async () => {
+  const r = await conn.cmd('check', { name: $('part-name').value, text: editor.text });
+  showCheck(r);
+  flash(r.ok ? `ok: ${r.blocks} blocks, ${r.drill_blocks} drilling, ${fmt(r.drill_depth_mm)} mm` : (r.message || `${(r.errors || []).length} error(s)`));
+};
+$('btn-upload').onclick = async () => {
+  const r = await conn.cmd('upload', { name: $('part-name').value, text: editor.text });
+  showCheck(r);
+  flash(r.ok ? `uploaded: ${r.blocks} blocks (program ${r.generation})` : r.message);
+};
+$('file').onchange = async (e) => {
+  const f = e.target.files[0];
+  if (!f) return;
+  if (f.size > 2 * 1024 * 1024) { flash('file larger than 2 MiB'); return; }
+  editor.text = await f.text();
+  $('part-name').value = f.name;
+};
+
+async function refreshStats() {
+  if ($('tab-stats').hidden || ui.role === null) return;
+  renderStats(await conn.cmd('stats'));
+}
+setInterval(refreshStats, 2000);
+for (const b of document.querySelectorAll('.tabs button')) {
+  b.onclick = () => {
+    for (const o of document.querySelectorAll('.tabs button')) o.classList.toggle('active', o === b);
+    $('tab-stats').hidden = b.dataset.tab !== 'stats';
+    $('tab-vars').hidden = b.dataset.tab !== 'vars';
+    refreshStats();
+  };
+}
+
+window.addEventListener('resize', () => { charts.resize(); toolpath.request(); });
+$('login-form').onsubmit = (e) => {
+  e.preventDefault();
+  $('login-error').textContent = '';
+  conn.login($('token').value.trim());
+};
+
+if (conn.hasToken()) conn.open(); else $('login').hidden = false;
