@@ -44,5 +44,6 @@ int cmd_machine(std::string_view command, const Args& args,
                 const edm::hmi::ConnectionSettings& settings);
 int cmd_watch(const Args& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_trace(const Args& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_serve(const Args& args, const edm::hmi::ConnectionSettings& settings);
 
 }  // namespace edmhmi

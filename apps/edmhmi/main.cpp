@@ -27,7 +27,9 @@ constexpr const char* kUsage =
     "  watch [--rate HZ] [--count N] VAR...     print variables until Ctrl-C (or N samples)\n"
     "  trace VAR... --out FILE.csv [--duration S]  record every cycle of VAR... to CSV\n"
     "  stats                              task statistics and bridge counters\n"
-    "  hold | resume | stop | estop | reset   machine commands\n";
+    "  hold | resume | stop | estop | reset   machine commands\n"
+    "  serve [--listen HOST:PORT] [--web-root DIR]  the operator's page in a browser (default\n"
+    "                                     127.0.0.1:8080; docs/web.md)\n";
 
 std::atomic<bool> g_interrupted{false};
 
@@ -70,6 +72,7 @@ int run(int argc, char** argv) {
   if (command == "stats") return cmd_stats(rest, settings);
   if (command == "watch") return cmd_watch(rest, settings);
   if (command == "trace") return cmd_trace(rest, settings);
+  if (command == "serve") return cmd_serve(rest, settings);
   for (std::string_view c : {"hold", "resume", "stop", "estop", "reset"}) {
     if (command == c) return cmd_machine(command, rest, settings);
   }

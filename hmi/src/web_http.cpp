@@ -1,0 +1,186 @@
+#include "edm/hmi/web_http.hpp"
+
+#include <boost/asio/strand.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket/rfc6455.hpp>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <optional>
+
+#include "edm/hmi/web_session.hpp"
+#include "edm/hmi/web_static.hpp"
+
+namespace edm::hmi {
+
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+namespace {
+
+constexpr auto kRequestTimeout = std::chrono::seconds(30);
+constexpr const char* kCsp =
+    "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'; "
+    "connect-src 'self'; frame-ancestors 'none'";
+
+void fail(beast::error_code ec, const char* what) {
+  if (ec == asio::error::operation_aborted || ec == beast::error::timeout ||
+      ec == http::error::end_of_stream || ec == asio::error::eof) {
+    return;
+  }
+  std::fprintf(stderr, "edmhmi serve: %s: %s\n", what, ec.message().c_str());
+}
+
+/// The host part of an Origin ("http://h:p" → "h:p").
+std::string_view origin_host(std::string_view origin) {
+  const auto p = origin.find("://");
+  return p == std::string_view::npos ? origin : origin.substr(p + 3);
+}
+
+class HttpSession : public std::enable_shared_from_this<HttpSession> {
+ public:
+  HttpSession(tcp::socket socket, const std::filesystem::path& root, WebHub& hub)
+      : stream_(std::move(socket)), root_(root), hub_(hub) {}
+
+  void run() {
+    asio::dispatch(stream_.get_executor(),
+                   beast::bind_front_handler(&HttpSession::do_read, shared_from_this()));
+  }
+
+ private:
+  void do_read() {
+    parser_.emplace();
+    parser_->header_limit(kMaxHttpHeaderBytes);
+    parser_->body_limit(kMaxHttpBodyBytes);
+    stream_.expires_after(kRequestTimeout);
+    http::async_read(stream_, buffer_, *parser_,
+                     beast::bind_front_handler(&HttpSession::on_read, shared_from_this()));
+  }
+
+  void on_read(beast::error_code ec, std::size_t) {
+    if (ec == http::error::header_limit || ec == http::error::body_limit) {
+      return send(simple(http::status::payload_too_large, "request too large\n"), true);
+    }
+    if (ec) return fail(ec, "http read");
+    http::request<http::string_body> req = parser_->release();
+    if (beast::websocket::is_upgrade(req)) {
+      if (req.target() != "/ws")
+        return send(simple(http::status::not_found, "no such socket\n"), true);
+      const auto origin_sv = req[http::field::origin];
+      const auto host_sv = req[http::field::host];
+      const std::string origin(origin_sv.data(), origin_sv.size());
+      const std::string host(host_sv.data(), host_sv.size());
+      if (!origin.empty() && origin_host(origin) != host) {
+        return send(simple(http::status::forbidden, "cross-origin WebSocket refused\n"), true);
+      }
+      stream_.expires_never();
+      return start_web_socket(std::move(stream_), std::move(req), hub_);
+    }
+    handle(req);
+  }
+
+  http::response<http::string_body> simple(http::status status, std::string body) {
+    http::response<http::string_body> res{status, 11};
+    res.set(http::field::server, "edmhmi");
+    res.set(http::field::content_type, "text/plain; charset=utf-8");
+    res.set(http::field::cache_control, "no-store");
+    res.set("X-Content-Type-Options", "nosniff");
+    res.body() = std::move(body);
+    res.prepare_payload();
+    return res;
+  }
+
+  void handle(const http::request<http::string_body>& req) {
+    if (req.method() != http::verb::get && req.method() != http::verb::head) {
+      auto res = simple(http::status::method_not_allowed, "GET or HEAD only\n");
+      res.set(http::field::allow, "GET, HEAD");
+      return send(std::move(res), !req.keep_alive());
+    }
+    const std::string target(req.target());
+    const std::optional<std::filesystem::path> file = resolve_static_path(root_, target);
+    if (!file) return send(simple(http::status::bad_request, "bad path\n"), true);
+    std::error_code fec;
+    const auto size = std::filesystem::file_size(*file, fec);
+    if (fec || !std::filesystem::is_regular_file(*file, fec)) {
+      return send(simple(http::status::not_found, "not found\n"), !req.keep_alive());
+    }
+    if (size > kMaxStaticFileBytes) {
+      return send(simple(http::status::internal_server_error, "file too large\n"), true);
+    }
+    http::response<http::string_body> res{http::status::ok, req.version()};
+    res.set(http::field::server, "edmhmi");
+    res.set(http::field::content_type, std::string(content_type_for(*file)));
+    res.set(http::field::cache_control, std::string(cache_control_for(target)));
+    res.set("X-Content-Type-Options", "nosniff");
+    res.set("Content-Security-Policy", kCsp);
+    res.set("Referrer-Policy", "no-referrer");
+    if (req.method() == http::verb::get) {
+      std::ifstream in(*file, std::ios::binary);
+      res.body().assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      res.prepare_payload();
+    } else {
+      res.content_length(size);
+    }
+    res.keep_alive(req.keep_alive());
+    send(std::move(res), !req.keep_alive());
+  }
+
+  void send(http::response<http::string_body> res, bool close) {
+    res_ = std::make_shared<http::response<http::string_body>>(std::move(res));
+    if (close) res_->keep_alive(false);
+    stream_.expires_after(kRequestTimeout);
+    http::async_write(stream_, *res_,
+                      [self = shared_from_this(), close](beast::error_code ec, std::size_t) {
+                        self->on_write(ec, close);
+                      });
+  }
+
+  void on_write(beast::error_code ec, bool close) {
+    if (ec) return fail(ec, "http write");
+    if (close) {
+      stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+      return;
+    }
+    res_.reset();
+    do_read();
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_{kMaxHttpHeaderBytes + kMaxHttpBodyBytes};
+  std::optional<http::request_parser<http::string_body>> parser_;
+  std::shared_ptr<http::response<http::string_body>> res_;
+  const std::filesystem::path& root_;
+  WebHub& hub_;
+};
+
+}  // namespace
+
+WebListener::WebListener(asio::io_context& ioc, const tcp::endpoint& endpoint,
+                         std::filesystem::path web_root, WebHub& hub)
+    : ioc_(ioc), acceptor_(ioc), web_root_(std::move(web_root)), hub_(hub) {
+  acceptor_.open(endpoint.protocol());
+  acceptor_.set_option(asio::socket_base::reuse_address(true));
+  acceptor_.bind(endpoint);
+  acceptor_.listen(asio::socket_base::max_listen_connections);
+}
+
+void WebListener::run() { do_accept(); }
+
+tcp::endpoint WebListener::local_endpoint() const { return acceptor_.local_endpoint(); }
+
+void WebListener::do_accept() {
+  acceptor_.async_accept(asio::make_strand(ioc_), [self = shared_from_this()](beast::error_code ec,
+                                                                              tcp::socket socket) {
+    if (ec) {
+      fail(ec, "accept");
+    } else {
+      std::make_shared<HttpSession>(std::move(socket), self->web_root_, self->hub_)->run();
+    }
+    if (self->acceptor_.is_open()) self->do_accept();
+  });
+}
+
+}  // namespace edm::hmi
