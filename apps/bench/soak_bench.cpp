@@ -9,11 +9,13 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -142,6 +144,19 @@ std::vector<TaskStats> read_stats(const fs::path& path) {
   return out;
 }
 
+/// "built YYYY-MM-DD HH:MM:SS, N bytes": which edmplc a phase ran (others rebuild build/ too).
+std::string binary_stamp(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    return "missing";
+  }
+  char when[32];
+  std::tm tm{};
+  ::gmtime_r(&st.st_mtime, &tm);
+  std::strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return fmt::format("built {}, {} bytes", when, st.st_size);
+}
+
 class Runner {
  public:
   Runner(Options o, fs::path out) : o_(std::move(o)), out_(std::move(out)) {
@@ -172,8 +187,9 @@ class Runner {
     soak::PlcProcess plc;
     const auto t0 = soak::Clock::now();
     auto since = [t0] { return std::chrono::duration<double>(soak::Clock::now() - t0).count(); };
-    fmt::print("[{}] edmplc --config {} --clock real --bridge-port {} ({} min{})\n", name,
-               config_.string(), port, minutes, hostile ? ", 16 hostile clients" : "");
+    fmt::print("[{}] edmplc --config {} --clock real --bridge-port {} ({} min{}); binary {}\n",
+               name, config_.string(), port, minutes, hostile ? ", 16 hostile clients" : "",
+               binary_stamp(edmplc_));
     std::fflush(stdout);
     const std::string started =
         plc.start({edmplc_, "--config", config_.string(), "--clock", "real", "--bridge-port",
@@ -192,6 +208,8 @@ class Runner {
     std::atomic<bool> stop_sampler{false}, plc_dead{false};
     std::mutex samples_mutex;
     std::thread sampler([&] {
+      std::ofstream live(dir / "samples.csv");  // written as it goes: readable during a run
+      live << "t_s,rss_kb,fds\n";
       while (!stop_sampler.load()) {
         const auto s = soak::sample_proc(plc.pid());
         if (!s || s->zombie) {
@@ -204,6 +222,8 @@ class Runner {
           std::lock_guard lock(samples_mutex);
           ph.samples.push_back(*s);
           ph.samples.back().t_s = since();
+          live << fmt::format("{:.1f},{},{}", ph.samples.back().t_s, s->rss_kb, s->fds)
+               << std::endl;
         }
         if (s->rss_kb > kRssKillKb) {
           ph.rss_killed = true;
