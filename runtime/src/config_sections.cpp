@@ -304,7 +304,9 @@ void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   out.loc = v.loc;
   auto m =
       r_.map(v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions",
-                 "max_line_bytes", "read_timeout", "queue_limit", "stall_timeout", "status_vars"});
+                 "max_line_bytes", "read_timeout", "queue_limit", "stall_timeout", "status_vars",
+                 "queue_bytes", "max_pending", "hello_timeout", "tls", "insecure_plaintext",
+                 "audit_file"});
   if (!m) {
     return;
   }
@@ -321,7 +323,8 @@ void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   int_in(*m, "max_sessions", 1, 64, out.max_sessions);
   int_in(*m, "max_line_bytes", 1024, kMaxLineBytes, out.max_line_bytes);
   for (auto [key, dest] : {std::pair{"read_timeout", &out.read_timeout},
-                           std::pair{"stall_timeout", &out.stall_timeout}}) {
+                           std::pair{"stall_timeout", &out.stall_timeout},
+                           std::pair{"hello_timeout", &out.hello_timeout}}) {
     if (const Field* f = m->find(key)) {
       if (auto d = r_.duration(f->value)) {
         if (*d < std::chrono::milliseconds(100) || *d > std::chrono::hours(24)) {
@@ -333,6 +336,26 @@ void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
     }
   }
   int_in(*m, "queue_limit", 16, 65536, out.queue_limit);
+  int_in(*m, "queue_bytes", 64 * 1024, 256 * 1024 * 1024, out.queue_bytes);
+  int_in(*m, "max_pending", 1, 1024, out.max_pending);
+  if (const Field* f = m->find("tls")) {
+    out.tls_loc = f->value.loc;
+    if (auto t = r_.map(f->value, {"cert", "key"})) {
+      for (auto [key, dest] : {std::pair{"cert", &out.tls_cert}, std::pair{"key", &out.tls_key}}) {
+        if (const Field* g = t->find(key)) {
+          *dest = r_.string(g->value).value_or("");
+        } else {
+          r_.error(f->value, std::string("tls needs '") + key + "'");
+        }
+      }
+    }
+  }
+  if (const Field* f = m->find("insecure_plaintext")) {
+    out.insecure_plaintext = r_.choice(f->value, {"true", "false"}).value_or("false") == "true";
+  }
+  if (const Field* f = m->find("audit_file")) {
+    out.audit_file = r_.string(f->value).value_or("");
+  }
   if (const Field* f = m->find("status_vars")) {
     out.status_vars = parse_variable_names(f->value);
     if (out.status_vars.size() > 16) {
@@ -349,6 +372,7 @@ void Parser::parse_retain(const Value& v, RetainSpec& out) {
   }
   if (const Field* f = r_.require(*m, "file")) {
     out.file = r_.string(f->value).value_or("");
+    out.file_loc = f->value.loc;
   }
   if (const Field* f = m->find("min_interval")) {
     if (auto d = r_.duration(f->value)) {

@@ -117,13 +117,13 @@ TEST_F(Bridge, every_error_code_is_reachable) {
   ServerOptions o;
   o.token_file = dir_.file("op.token");
   o.viewer_token_file = dir_.file("viewer.token");
-  write_token(o.token_file, "op-secret", 0600);
-  write_token(o.viewer_token_file, "viewer-secret", 0600);
+  write_token(o.token_file, "op-secret-0123456789", 0600);
+  write_token(o.viewer_token_file, "viewer-secret-0123456789", 0600);
   o.max_sessions = 3;
   start(o);
 
   Client op;
-  ASSERT_EQ(op.connect(client_opts("op-secret")), Role::kOperator);
+  ASSERT_EQ(op.connect(client_opts("op-secret-0123456789")), Role::kOperator);
   expect_error(op.request_raw("{\"id\": 1, oops"), ErrorCode::kBadJson);
   expect_error(op.request("subscribe", {{"topics", 5}}), ErrorCode::kBadRequest);
   expect_error(op.request("subscribe", {{"topics", {"status"}}, {"rate_hz", 101}}),
@@ -137,7 +137,7 @@ TEST_F(Bridge, every_error_code_is_reachable) {
   EXPECT_TRUE(op.request("ping")) << "the session lives on after too_large";
 
   Client viewer;
-  ASSERT_EQ(viewer.connect(client_opts("viewer-secret")), Role::kViewer);
+  ASSERT_EQ(viewer.connect(client_opts("viewer-secret-0123456789")), Role::kViewer);
   expect_error(viewer.request("cycle.start"), ErrorCode::kForbidden);
   EXPECT_TRUE(viewer.request("status"));
 
@@ -160,10 +160,10 @@ TEST_F(Bridge, every_error_code_is_reachable) {
   EXPECT_TRUE(op.upload_program(prog));
   // ... and a full house refuses the next connection with busy.
   Client third;
-  ASSERT_NO_THROW(third.connect(client_opts("viewer-secret")));
+  ASSERT_NO_THROW(third.connect(client_opts("viewer-secret-0123456789")));
   Client fourth;
   try {
-    fourth.connect(client_opts("viewer-secret"));
+    fourth.connect(client_opts("viewer-secret-0123456789"));
     ADD_FAILURE() << "max_sessions was not enforced";
   } catch (const ClientError& e) {
     ASSERT_TRUE(e.code().has_value()) << e.what();
@@ -422,15 +422,15 @@ TEST_F(Bridge, idle_sessions_time_out) {
 TEST(BridgeAuth, token_files_readable_by_others_are_refused) {
   edm::test::TempDir dir("edm-bridge-auth");
   const std::string f = dir.file("op.token");
-  write_token(f, "secret", 0644);
+  write_token(f, "secret-0123456789abc", 0644);
   try {
     load_tokens(f, "");
     ADD_FAILURE() << "a world-readable token file was accepted";
   } catch (const BridgeError& e) {
     EXPECT_NE(std::string(e.what()).find("mode 0644"), std::string::npos) << e.what();
   }
-  write_token(f, "secret", 0600);
-  EXPECT_EQ(load_tokens(f, "").operator_token, "secret");
+  write_token(f, "secret-0123456789abc", 0600);
+  EXPECT_EQ(load_tokens(f, "").operator_token, "secret-0123456789abc");
   write_token(f, "  \n", 0600);
   EXPECT_THROW(load_tokens(f, ""), BridgeError);
   EXPECT_THROW(load_tokens(dir.file("missing"), ""), BridgeError);

@@ -34,8 +34,8 @@ TEST(ThirdPartyClient, python_session_against_a_real_edmplc) {
   edm::test::TempDir dir("edm-bridge-py");
   const std::string op = dir.file("op.token");
   const std::string viewer = dir.file("viewer.token");
-  write_token(op, "op-7f3a9c", 0600);
-  write_token(viewer, "viewer-51be", 0600);
+  write_token(op, "op-7f3a9c0d1e2f3a4b", 0600);
+  write_token(viewer, "viewer-51be6c7d8e9f", 0600);
   const std::string cfg = dir.file("machine.yaml");
   std::ofstream(cfg) << kBridgeTestConfig << "bridge: {token_file: " << op
                      << ", viewer_token_file: " << viewer << "}\n";
@@ -45,7 +45,7 @@ TEST(ThirdPartyClient, python_session_against_a_real_edmplc) {
 
   edm::test::Child py({"/usr/bin/python3",
                        std::string(EDM_TEST_DATA_DIR) + "/bridge/third_party_client.py",
-                       std::to_string(port), "op-7f3a9c", "viewer-51be"});
+                       std::to_string(port), "op-7f3a9c0d1e2f3a4b", "viewer-51be6c7d8e9f"});
   const int rc = py.wait();
   EXPECT_EQ(rc, 0) << py.output();
   EXPECT_NE(py.output().find("PASS"), std::string::npos) << py.output();
@@ -58,7 +58,7 @@ TEST(ThirdPartyClient, python_session_against_a_real_edmplc) {
 TEST(ThirdPartyClient, edmplc_refuses_a_world_readable_token_file) {
   edm::test::TempDir dir("edm-bridge-py");
   const std::string op = dir.file("op.token");
-  write_token(op, "op-7f3a9c", 0644);
+  write_token(op, "op-7f3a9c0d1e2f3a4b", 0644);
   const std::string cfg = dir.file("machine.yaml");
   std::ofstream(cfg) << kBridgeTestConfig << "bridge: {token_file: " << op << "}\n";
   edm::test::Child plc(

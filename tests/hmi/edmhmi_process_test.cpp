@@ -190,8 +190,8 @@ TEST_F(EdmhmiProcessTest, BusyMachineRefusesASecondRun) {
 class EdmhmiTokenTest : public EdmhmiProcessTest {
  protected:
   void SetUp() override {
-    write_token(op_, "op-3c1d77");
-    write_token(viewer_, "viewer-90ab");
+    write_token(op_, "op-3c1d77a0b1c2d3e4");
+    write_token(viewer_, "viewer-90abf1e2d3c4b5");
     write_token(wrong_, "not-the-token");
     std::string cfg = read_file(kDrillSim);
     const std::string anchor = "\n  port: 7730\n";
@@ -200,7 +200,7 @@ class EdmhmiTokenTest : public EdmhmiProcessTest {
     cfg.insert(at + anchor.size(),
                "  token_file: " + op_ + "\n  viewer_token_file: " + viewer_ + "\n");
     std::ofstream(config_) << cfg;
-    start_plc(config_, "op-3c1d77");
+    start_plc(config_, "op-3c1d77a0b1c2d3e4");
   }
   static void write_token(const std::string& path, const std::string& token) {
     std::ofstream(path) << token << "\n";
@@ -241,7 +241,7 @@ TEST_F(EdmhmiTokenTest, WrongOrMissingTokenIsUnauthorized) {
   EXPECT_EQ(none.code, 1) << none.out << none.err;
   EXPECT_NE(none.err.find("unauthorized"), std::string::npos) << none.err;
   // The operator's token from the environment works.
-  const Outcome op = edmhmi({"status"}, {{"EDM_TOKEN", "op-3c1d77"}});
+  const Outcome op = edmhmi({"status"}, {{"EDM_TOKEN", "op-3c1d77a0b1c2d3e4"}});
   EXPECT_EQ(op.code, 0) << op.err;
   // An empty token file is refused before connecting (bad input).
   const std::string empty = dir_.file("empty.token");

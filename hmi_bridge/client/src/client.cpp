@@ -6,8 +6,10 @@
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/ssl.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/write.hpp>
+#include <cctype>
 #include <condition_variable>
 #include <deque>
 #include <future>
@@ -55,12 +57,48 @@ Reply to_reply(Json j) {
   return r;
 }
 
+/// SHA-256 of the peer's certificate (DER), as lower-case hex without separators.
+std::string peer_fingerprint(SSL* ssl) {
+  X509* cert = SSL_get1_peer_certificate(ssl);
+  if (cert == nullptr) {
+    return "";
+  }
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int n = 0;
+  const int ok = X509_digest(cert, EVP_sha256(), md, &n);
+  X509_free(cert);
+  if (ok != 1) {
+    return "";
+  }
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < n; ++i) {
+    out += kHex[md[i] >> 4];
+    out += kHex[md[i] & 0xF];
+  }
+  return out;
+}
+
 }  // namespace
 
-/// One TCP connection; touched only on the I/O thread once started.
+std::string normalise_fingerprint(std::string_view text) {
+  std::string out;
+  for (const char ch : text) {
+    if (ch == ':' || ch == ' ') {
+      continue;
+    }
+    out += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  }
+  return out;
+}
+
+/// One TCP connection, with TLS over it when the options ask; touched only on the I/O thread
+/// once started.
 struct Conn {
   explicit Conn(asio::io_context& ioc) : socket(ioc), keepalive(ioc) {}
   tcp::socket socket;
+  std::shared_ptr<asio::ssl::context> tls_ctx;
+  std::optional<asio::ssl::stream<tcp::socket&>> tls;
   asio::steady_timer keepalive;
   std::array<char, 64 * 1024> rx{};
   std::string line;
@@ -109,9 +147,14 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
 
   // ---- I/O thread ----
   void start_read(const std::shared_ptr<Conn>& c) {
-    c->socket.async_read_some(asio::buffer(c->rx), [self = shared_from_this(), c](
-                                                       boost::system::error_code ec,
-                                                       std::size_t n) { self->on_read(c, ec, n); });
+    auto h = [self = shared_from_this(), c](boost::system::error_code ec, std::size_t n) {
+      self->on_read(c, ec, n);
+    };
+    if (c->tls) {
+      c->tls->async_read_some(asio::buffer(c->rx), std::move(h));
+    } else {
+      c->socket.async_read_some(asio::buffer(c->rx), std::move(h));
+    }
   }
 
   void on_read(const std::shared_ptr<Conn>& c, boost::system::error_code ec, std::size_t n) {
@@ -148,8 +191,9 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
   }
 
   void handle_line(const std::string& line) {
-    Json j = Json::parse(line, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) {
+    Json j;
+    std::string why;
+    if (!parse_json_strict(line, j, why) || !j.is_object()) {
       return;
     }
     if (j.contains("event")) {
@@ -206,16 +250,20 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
       return;
     }
     c->writing = true;
-    asio::async_write(c->socket, asio::buffer(c->wq.front()),
-                      [self = shared_from_this(), c](boost::system::error_code ec, std::size_t) {
-                        c->writing = false;
-                        if (ec) {
-                          self->lose(c, ec.message());
-                          return;
-                        }
-                        c->wq.pop_front();
-                        self->do_write(c);
-                      });
+    auto h = [self = shared_from_this(), c](boost::system::error_code ec, std::size_t) {
+      c->writing = false;
+      if (ec) {
+        self->lose(c, ec.message());
+        return;
+      }
+      c->wq.pop_front();
+      self->do_write(c);
+    };
+    if (c->tls) {
+      asio::async_write(*c->tls, asio::buffer(c->wq.front()), std::move(h));
+    } else {
+      asio::async_write(c->socket, asio::buffer(c->wq.front()), std::move(h));
+    }
   }
 
   void arm_keepalive(const std::shared_ptr<Conn>& c) {
@@ -339,6 +387,72 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
     done.get_future().wait();
   }
 
+  /// TLS over the connected socket: the server is verified against a CA file (chain and name)
+  /// or a pinned SHA-256 fingerprint of its certificate. Throws ClientError.
+  void tls_handshake(const std::shared_ptr<Conn>& c, const ClientOptions& o) {
+    const std::string where = "bridge: TLS to " + o.host + ":" + std::to_string(o.port) + ": ";
+    c->tls_ctx = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_client);
+    c->tls_ctx->set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
+                            asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
+                            asio::ssl::context::no_tlsv1_1);
+    boost::system::error_code ec;
+    if (!o.tls.ca_file.empty()) {
+      c->tls_ctx->load_verify_file(o.tls.ca_file, ec);
+      if (ec) {
+        throw ClientError(where + "CA file " + o.tls.ca_file + ": " + ec.message());
+      }
+      c->tls_ctx->set_verify_mode(asio::ssl::verify_peer);
+    } else if (o.tls.fingerprint.empty()) {
+      throw ClientError(where + "no way to verify the server: give a CA file or a fingerprint");
+    } else {
+      c->tls_ctx->set_verify_mode(asio::ssl::verify_none);  // the pin is checked below
+    }
+    c->tls.emplace(c->socket, *c->tls_ctx);
+    SSL* ssl = c->tls->native_handle();
+    if (!o.tls.ca_file.empty()) {
+      // The certificate must name the host we dialled (an IP SAN for an address).
+      boost::system::error_code aec;
+      asio::ip::make_address(o.host, aec);
+      X509_VERIFY_PARAM* param = SSL_get0_param(ssl);
+      const int ok = aec ? X509_VERIFY_PARAM_set1_host(param, o.host.c_str(), 0)
+                         : X509_VERIFY_PARAM_set1_ip_asc(param, o.host.c_str());
+      if (ok != 1) {
+        throw ClientError(where + "cannot set the name to verify");
+      }
+      if (aec) {
+        SSL_set_tlsext_host_name(ssl, o.host.c_str());
+      }
+    }
+    std::promise<boost::system::error_code> done;
+    auto f = done.get_future();
+    asio::post(ioc, [c, &done] {
+      c->tls->async_handshake(asio::ssl::stream_base::client,
+                              [&done](boost::system::error_code e) { done.set_value(e); });
+    });
+    if (f.wait_for(o.timeout) != std::future_status::ready) {
+      asio::post(ioc, [c] {
+        boost::system::error_code ignored;
+        c->socket.close(ignored);
+      });
+      f.wait();
+      throw ClientError(where + "handshake timed out");
+    }
+    if (const auto e = f.get()) {
+      throw ClientError(where + "handshake failed: " + e.message());
+    }
+    if (!o.tls.fingerprint.empty()) {
+      const std::string got = peer_fingerprint(ssl);
+      if (got != normalise_fingerprint(o.tls.fingerprint)) {
+        asio::post(ioc, [c] {
+          boost::system::error_code ignored;
+          c->socket.close(ignored);
+        });
+        throw ClientError(where + "the server's certificate fingerprint " + got +
+                          " is not the pinned one");
+      }
+    }
+  }
+
   Role connect_once() {
     ClientOptions o;
     {
@@ -374,6 +488,9 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
     if (const auto e = connected_f.get()) {
       throw ClientError("bridge: connect to " + o.host + ":" + std::to_string(o.port) + ": " +
                         e.message());
+    }
+    if (o.tls.enabled) {
+      tls_handshake(c, o);
     }
     {
       std::lock_guard lock(mu);

@@ -1,10 +1,12 @@
 #include "edm/bridge/codec.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <unordered_set>
 
 namespace edm::bridge {
 
@@ -279,13 +281,76 @@ Json make_event(std::string_view name, std::uint64_t seq, const Json& body) {
   return j;
 }
 
+namespace {
+
+/// True when `text` nests arrays and objects deeper than `max_depth` (string contents skipped).
+/// Exact for valid JSON; for invalid text it only has to be conservative enough that the parser
+/// never sees deeper nesting than this admits.
+bool nesting_exceeds(std::string_view text, int max_depth) noexcept {
+  int depth = 0;
+  bool in_string = false;
+  bool escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) {
+        return true;
+      }
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+bool parse_json_strict(std::string_view text, Json& out, std::string& error) {
+  if (nesting_exceeds(text, kMaxJsonDepth)) {
+    error = "nested deeper than " + std::to_string(kMaxJsonDepth) + " levels";
+    return false;
+  }
+  // Keys seen in each open object, innermost last (depth is bounded above).
+  std::vector<std::unordered_set<std::string>> keys;
+  bool duplicate = false;
+  const Json::parser_callback_t cb = [&](int /*depth*/, Json::parse_event_t ev, Json& parsed) {
+    if (ev == Json::parse_event_t::object_start) {
+      keys.emplace_back();
+    } else if (ev == Json::parse_event_t::object_end && !keys.empty()) {
+      keys.pop_back();
+    } else if (ev == Json::parse_event_t::key && !keys.empty() && parsed.is_string()) {
+      duplicate = !keys.back().insert(parsed.get<std::string>()).second || duplicate;
+    }
+    return true;
+  };
+  Json j = Json::parse(text.begin(), text.end(), cb, /*allow_exceptions=*/false);
+  if (j.is_discarded()) {
+    error = "not valid JSON";
+    return false;
+  }
+  if (duplicate) {
+    error = "duplicate key in an object";
+    return false;
+  }
+  out = std::move(j);
+  return true;
+}
+
 std::optional<ParsedRequest> parse_request(std::string_view line, ErrorCode& code,
                                            std::string& message, Json& id_if_known) {
   id_if_known = nullptr;
-  Json j = Json::parse(line.begin(), line.end(), nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded()) {
+  Json j;
+  if (!parse_json_strict(line, j, message)) {
     code = ErrorCode::kBadJson;
-    message = "not valid JSON";
     return std::nullopt;
   }
   if (!j.is_object()) {

@@ -10,7 +10,7 @@
 
 namespace edm::bridge {
 
-std::string read_token_file(const std::string& path, std::string_view key) {
+void check_private_file(const std::string& path, std::string_view key) {
   const std::string where = "bridge." + std::string(key) + " " + path + ": ";
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
@@ -25,17 +25,38 @@ std::string read_token_file(const std::string& path, std::string_view key) {
     throw BridgeError(where + "readable or writable by group/others (mode " + mode +
                       "); chmod 600 it");
   }
+}
+
+std::string read_token_file(const std::string& path, std::string_view key) {
+  const std::string where = "bridge." + std::string(key) + " " + path + ": ";
+  check_private_file(path, key);
   std::ifstream in(path);
   std::string line;
-  if (!in || !std::getline(in, line)) {
+  // A token is one short line: read at most a bounded prefix whatever the file holds.
+  constexpr std::size_t kMaxRead = 4096;
+  std::string head(kMaxRead, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (!in && !in.eof()) {
     throw BridgeError(where + "cannot read a token from it");
   }
+  line = head.substr(0, head.find('\n'));
   const auto first = line.find_first_not_of(" \t\r\n");
   const auto last = line.find_last_not_of(" \t\r\n");
   if (first == std::string::npos) {
     throw BridgeError(where + "the token is empty");
   }
-  return line.substr(first, last - first + 1);
+  line = line.substr(first, last - first + 1);
+  if (line.size() < kMinTokenChars) {
+    throw BridgeError(where + "the token has " + std::to_string(line.size()) +
+                      " characters; at least " + std::to_string(kMinTokenChars) +
+                      " are required (e.g. openssl rand -hex 16)");
+  }
+  if (line.size() > kMaxTokenChars) {
+    throw BridgeError(where + "the token is longer than " + std::to_string(kMaxTokenChars) +
+                      " characters");
+  }
+  return line;
 }
 
 TokenSet load_tokens(const std::string& operator_file, const std::string& viewer_file) {

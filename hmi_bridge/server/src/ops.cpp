@@ -30,6 +30,15 @@ Body error(ErrorCode code, std::string message, Json details = nullptr) {
   return Error{code, std::move(message), std::move(details)};
 }
 
+/// A client-supplied name quoted in a message: at most 64 characters, never the client's JSON.
+std::string brief_name(std::string_view name) {
+  constexpr std::size_t kMax = 64;
+  std::string q = "'";
+  q.append(name.substr(0, kMax));
+  q += name.size() > kMax ? "…'" : "'";
+  return q;
+}
+
 /// A required field of type T, or an error naming it.
 template <class Pred>
 const Json* field(const Json& msg, const char* key, Pred ok) {
@@ -53,20 +62,43 @@ ErrorCode var_error(rt::VarResult r) {
 
 Body op_hello(Session& s, const Json& msg) {
   auto& srv = s.server();
-  const Json* proto = field(msg, "protocol", [](const Json& j) { return j.is_number_integer(); });
-  if (proto == nullptr || proto->get<std::int64_t>() != kProtocolVersion) {
-    return error(ErrorCode::kUnauthorized,
-                 "protocol version " + std::to_string(kProtocolVersion) + " required");
+  if (s.role_) {
+    return error(ErrorCode::kInvalidState,
+                 "hello already said (role " + std::string(to_string(*s.role_)) + ")");
   }
+  const Json* proto = field(msg, "protocol", [](const Json& j) { return j.is_number_integer(); });
   std::string token;
   if (auto it = msg.find("token"); it != msg.end() && it->is_string()) {
     token = it->get<std::string>();
   }
-  const auto role = authenticate(srv.tokens, token, s.loopback());
+  std::optional<Role> role;
+  if (proto != nullptr && proto->get<std::int64_t>() == kProtocolVersion) {
+    role = authenticate(srv.tokens, token, s.loopback());
+  }
   if (!role) {
-    return error(ErrorCode::kUnauthorized, "bad token");
+    srv.counters.hello_failures.fetch_add(1, std::memory_order_relaxed);
+    const auto delay = srv.throttle.on_failure(s.peer_address(), SteadyClock::now());
+    std::string why = proto == nullptr || proto->get<std::int64_t>() != kProtocolVersion
+                          ? "protocol version " + std::to_string(kProtocolVersion) + " required"
+                      : !srv.tokens.any() ? "only loopback clients are served without a token"
+                                          : "bad token";
+    spdlog::warn(
+        "bridge: session {} ({}): hello refused: {} (next hello from this address in "
+        "{} ms)",
+        s.id(), s.peer(), why, delay.count());
+    return error(ErrorCode::kUnauthorized, std::move(why));
+  }
+  srv.throttle.on_success(s.peer_address());
+  if (!srv.admit(s, *role)) {
+    spdlog::info("bridge: session {} ({}): {} refused: every slot is taken", s.id(), s.peer(),
+                 to_string(*role));
+    return error(ErrorCode::kBusy, "too many sessions (max " +
+                                       std::to_string(srv.opt.max_sessions) + ", " +
+                                       std::to_string(kOperatorReserve) + " kept for an operator)");
   }
   s.role_ = role;
+  spdlog::info("bridge: session {} ({}{}): hello as {}", s.id(), s.peer(),
+               s.loopback() ? "" : ", network", to_string(*role));
   return Json{{"role", std::string(to_string(*role))},
               {"protocol", kProtocolVersion},
               {"server", "edmplc"},
@@ -92,7 +124,9 @@ Body op_subscribe(Session& s, const Json& msg) {
       progress = true;
     } else {
       return error(ErrorCode::kBadRequest,
-                   "unknown topic " + t.dump() + " (status, alarm, progress; traces: trace.start)");
+                   "unknown topic" +
+                       (t.is_string() ? " " + brief_name(t.get_ref<const std::string&>()) : "") +
+                       " (status, alarm, progress; traces: trace.start)");
     }
   }
   int rate = s.rate_hz_ > 0 ? s.rate_hz_ : 10;
@@ -319,7 +353,7 @@ Body op_var_read(Session& s, const Json& msg) {
   for (const auto& name : names) {
     const rt::Variable* v = reg.find(name);
     if (v == nullptr) {
-      return error(ErrorCode::kNotFound, "no variable '" + name + "'", Json{{"name", name}});
+      return error(ErrorCode::kNotFound, "no variable " + brief_name(name));
     }
     const auto value = reg.read(name);
     values[name] = value && std::isfinite(*value) ? Json(*value) : Json(nullptr);
@@ -396,12 +430,19 @@ Body op_trace_start(Session& s, const Json& msg) {
       return error(ErrorCode::kBadRequest, "'vars' must be an array of strings");
     }
     const auto& n = v.get_ref<const std::string&>();
+    if (std::find(names.begin(), names.end(), n) != names.end()) {
+      continue;  // a repeated name is traced once
+    }
+    if (names.size() == rt::kMaxTraceVarsPerTask) {
+      return error(ErrorCode::kTooLarge, "at most " + std::to_string(rt::kMaxTraceVarsPerTask) +
+                                             " distinct trace variables per session");
+    }
     const rt::Variable* var = reg.find(n);
     if (var == nullptr) {
-      return error(ErrorCode::kNotFound, "no variable '" + n + "'", Json{{"name", n}});
+      return error(ErrorCode::kNotFound, "no variable " + brief_name(n));
     }
     if (!var->is_pin() || var->owner == nullptr) {
-      return error(ErrorCode::kBadRequest, "'" + n + "' is a parameter; only pins are traced");
+      return error(ErrorCode::kBadRequest, brief_name(n) + " is a parameter; only pins are traced");
     }
     names.push_back(n);
   }
@@ -480,7 +521,26 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
     const rt::Runtime& rt = s.server().rt;
     return to_json(rt.tables(), rt.config().machine.name);
   }
-  return error(ErrorCode::kUnknownOp, "unknown op '" + op + "'");
+  return error(ErrorCode::kUnknownOp, "unknown op " + brief_name(op));
+}
+
+/// What an audit entry says about a request beyond its op: the variable and value, or the
+/// program's size. Short, and built from validated fields only.
+std::string audit_detail(const std::string& op, const Json& msg) {
+  std::string d;
+  if (auto it = msg.find("name"); it != msg.end() && it->is_string()) {
+    d = "name=" + brief_name(it->get_ref<const std::string&>());
+  }
+  if (auto it = msg.find("value"); it != msg.end() && (it->is_primitive())) {
+    std::string v = it->dump();
+    d += (d.empty() ? "" : " ") + ("value=" + v.substr(0, 32));
+  }
+  if (op == "program.commit") {
+    if (auto it = msg.find("checksum"); it != msg.end() && it->is_string()) {
+      d = "checksum=" + brief_name(it->get_ref<const std::string&>());
+    }
+  }
+  return d;
 }
 
 }  // namespace
@@ -490,10 +550,18 @@ OpResult run_op(Session& s, const ParsedRequest& req) {
   const OpInfo* info = find_op(req.op);
   Body body;
   if (info == nullptr) {
-    body = error(ErrorCode::kUnknownOp, "unknown op '" + req.op + "'");
+    body = error(ErrorCode::kUnknownOp, "unknown op " + brief_name(req.op));
   } else if (req.op == "hello") {
+    if (!s.role_) {
+      const auto now = SteadyClock::now();
+      const auto when = s.server().throttle.admit_at(s.peer_address(), now);
+      if (when > now) {
+        r.retry_at = when;  // evaluated later: the failed-hello throttle of this address
+        return r;
+      }
+    }
     body = op_hello(s, req.msg);
-    r.close_after = std::holds_alternative<Error>(body);  // a wrong token ends the session
+    r.close_after = std::holds_alternative<Error>(body) && !s.role_;  // refused: session ends
   } else if (!s.role_) {
     body = error(ErrorCode::kUnauthorized, "hello first");
   } else if (info->operator_only && *s.role_ != Role::kOperator) {
@@ -501,7 +569,13 @@ OpResult run_op(Session& s, const ParsedRequest& req) {
   } else {
     body = dispatch(s, req.op, req.msg);
   }
-  if (auto* e = std::get_if<Error>(&body)) {
+  const auto* e = std::get_if<Error>(&body);
+  if (info != nullptr && info->operator_only && s.role_) {
+    s.server().audit.record(s.id(), to_string(*s.role_), s.peer(), req.op,
+                            audit_detail(req.op, req.msg),
+                            e != nullptr ? to_string(e->code) : "ok");
+  }
+  if (e != nullptr) {
     r.reply = make_error(req.id, e->code, e->message, e->details);
   } else {
     r.reply = make_reply(req.id, std::get<Json>(body));

@@ -66,28 +66,65 @@ ServerOptions options_from_config(const rt::BridgeSpec& spec) {
   o.read_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(spec.read_timeout);
   o.queue_limit = spec.queue_limit;
   o.stall_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(spec.stall_timeout);
+  o.queue_bytes = spec.queue_bytes;
+  o.max_pending = spec.max_pending;
+  o.hello_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(spec.hello_timeout);
+  o.tls_cert = spec.tls_cert;
+  o.tls_key = spec.tls_key;
+  o.insecure_plaintext = spec.insecure_plaintext;
+  o.audit_file = spec.audit_file;
   for (const auto& v : spec.status_vars) {
     o.status_vars.push_back(v.name);
   }
   return o;
 }
 
+TokenSet validate_options(const ServerOptions& opt) {
+  TokenSet tokens = load_tokens(opt.token_file, opt.viewer_token_file);
+  boost::system::error_code ec;
+  asio::ip::make_address(opt.bind, ec);
+  if (ec) {
+    throw BridgeError("bridge.bind '" + opt.bind + "': not an IP address");
+  }
+  if (opt.tls_cert.empty() != opt.tls_key.empty()) {
+    throw BridgeError("bridge.tls: both cert and key are required");
+  }
+  if (!opt.tls_key.empty()) {
+    check_private_file(opt.tls_key, "tls.key");
+    make_tls_server_context(opt.tls_cert, opt.tls_key);  // throws naming the file at fault
+  }
+  if (!is_loopback_address(opt.bind)) {
+    if (!tokens.any()) {
+      throw BridgeError("bridge.bind " + opt.bind +
+                        " is not a loopback address and no token_file is configured; refusing "
+                        "to serve the network without authentication");
+    }
+    if (opt.tls_cert.empty() && !opt.insecure_plaintext) {
+      throw BridgeError("bridge.bind " + opt.bind +
+                        " is not a loopback address and bridge.tls is not configured; refusing "
+                        "to send tokens in clear text (bridge.insecure_plaintext: true to "
+                        "allow it anyway)");
+    }
+  }
+  return tokens;
+}
+
 Server::Impl::Impl(rt::Runtime& runtime, ServerOptions options)
     : rt(runtime), opt(std::move(options)) {}
 
 void Server::Impl::start() {
-  tokens = load_tokens(opt.token_file, opt.viewer_token_file);
-  const bool loopback_bind = is_loopback_address(opt.bind);
+  tokens = validate_options(opt);
+  const auto address = asio::ip::make_address(opt.bind);
+  if (!opt.tls_cert.empty()) {
+    tls = make_tls_server_context(opt.tls_cert, opt.tls_key);
+  } else if (!is_loopback_address(opt.bind)) {
+    spdlog::warn(
+        "bridge: INSECURE: serving {} without TLS (bridge.insecure_plaintext): tokens and "
+        "commands cross the network in clear text",
+        opt.bind);
+  }
+  audit.open(opt.audit_file);
   boost::system::error_code ec;
-  const auto address = asio::ip::make_address(opt.bind, ec);
-  if (ec) {
-    throw BridgeError("bridge.bind '" + opt.bind + "': not an IP address");
-  }
-  if (!loopback_bind && !tokens.any()) {
-    throw BridgeError("bridge.bind " + opt.bind +
-                      " is not a loopback address and no token_file is configured; refusing to "
-                      "serve the network without authentication");
-  }
 
   // Status board on the I/O task (the one with the driver), else the first task.
   std::vector<rt::PinRef> pins;
@@ -154,7 +191,8 @@ void Server::Impl::start() {
   trace_tick();
   thread = std::thread([this] { ioc.run(); });
   started = true;
-  spdlog::info("bridge: listening on {}:{} ({}{})", opt.bind, bound_port,
+  spdlog::info("bridge: listening on {}:{} ({}, {}{})", opt.bind, bound_port,
+               tls ? "TLS" : "plain TCP",
                tokens.any() ? "token authentication" : "loopback only, no token",
                tokens.viewer_token.empty() ? "" : ", viewer token");
 }
@@ -174,14 +212,15 @@ void Server::Impl::stop() {
     acceptor.close(ec);
     progress_timer.cancel();
     trace_timer.cancel();
-    std::vector<std::shared_ptr<Session>> all;
-    for (auto& [p, w] : sessions) {
+    accept_timer.cancel();
+    std::vector<std::shared_ptr<Session>> all = live_sessions();
+    for (auto& [id, w] : pending) {
       if (auto s = w.lock()) {
         all.push_back(std::move(s));
       }
     }
     for (auto& s : all) {
-      s->async_close();
+      s->close();
     }
     done.set_value();
   });
@@ -197,42 +236,126 @@ void Server::Impl::stop() {
 }
 
 void Server::Impl::do_accept() {
-  acceptor.async_accept(
-      asio::make_strand(ioc), [this](boost::system::error_code ec, tcp::socket socket) {
-        if (ec) {
-          if (ec != asio::error::operation_aborted) {
-            spdlog::warn("bridge: accept: {}", ec.message());
-            do_accept();
-          }
-          return;
-        }
-        auto s = std::make_shared<Session>(*this, std::move(socket), next_session_id++);
-        const bool full = sessions.size() >= static_cast<std::size_t>(opt.max_sessions);
-        if (full || (!tokens.any() && !s->loopback())) {
-          counters.sessions_refused.fetch_add(1, std::memory_order_relaxed);
-          // The refusal answers the client's first request (its hello), with that request's
-          // id, so a client can tell it from a dropped connection; then the session closes.
-          s->refuse(full ? ErrorCode::kBusy : ErrorCode::kUnauthorized,
-                    full ? "too many sessions (max " + std::to_string(opt.max_sessions) + ")"
-                         : "only loopback clients are served without a token");
-          s->start();
-        } else {
-          counters.sessions_accepted.fetch_add(1, std::memory_order_relaxed);
-          counters.sessions_open.fetch_add(1, std::memory_order_relaxed);
-          sessions.emplace(s.get(), s);
-          s->start();
-        }
-        do_accept();
-      });
+  acceptor.async_accept(ioc, [this](boost::system::error_code ec, tcp::socket socket) {
+    if (ec) {
+      on_accept_error(ec);
+      return;
+    }
+    if (accept_backoff.count() > 0) {
+      spdlog::info("bridge: accepting again after {} accept errors",
+                   counters.accept_errors.load(std::memory_order_relaxed));
+      accept_backoff = std::chrono::milliseconds(0);
+    }
+    if (opt.send_buffer_bytes > 0) {
+      socket.set_option(asio::socket_base::send_buffer_size(opt.send_buffer_bytes), ec);
+    }
+    adopt(tls ? make_tls_transport(std::move(socket), *tls)
+              : make_tcp_transport(std::move(socket)));
+    do_accept();
+  });
 }
 
-void Server::Impl::remove(Session* s) {
-  if (sessions.erase(s) > 0) {
-    counters.sessions_open.fetch_sub(1, std::memory_order_relaxed);
+// Out of descriptors (EMFILE/ENFILE), out of memory, or a network error: accept again later,
+// backing off to 1 s, and log once per episode rather than once per failure.
+void Server::Impl::on_accept_error(const boost::system::error_code& ec) {
+  if (ec == asio::error::operation_aborted || stopping.load(std::memory_order_acquire)) {
+    return;
   }
-  if (!s->trace_vars().empty()) {
+  counters.accept_errors.fetch_add(1, std::memory_order_relaxed);
+  if (accept_backoff.count() == 0) {
+    spdlog::warn("bridge: accept: {}; backing off", ec.message());
+    accept_backoff = std::chrono::milliseconds(10);
+  } else {
+    accept_backoff = std::min(accept_backoff * 2, std::chrono::milliseconds(1000));
+  }
+  accept_timer.expires_after(accept_backoff);
+  accept_timer.async_wait([this](boost::system::error_code e) {
+    if (!e) {
+      do_accept();
+    }
+  });
+}
+
+void Server::Impl::adopt(std::unique_ptr<Transport> t) {
+  // Pre-authentication connections have a cap of their own. When it is reached the oldest one
+  // goes — the oldest of the newcomer's own address when that address holds a quarter of the
+  // slots — so a flood of silent sockets never keeps a client that says hello at once out.
+  const std::string address = t->peer_address();
+  const std::size_t per_peer =
+      std::max<std::size_t>(1, static_cast<std::size_t>(opt.max_pending) / 4);
+  std::vector<std::shared_ptr<Session>> same_peer;
+  std::shared_ptr<Session> oldest;
+  for (auto it = pending.begin(); it != pending.end();) {
+    auto s = it->second.lock();
+    if (!s) {
+      it = pending.erase(it);
+      continue;
+    }
+    if (!oldest) {
+      oldest = s;
+    }
+    if (s->peer_address() == address) {
+      same_peer.push_back(s);
+    }
+    ++it;
+  }
+  std::shared_ptr<Session> evict;
+  if (same_peer.size() >= per_peer) {
+    evict = same_peer.front();
+  } else if (pending.size() >= static_cast<std::size_t>(opt.max_pending)) {
+    evict = oldest;
+  }
+  if (evict) {
+    counters.pending_evicted.fetch_add(1, std::memory_order_relaxed);
+    spdlog::debug("bridge: session {} ({}): evicted before hello (pending cap)", evict->id(),
+                  evict->peer());
+    evict->close();
+  }
+  auto s = std::make_shared<Session>(*this, std::move(t), next_session_id++);
+  pending.emplace(s->id(), s);
+  counters.sessions_pending.store(pending.size(), std::memory_order_relaxed);
+  s->start();
+}
+
+bool Server::Impl::admit(Session& s, Role role) {
+  std::size_t viewers = 0;
+  for (const auto& w : live_sessions()) {
+    viewers += w->role_ == Role::kViewer ? 1 : 0;
+  }
+  const auto max = static_cast<std::size_t>(opt.max_sessions);
+  const std::size_t reserve = max > 1 ? kOperatorReserve : 0;
+  const bool full = sessions.size() >= max || (role == Role::kViewer && viewers >= max - reserve);
+  if (full) {
+    counters.sessions_refused.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  pending.erase(s.id());
+  sessions.emplace(s.id(), s.weak_from_this());
+  counters.sessions_pending.store(pending.size(), std::memory_order_relaxed);
+  counters.sessions_accepted.fetch_add(1, std::memory_order_relaxed);
+  counters.sessions_open.store(sessions.size(), std::memory_order_relaxed);
+  return true;
+}
+
+void Server::Impl::remove(Session& s) {
+  pending.erase(s.id());
+  sessions.erase(s.id());
+  counters.sessions_pending.store(pending.size(), std::memory_order_relaxed);
+  counters.sessions_open.store(sessions.size(), std::memory_order_relaxed);
+  if (!s.trace_vars().empty()) {
     retrace();
   }
+}
+
+std::vector<std::shared_ptr<Session>> Server::Impl::live_sessions() const {
+  std::vector<std::shared_ptr<Session>> out;
+  out.reserve(sessions.size());
+  for (const auto& [id, w] : sessions) {
+    if (auto s = w.lock()) {
+      out.push_back(std::move(s));
+    }
+  }
+  return out;
 }
 
 void Server::Impl::on_alarm(const rt::Alarm& a) {
@@ -243,8 +366,8 @@ void Server::Impl::on_alarm(const rt::Alarm& a) {
                {"source", std::string(a.source)},
                {"text", std::string(a.text)},
                {"value", std::isfinite(a.value) ? Json(a.value) : Json(nullptr)}};
-  for (auto& [p, w] : sessions) {
-    if (auto s = w.lock(); s && s->wants(kTopicAlarm)) {
+  for (const auto& s : live_sessions()) {
+    if (s->wants(kTopicAlarm)) {
       s->send_event("alarm", body);
     }
   }
@@ -255,8 +378,8 @@ void Server::Impl::progress_tick() {
   if (!same_progress(p, last_progress)) {
     last_progress = p;
     const Json body = progress_json(p);
-    for (auto& [ptr, w] : sessions) {
-      if (auto s = w.lock(); s && s->wants(kTopicProgress)) {
+    for (const auto& s : live_sessions()) {
+      if (s->wants(kTopicProgress)) {
         s->send_event("progress", body);
       }
     }
@@ -272,10 +395,8 @@ void Server::Impl::progress_tick() {
 void Server::Impl::retrace() {
   // The union of every session's trace variables, split by owning task.
   std::set<std::string> wanted;
-  for (auto& [p, w] : sessions) {
-    if (auto s = w.lock()) {
-      wanted.insert(s->trace_vars().begin(), s->trace_vars().end());
-    }
+  for (const auto& s : live_sessions()) {
+    wanted.insert(s->trace_vars().begin(), s->trace_vars().end());
   }
   const auto& tasks = rt.tasks();
   for (std::size_t i = 0; i < tasks.size() && i < taps.size(); ++i) {
@@ -299,9 +420,8 @@ void Server::Impl::trace_tick() {
     trace_scratch.clear();
     while (taps[i]->drain(trace_scratch, kTraceSamplesPerEvent) > 0) {
       const auto& names = tap_names[i];
-      for (auto& [p, w] : sessions) {
-        auto s = w.lock();
-        if (!s || s->trace_vars().empty()) {
+      for (const auto& s : live_sessions()) {
+        if (s->trace_vars().empty()) {
           continue;
         }
         std::vector<std::size_t> cols;
@@ -382,12 +502,26 @@ void Server::start() { impl_->start(); }
 void Server::stop() { impl_->stop(); }
 std::uint16_t Server::port() const noexcept { return impl_->bound_port; }
 
+void Server::adopt(std::unique_ptr<Transport> transport) {
+  asio::post(impl_->ioc, [impl = impl_.get(), t = std::move(transport)]() mutable {
+    impl->adopt(std::move(t));
+  });
+}
+
+boost::asio::io_context& Server::io_context() noexcept { return impl_->ioc; }
+
 ServerStats Server::stats() const noexcept { return impl_->stats_snapshot(); }
 
 ServerStats Server::Impl::stats_snapshot() const noexcept {
   const Counters& c = counters;
   ServerStats s;
   s.sessions_open = c.sessions_open.load();
+  s.sessions_pending = c.sessions_pending.load();
+  s.pending_evicted = c.pending_evicted.load();
+  s.hello_timeouts = c.hello_timeouts.load();
+  s.hello_failures = c.hello_failures.load();
+  s.accept_errors = c.accept_errors.load();
+  s.queue_bytes_peak = c.queue_bytes_peak.load();
   s.sessions_accepted = c.sessions_accepted.load();
   s.sessions_refused = c.sessions_refused.load();
   s.requests = c.requests.load();

@@ -1,7 +1,7 @@
 #pragma once
 // Internals of the bridge server: the shared state (Server::Impl) and the Session.
-// Everything here runs on the server's single io thread; each session's handlers are also
-// serialised by its strand. Counters are atomics so stats() may be read from any thread.
+// Everything here runs on the server's single io thread (one thread runs the io_context, so
+// handlers never run concurrently). Counters are atomics so stats() may be read from any thread.
 
 #include <array>
 #include <atomic>
@@ -11,6 +11,7 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,11 +21,18 @@
 #include <unordered_map>
 #include <vector>
 
+#include "audit.hpp"
 #include "edm/bridge/codec.hpp"
+#include "edm/bridge/hello_throttle.hpp"
 #include "edm/bridge/server.hpp"
 #include "edm/bridge/status_board.hpp"
 #include "edm/bridge/trace_tap.hpp"
+#include "edm/bridge/transport.hpp"
 #include "edm/runtime/runtime.hpp"
+
+namespace boost::asio::ssl {
+class context;
+}
 
 namespace edm::bridge {
 
@@ -36,8 +44,14 @@ class Session;
 
 struct Counters {
   std::atomic<std::uint64_t> sessions_open{0};
+  std::atomic<std::uint64_t> sessions_pending{0};
   std::atomic<std::uint64_t> sessions_accepted{0};
   std::atomic<std::uint64_t> sessions_refused{0};
+  std::atomic<std::uint64_t> pending_evicted{0};
+  std::atomic<std::uint64_t> hello_timeouts{0};
+  std::atomic<std::uint64_t> hello_failures{0};
+  std::atomic<std::uint64_t> accept_errors{0};
+  std::atomic<std::uint64_t> queue_bytes_peak{0};
   std::atomic<std::uint64_t> requests{0};
   std::atomic<std::uint64_t> errors{0};
   std::atomic<std::uint64_t> events_sent{0};
@@ -51,7 +65,14 @@ struct Counters {
 struct OpResult {
   Json reply;
   bool close_after{false};
+  /// The hello may not be evaluated yet (failed-hello throttle): run it again at this time.
+  std::optional<SteadyClock::time_point> retry_at;
 };
+
+/// Longest line a session that has not said hello yet may send (a hello is small).
+inline constexpr std::size_t kPreAuthLineBytes = 8 * 1024;
+/// Viewers may hold every session slot but this many: an operator always gets in.
+inline constexpr int kOperatorReserve = 1;
 
 struct Server::Impl {
   Impl(rt::Runtime& runtime, ServerOptions options);
@@ -59,10 +80,19 @@ struct Server::Impl {
   void start();
   void stop();
   void do_accept();
+  void on_accept_error(const boost::system::error_code& ec);
+  /// Registers a connected transport as a new pending session and starts it (io thread).
+  void adopt(std::unique_ptr<Transport> t);
+  /// A session said a valid hello as `role`: moves it to the authenticated sessions, or
+  /// returns false (busy) when that role has no free slot.
+  bool admit(Session& s, Role role);
   void on_alarm(const rt::Alarm& a);
   void progress_tick();
   void trace_tick();
-  void remove(Session* s);
+  void remove(Session& s);
+  /// Authenticated sessions, as strong references: broadcasts iterate this copy, because a
+  /// send may close a session and closing removes it from the registry.
+  std::vector<std::shared_ptr<Session>> live_sessions() const;
   /// Recomputes each task's tap from the union of the sessions' trace variables.
   void retrace();
   /// Fills a status message (from the board when it has published, else directly).
@@ -72,6 +102,9 @@ struct Server::Impl {
   rt::Runtime& rt;
   ServerOptions opt;
   TokenSet tokens;
+  std::shared_ptr<asio::ssl::context> tls;  // null: plain TCP
+  HelloThrottle throttle;
+  AuditLog audit;
   std::vector<std::string> status_var_names;
   std::unique_ptr<StatusBoard> board;
   std::vector<std::unique_ptr<TraceTap>> taps;      // one per task, same order as rt.tasks()
@@ -89,10 +122,14 @@ struct Server::Impl {
   asio::io_context ioc{1};
   std::optional<asio::executor_work_guard<asio::io_context::executor_type>> work;
   tcp::acceptor acceptor{ioc};
+  asio::steady_timer accept_timer{ioc};
+  std::chrono::milliseconds accept_backoff{0};
   asio::steady_timer progress_timer{ioc};
   asio::steady_timer trace_timer{ioc};
   rt::JobProgress last_progress{};
-  std::unordered_map<Session*, std::weak_ptr<Session>> sessions;
+  // Keyed by session id, so iteration is in age order (oldest first).
+  std::map<std::uint64_t, std::weak_ptr<Session>> pending;   // no valid hello yet
+  std::map<std::uint64_t, std::weak_ptr<Session>> sessions;  // authenticated
   std::thread thread;
   std::atomic<bool> started{false};
   std::atomic<bool> stopping{false};
@@ -110,61 +147,75 @@ struct Upload {
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
-  Session(Server::Impl& server, tcp::socket socket, std::uint64_t id);
+  Session(Server::Impl& server, std::unique_ptr<Transport> transport, std::uint64_t id);
 
+  /// Handshake (TLS), then reads; the hello deadline starts now.
   void start();
-  /// Closes the socket and cancels the timers; the session goes away when its handlers finish.
+  /// Closes the transport and cancels the timers; the session goes away when its handlers
+  /// finish. Never call it while iterating the server's registries (use live_sessions()).
   void close();
-  /// close() on the session's strand (from outside it).
+  /// close() posted to the io thread (from anywhere, e.g. inside a broadcast loop).
   void async_close();
   /// Closes once the queued messages are written.
   void close_after_flush();
-  void linger_close();
-  /// Before start(): the session only answers its first request with this error, then closes.
-  void refuse(ErrorCode code, std::string message);
-  /// Sends a reply (never dropped; a client that floods requests without reading is paused).
+  /// Sends a reply. Never dropped: a client that does not read its replies stops being read
+  /// (its requests wait in its own socket buffer) while the queue is over its byte limit.
   void send_reply(const Json& reply);
-  /// Queues an event if the queue has room; else drops it (counted) and disconnects a reader
-  /// that stays stalled past stall_timeout. Assigns seq only to events actually queued, so a
-  /// subscriber sees seq without gaps (and `dropped` in status events says what it missed).
+  /// Queues an event if the queue has room (messages and bytes); else drops it (counted) and
+  /// disconnects a reader that stays stalled past stall_timeout. Assigns seq only to events
+  /// actually queued, so a subscriber sees seq without gaps (`dropped` says what it missed).
   void send_event(std::string_view name, Json body);
 
   [[nodiscard]] bool wants(std::string_view topic) const;
   [[nodiscard]] const std::vector<std::string>& trace_vars() const { return trace_vars_; }
   [[nodiscard]] std::uint64_t id() const { return id_; }
+  [[nodiscard]] const std::string& peer() const { return peer_; }
+  [[nodiscard]] const std::string& peer_address() const { return address_; }
+  [[nodiscard]] bool authenticated() const { return role_.has_value(); }
+  [[nodiscard]] std::size_t queued_bytes() const { return queued_bytes_; }
 
  private:
   friend struct Ops;
+  void on_handshake(boost::system::error_code ec);
   void do_read();
   void on_read(boost::system::error_code ec, std::size_t n);
+  void process_input();
   void handle_line(std::string_view line);
   void arm_read_timer();
-  void enqueue(std::shared_ptr<const std::string> msg);
+  void arm_hello_timer();
+  void linger_close();
+  void start_shutdown();
+  void enqueue(std::string msg);
+  [[nodiscard]] bool queue_full() const;
   void do_write();
   void on_write(boost::system::error_code ec, std::size_t n);
   void start_status_timer();
   void on_status_tick(boost::system::error_code ec, std::uint64_t gen);
 
   Server::Impl& server_;
-  tcp::socket socket_;
-  asio::strand<asio::io_context::executor_type> strand_;
+  std::unique_ptr<Transport> transport_;
   const std::uint64_t id_;
   bool loopback_{false};
+  std::string address_;
   std::string peer_;
 
   std::array<char, 64 * 1024> rx_{};
+  std::string input_;  // the part of the last read not yet framed (while the queue is full)
   std::string line_;
   bool discarding_{false};  // skipping the rest of a too-long line
   bool reading_{false};
   bool read_paused_{false};
+  bool handshaken_{false};
   asio::steady_timer read_timer_;
+  asio::steady_timer hello_timer_;
+  asio::steady_timer throttle_timer_;
+  std::optional<std::string> deferred_hello_;  // waiting for the failed-hello throttle
 
-  std::deque<std::shared_ptr<const std::string>> queue_;
+  std::deque<std::string> queue_;
+  std::size_t queued_bytes_{0};
   bool writing_{false};
   bool close_after_flush_{false};
   bool lingering_{false};
-  std::optional<std::pair<ErrorCode, std::string>>
-      refusal_;  // half-closed, draining the client's input until it closes
   bool closed_{false};
   std::uint64_t seq_{0};
   std::uint64_t dropped_{0};

@@ -1,9 +1,9 @@
-// One client connection: line framing, read timeout, bounded write queue, status timer.
+// One client connection: handshake, hello deadline, line framing, read timeout, a write queue
+// bounded in messages and bytes, the status timer, and a graceful close.
 #include <spdlog/spdlog.h>
 
-#include <boost/asio/bind_executor.hpp>
 #include <boost/asio/buffer.hpp>
-#include <boost/asio/write.hpp>
+#include <boost/asio/post.hpp>
 
 #include "server_impl.hpp"
 
@@ -26,30 +26,37 @@ void fail(const boost::system::error_code& ec, const char* what, std::uint64_t i
 
 }  // namespace
 
-Session::Session(Server::Impl& server, tcp::socket socket, std::uint64_t id)
+Session::Session(Server::Impl& server, std::unique_ptr<Transport> transport, std::uint64_t id)
     : server_(server),
-      socket_(std::move(socket)),
-      strand_(asio::make_strand(server.ioc)),
+      transport_(std::move(transport)),
       id_(id),
-      read_timer_(strand_),
-      status_timer_(strand_) {
-  boost::system::error_code ec;
-  const auto ep = socket_.remote_endpoint(ec);
-  if (!ec) {
-    loopback_ = is_loopback_address(ep.address().to_string());
-    peer_ = ep.address().to_string() + ":" + std::to_string(ep.port());
-  }
-  socket_.set_option(tcp::no_delay(true), ec);
-  if (server.opt.send_buffer_bytes > 0) {
-    socket_.set_option(asio::socket_base::send_buffer_size(server.opt.send_buffer_bytes), ec);
-  }
+      address_(transport_->peer_address()),
+      peer_(transport_->peer()),
+      read_timer_(server.ioc),
+      hello_timer_(server.ioc),
+      throttle_timer_(server.ioc),
+      status_timer_(server.ioc) {
+  loopback_ = is_loopback_address(address_);
 }
 
 void Session::start() {
-  asio::dispatch(strand_, [self = shared_from_this()] {
-    self->arm_read_timer();
-    self->do_read();
-  });
+  arm_hello_timer();
+  transport_->async_handshake(
+      [self = shared_from_this()](boost::system::error_code ec) { self->on_handshake(ec); });
+}
+
+void Session::on_handshake(boost::system::error_code ec) {
+  if (closed_) {
+    return;
+  }
+  if (ec) {
+    spdlog::info("bridge: session {} ({}): TLS handshake failed: {}", id_, peer_, ec.message());
+    close();
+    return;
+  }
+  handshaken_ = true;
+  arm_read_timer();
+  do_read();
 }
 
 void Session::close() {
@@ -57,21 +64,18 @@ void Session::close() {
     return;
   }
   closed_ = true;
-  boost::system::error_code ec;
-  socket_.shutdown(tcp::socket::shutdown_both, ec);
-  socket_.close(ec);
+  transport_->close();
   read_timer_.cancel();
+  hello_timer_.cancel();
+  throttle_timer_.cancel();
   status_timer_.cancel();
   queue_.clear();
-  server_.remove(this);
+  queued_bytes_ = 0;
+  server_.remove(*this);
 }
 
 void Session::async_close() {
-  asio::dispatch(strand_, [self = shared_from_this()] { self->close(); });
-}
-
-void Session::refuse(ErrorCode code, std::string message) {
-  refusal_.emplace(code, std::move(message));
+  asio::post(server_.ioc, [self = shared_from_this()] { self->close(); });
 }
 
 void Session::close_after_flush() {
@@ -81,21 +85,13 @@ void Session::close_after_flush() {
   }
 }
 
-// Half-close after the last reply: send FIN, then drain what the client still sends until it
-// closes too (or kLinger passes). Closing with unread input would send an RST, and the client's
-// TCP stack may then drop the reply it has not read yet (a refused hello would read as a plain
-// disconnect instead of `busy` / `unauthorized`).
+// After the last reply: end gracefully (FIN and drain, or TLS close_notify) so the reply is
+// not lost to a reset, and close at the latest kLinger later.
 void Session::linger_close() {
   if (closed_ || lingering_) {
     return;
   }
   lingering_ = true;
-  boost::system::error_code ec;
-  socket_.shutdown(tcp::socket::shutdown_send, ec);
-  if (ec) {
-    close();
-    return;
-  }
   constexpr std::chrono::milliseconds kLinger{1000};
   read_timer_.expires_after(kLinger);
   read_timer_.async_wait([self = shared_from_this()](boost::system::error_code e) {
@@ -103,7 +99,16 @@ void Session::linger_close() {
       self->close();
     }
   });
-  do_read();
+  if (reading_) {
+    transport_->cancel();  // on_read starts the shutdown once the read has let go
+  } else {
+    start_shutdown();
+  }
+}
+
+void Session::start_shutdown() {
+  transport_->async_shutdown(
+      [self = shared_from_this()](boost::system::error_code) { self->close(); });
 }
 
 bool Session::wants(std::string_view topic) const {
@@ -122,7 +127,7 @@ bool Session::wants(std::string_view topic) const {
 void Session::arm_read_timer() {
   read_timer_.expires_after(server_.opt.read_timeout);
   read_timer_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
-    if (ec || self->closed_) {
+    if (ec || self->closed_ || self->lingering_) {
       return;
     }
     self->server_.counters.timeouts.fetch_add(1, std::memory_order_relaxed);
@@ -132,43 +137,75 @@ void Session::arm_read_timer() {
   });
 }
 
+// A connection that has not said a valid hello this soon is closed: unauthenticated sockets
+// cannot hold a slot for long.
+void Session::arm_hello_timer() {
+  hello_timer_.expires_after(server_.opt.hello_timeout);
+  hello_timer_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
+    if (ec || self->closed_ || self->role_ || self->lingering_ || self->deferred_hello_) {
+      return;  // a hello that came in time and waits for the throttle is not timed out
+    }
+    self->server_.counters.hello_timeouts.fetch_add(1, std::memory_order_relaxed);
+    spdlog::info("bridge: session {} ({}): no valid hello within {} ms, closing", self->id_,
+                 self->peer_, self->server_.opt.hello_timeout.count());
+    self->close();
+  });
+}
+
 void Session::do_read() {
-  if (closed_ || reading_) {
+  if (closed_ || reading_ || !handshaken_) {
     return;
   }
-  if (queue_.size() >= server_.opt.queue_limit && !lingering_) {
+  if (lingering_) {
+    return;  // the shutdown drains what the client still sends
+  }
+  if (queue_full()) {
     read_paused_ = true;  // the client is not reading its replies: stop reading its requests
     return;
   }
   reading_ = true;
-  socket_.async_read_some(
-      asio::buffer(rx_),
-      asio::bind_executor(strand_,
-                          [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
-                            self->on_read(ec, n);
-                          }));
+  transport_->async_read_some(
+      asio::buffer(rx_), [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+        self->on_read(ec, n);
+      });
 }
 
 void Session::on_read(boost::system::error_code ec, std::size_t n) {
   reading_ = false;
+  if (closed_) {
+    return;
+  }
+  if (lingering_) {
+    start_shutdown();
+    return;
+  }
   if (ec) {
     fail(ec, "read", id_);
     close();
     return;
   }
-  if (lingering_) {  // closing: what the client still sends is read and dropped
-    do_read();
-    return;
+  if (deferred_hello_) {
+    do_read();  // waiting for the throttle: what else the client sends is dropped, but its
+    return;     // closing the connection is seen (and frees the slot) at once
   }
-  const std::size_t limit = server_.opt.max_line_bytes;
-  std::string_view chunk(rx_.data(), n);
-  while (!chunk.empty() && !closed_) {
-    const auto nl = chunk.find('\n');
-    const std::string_view part = chunk.substr(0, nl);
+  input_.assign(rx_.data(), n);
+  process_input();
+}
+
+// Frames and runs the requests of the last read, but only while the reply queue has room: a
+// client that pipelines requests without reading replies stops being read, mid-read if need
+// be, so its replies never take more than about queue_bytes.
+void Session::process_input() {
+  const std::size_t limit = role_ ? server_.opt.max_line_bytes : kPreAuthLineBytes;
+  std::size_t used = 0;
+  while (used < input_.size() && !closed_ && !close_after_flush_ && !deferred_hello_ &&
+         !queue_full()) {
+    const std::string_view rest = std::string_view(input_).substr(used);
+    const auto nl = rest.find('\n');
+    const std::string_view part = rest.substr(0, nl);
+    used += nl == std::string_view::npos ? rest.size() : nl + 1;
     if (discarding_) {
-      if (nl != std::string_view::npos) {
-        discarding_ = false;  // the too-long line has ended; the session goes on
-      }
+      discarding_ = nl == std::string_view::npos;  // until the too-long line has ended
     } else if (line_.size() + part.size() > limit) {
       server_.counters.errors.fetch_add(1, std::memory_order_relaxed);
       send_reply(make_error(nullptr, ErrorCode::kTooLarge,
@@ -186,44 +223,63 @@ void Session::on_read(boost::system::error_code ec, std::size_t n) {
       line_.clear();
       handle_line(line);
     }
-    if (nl == std::string_view::npos) {
-      break;
-    }
-    chunk.remove_prefix(nl + 1);
+  }
+  input_.erase(0, used);
+  if (closed_) {
+    return;
+  }
+  if (deferred_hello_ || close_after_flush_) {
+    input_.clear();  // a throttled hello's followers, or requests of an ending session: dropped
+  }
+  if (!input_.empty()) {
+    read_paused_ = true;  // resumed by on_write once the queue has drained
+    return;
   }
   do_read();
 }
 
 void Session::handle_line(std::string_view line) {
-  if (close_after_flush_) {
+  if (close_after_flush_ || closed_) {
     return;  // the session is ending: later requests get no reply
   }
   if (!line.empty() && line.back() == '\r') {
     line.remove_suffix(1);
   }
-  if (line.find_first_not_of(" \t") == std::string_view::npos) {
-    return;  // blank lines are keep-alives
-  }
+  // Any line, a blank keep-alive included, is activity (docs/protocol.md); it does not extend
+  // the hello deadline.
   arm_read_timer();
+  if (line.find_first_not_of(" \t") == std::string_view::npos) {
+    return;
+  }
   server_.counters.requests.fetch_add(1, std::memory_order_relaxed);
   ErrorCode code{};
   std::string message;
   Json id;
   auto req = parse_request(line, code, message, id);
   OpResult r;
-  if (refusal_) {
-    send_reply(make_error(id, refusal_->first, refusal_->second));
-    close_after_flush();
-    return;
-  }
   if (!req) {
     r.reply = make_error(id, code, message);
   } else {
     try {
       r = run_op(*this, *req);
     } catch (const std::exception& e) {  // a bug or bad_alloc must not take the server down
-      r.reply = make_error(req->id, ErrorCode::kBadRequest, std::string("internal: ") + e.what());
+      spdlog::error("bridge: session {}: op '{}' failed: {}", id_, req->op, e.what());
+      r.reply = make_error(req->id, ErrorCode::kBadRequest, "internal error");
     }
+  }
+  if (r.retry_at) {
+    deferred_hello_ = std::string(line);
+    throttle_timer_.expires_at(*r.retry_at);
+    throttle_timer_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
+      if (ec || self->closed_ || !self->deferred_hello_) {
+        return;
+      }
+      std::string again = std::move(*self->deferred_hello_);
+      self->deferred_hello_.reset();
+      self->handle_line(again);
+      self->do_read();
+    });
+    return;
   }
   if (r.reply.is_null()) {
     return;
@@ -241,14 +297,18 @@ void Session::send_reply(const Json& reply) {
   if (closed_) {
     return;
   }
-  enqueue(std::make_shared<const std::string>(to_line(reply)));
+  enqueue(to_line(reply));
+}
+
+bool Session::queue_full() const {
+  return queue_.size() >= server_.opt.queue_limit || queued_bytes_ >= server_.opt.queue_bytes;
 }
 
 void Session::send_event(std::string_view name, Json body) {
-  if (closed_ || close_after_flush_) {
+  if (closed_ || close_after_flush_ || lingering_) {
     return;
   }
-  if (queue_.size() >= server_.opt.queue_limit) {
+  if (queue_full()) {
     ++dropped_;
     server_.counters.events_dropped.fetch_add(1, std::memory_order_relaxed);
     const auto now = SteadyClock::now();
@@ -260,53 +320,63 @@ void Session::send_event(std::string_view name, Json body) {
           "bridge: session {} ({}): not reading for {} ms ({} events dropped); "
           "disconnecting",
           id_, peer_, server_.opt.stall_timeout.count(), dropped_);
-      close();
+      // Posted: the caller is a broadcast loop, and closing takes the session out of the
+      // server's registry.
+      async_close();
     }
     return;
   }
   server_.counters.events_sent.fetch_add(1, std::memory_order_relaxed);
-  enqueue(std::make_shared<const std::string>(to_line(make_event(name, ++seq_, body))));
+  enqueue(to_line(make_event(name, ++seq_, body)));
 }
 
-void Session::enqueue(std::shared_ptr<const std::string> msg) {
+void Session::enqueue(std::string msg) {
+  queued_bytes_ += msg.size();
   queue_.push_back(std::move(msg));
+  if (queued_bytes_ > server_.counters.queue_bytes_peak.load(std::memory_order_relaxed)) {
+    server_.counters.queue_bytes_peak.store(queued_bytes_, std::memory_order_relaxed);
+  }
   if (!writing_) {
     do_write();
   }
 }
 
 void Session::do_write() {
-  if (closed_ || queue_.empty()) {
+  if (closed_ || writing_ || queue_.empty()) {  // one write in flight
     return;
   }
   writing_ = true;
-  asio::async_write(socket_, asio::buffer(*queue_.front()),
-                    asio::bind_executor(strand_, [self = shared_from_this()](
-                                                     boost::system::error_code ec, std::size_t n) {
-                      self->on_write(ec, n);
-                    }));
+  transport_->async_write(asio::buffer(queue_.front()),
+                          [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                            self->on_write(ec, n);
+                          });
 }
 
 void Session::on_write(boost::system::error_code ec, std::size_t /*n*/) {
   writing_ = false;
+  if (closed_) {
+    return;
+  }
   if (ec) {
     fail(ec, "write", id_);
     close();
     return;
   }
   if (!queue_.empty()) {
+    queued_bytes_ -= queue_.front().size();
     queue_.pop_front();
   }
-  if (queue_.size() < server_.opt.queue_limit) {
+  if (!queue_full()) {
     stalled_since_.reset();
   }
   if (queue_.empty() && close_after_flush_) {
     linger_close();
     return;
   }
-  if (read_paused_ && queue_.size() < server_.opt.queue_limit / 2 + 1) {
+  if (read_paused_ && queue_.size() <= server_.opt.queue_limit / 2 &&
+      queued_bytes_ <= server_.opt.queue_bytes / 2) {
     read_paused_ = false;
-    do_read();
+    process_input();
   }
   do_write();
 }

@@ -34,6 +34,18 @@
 
 namespace edm::bridge {
 
+/// TLS to the bridge (docs/security.md). The server is verified either against a CA file (its
+/// chain, and that it names the host dialled) or by the SHA-256 fingerprint of its certificate
+/// (`openssl x509 -in cert.pem -noout -fingerprint -sha256`; colons and case do not matter).
+struct ClientTls {
+  bool enabled{false};
+  std::string ca_file;
+  std::string fingerprint;
+};
+
+/// "AB:CD:…" → "abcd…".
+std::string normalise_fingerprint(std::string_view text);
+
 struct ClientOptions {
   std::string host{"127.0.0.1"};
   std::uint16_t port{kDefaultPort};
@@ -44,6 +56,7 @@ struct ClientOptions {
   std::chrono::milliseconds reconnect_min{100};
   std::chrono::milliseconds reconnect_max{5000};
   std::size_t max_line_bytes{64u << 20};  // longest reply/event accepted
+  ClientTls tls;
 };
 
 /// Could not connect or the hello was refused. what() says why (with the server's error code).

@@ -68,6 +68,11 @@ Json make_error(const Json& id, ErrorCode code, std::string_view message,
 /// {"event": name, "seq": seq, ...body}.
 Json make_event(std::string_view name, std::uint64_t seq, const Json& body = Json::object());
 
+/// Parses one JSON text strictly: nesting deeper than kMaxJsonDepth and duplicate object keys
+/// are errors (a repeated "op" must not pick the last one). On failure returns false and says
+/// why in `error`, without quoting the input. Never recursive over the input's depth.
+bool parse_json_strict(std::string_view text, Json& out, std::string& error);
+
 /// One line as the server sees it: a JSON object with a string `op` (id optional).
 struct ParsedRequest {
   Json id;  // null when absent

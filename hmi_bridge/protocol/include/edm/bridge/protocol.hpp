@@ -17,6 +17,9 @@ inline constexpr int kProtocolVersion = 1;
 inline constexpr std::uint16_t kDefaultPort = 7730;
 /// Longest line either side accepts, newline excluded (DESIGN §9: 1 MiB).
 inline constexpr std::size_t kMaxLineBytes = std::size_t{1} << 20;
+/// Deepest nesting of arrays and objects a line may have (either side). Parsing is bounded by
+/// it before any parser runs, so a hostile line cannot exhaust a stack.
+inline constexpr int kMaxJsonDepth = 32;
 /// Status subscription rates the server accepts (Hz).
 inline constexpr int kMinRateHz = 1;
 inline constexpr int kMaxRateHz = 100;

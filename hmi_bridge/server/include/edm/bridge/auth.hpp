@@ -31,8 +31,18 @@ struct TokenSet {
   }
 };
 
+/// Shortest and longest token accepted: 16 characters is 64 bits as hex, the least that the
+/// failed-hello throttle makes impractical to guess.
+inline constexpr std::size_t kMinTokenChars = 16;
+inline constexpr std::size_t kMaxTokenChars = 1024;
+
+/// Throws BridgeError unless `path` is a regular file with no group/other permission bits
+/// (token files, the TLS key). `key` names the config key in messages.
+void check_private_file(const std::string& path, std::string_view key);
+
 /// Reads one token file: the first line without surrounding whitespace. Throws BridgeError when
-/// the file is missing, not a regular file, readable or writable by group/others, or empty.
+/// the file is missing, not a regular file, readable or writable by group/others, empty, or
+/// when the token is shorter than kMinTokenChars or longer than kMaxTokenChars.
 /// `key` names the config key in messages.
 std::string read_token_file(const std::string& path, std::string_view key);
 

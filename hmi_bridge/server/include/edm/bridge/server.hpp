@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "edm/bridge/auth.hpp"
+#include "edm/bridge/transport.hpp"
 #include "edm/runtime/config.hpp"
 
 namespace edm::rt {
@@ -41,18 +42,37 @@ struct ServerOptions {
   std::chrono::milliseconds read_timeout{60'000};  // no complete line for this long: close
   std::size_t queue_limit{256};                    // queued messages per session before dropping
   std::chrono::milliseconds stall_timeout{5'000};  // dropping events this long: disconnect
-  std::vector<std::string> status_vars;            // empty: the defaults that exist
-  int send_buffer_bytes{0};                        // SO_SNDBUF per session; 0: system default
+  std::size_t queue_bytes{std::size_t{4} << 20};   // queued bytes per session (replies + events)
+  int max_pending{16};                             // connections that have not said hello yet
+  std::chrono::milliseconds hello_timeout{5'000};  // no valid hello this soon: close
+  std::string tls_cert;                            // PEM files; both set: the bridge speaks TLS
+  std::string tls_key;
+  bool insecure_plaintext{false};        // allow a non-loopback bind without TLS (loud)
+  std::string audit_file;                // state-changing ops appended here too ("" = log only)
+  std::vector<std::string> status_vars;  // empty: the defaults that exist
+  int send_buffer_bytes{0};              // SO_SNDBUF per session; 0: system default (tests)
 };
 
 /// The options a config's `bridge:` section gives; `port` overrides bridge.port when set.
 ServerOptions options_from_config(const rt::BridgeSpec& spec);
 
+/// Checks what start() would refuse, without binding or starting anything (edmplc --check):
+/// the token files (mode, minimum length, distinct), the bind address and its policy (a
+/// non-loopback bind needs a token, and TLS or insecure_plaintext), the TLS key's mode.
+/// Returns the tokens. Throws BridgeError.
+TokenSet validate_options(const ServerOptions& options);
+
 /// Counters since start(). Any thread.
 struct ServerStats {
-  std::uint64_t sessions_open{0};
+  std::uint64_t sessions_open{0};     // authenticated sessions now
+  std::uint64_t sessions_pending{0};  // connections waiting for their hello now
+  std::uint64_t pending_evicted{0};   // pre-hello connections closed for a newer one (cap)
+  std::uint64_t hello_timeouts{0};    // no valid hello within hello_timeout
+  std::uint64_t hello_failures{0};    // wrong token or protocol
+  std::uint64_t accept_errors{0};     // accept() failed (e.g. out of descriptors)
+  std::uint64_t queue_bytes_peak{0};  // most bytes one session ever had queued
   std::uint64_t sessions_accepted{0};
-  std::uint64_t sessions_refused{0};  // max_sessions reached, or not loopback without tokens
+  std::uint64_t sessions_refused{0};  // a valid hello found no free slot (busy)
   std::uint64_t requests{0};
   std::uint64_t errors{0};
   std::uint64_t events_sent{0};
@@ -82,6 +102,12 @@ class Server {
   /// The bound port (after start()).
   [[nodiscard]] std::uint16_t port() const noexcept;
   [[nodiscard]] ServerStats stats() const noexcept;
+
+  /// Hands a connected transport to the server as a new session, as the listener does with
+  /// each accepted socket (tests and fuzzing use in-memory transports). Any thread.
+  void adopt(std::unique_ptr<Transport> transport);
+  /// The io_context the server's thread runs (to make transports for adopt()).
+  boost::asio::io_context& io_context() noexcept;
 
   struct Impl;
 
