@@ -214,7 +214,8 @@ int main(int argc, char** argv) {
     return kExitOk;
   }
   if (!rt->retain_warning().empty()) {
-    spdlog::warn("retain: {} — starting from defaults", rt->retain_warning());
+    spdlog::error("retain: {} (alarm retain_corrupt: the machine starts in FAULT)",
+                  rt->retain_warning());
   }
   const int bridge_port =
       opt.bridge_port.value_or(rt->config().bridge.loc.line != 0 ? rt->config().bridge.port : 0);

@@ -1,5 +1,7 @@
 #include "edm/runtime/machine.hpp"
 
+#include <cstring>
+
 namespace edm::rt {
 
 std::string_view to_string(MachineState s) noexcept {
@@ -66,6 +68,10 @@ std::string_view to_string(AlarmCode c) noexcept {
       return "electrode_used_up";
     case AlarmCode::kWireBreak:
       return "wire_break";
+    case AlarmCode::kRetainCorrupt:
+      return "retain_corrupt";
+    case AlarmCode::kForcesReleased:
+      return "forces_released";
   }
   return "?";
 }
@@ -127,10 +133,13 @@ CommandResult Machine::command(MachineCommand c, TimePoint now) noexcept {
         break;
     }
     if (transition(s, to, cause)) {
+      if (c == MachineCommand::kReset) {
+        clear_all_latches();  // after reset, a condition that persists is a new occurrence
+      }
       if (c == MachineCommand::kEstop) {
         Alarm a;
         a.code = AlarmCode::kEstop;
-        a.time = now;
+        a.time = now != TimePoint{} ? now : last_release();
         a.source = "operator";
         a.text = "emergency stop";
         if (!alarms_.push(a)) {
@@ -142,23 +151,104 @@ CommandResult Machine::command(MachineCommand c, TimePoint now) noexcept {
   }
 }
 
-void Machine::raise(const Alarm& a) noexcept {
-  if (!alarms_.push(a)) {
-    dropped_alarms_.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (a.severity != AlarmSeverity::kFault) {
-    return;
-  }
+namespace {
+
+bool same_source(const char* a, const char* b) noexcept {
+  return a == b || (a != nullptr && b != nullptr && std::strcmp(a, b) == 0);
+}
+
+}  // namespace
+
+void Machine::enter_fault(AlarmCode cause) noexcept {
   for (;;) {
     const MachineState s = state();
     // ESTOP outranks FAULT; OFF has nothing energised; an existing FAULT keeps its first cause.
     if (s == MachineState::kEstop || s == MachineState::kOff || s == MachineState::kFault) {
       return;
     }
-    if (transition(s, MachineState::kFault, a.code)) {
+    if (transition(s, MachineState::kFault, cause)) {
       return;
     }
   }
+}
+
+bool Machine::raise(const Alarm& in) noexcept {
+  Alarm a = in;
+  if (a.time == TimePoint{}) {
+    a.time = last_release();
+  }
+  bool fresh = true;
+  for (Latch& l : latches_) {
+    if (l.state.load(std::memory_order_acquire) == 2 &&
+        l.code.load(std::memory_order_relaxed) == a.code &&
+        same_source(l.source.load(std::memory_order_relaxed), a.source)) {
+      l.count.fetch_add(1, std::memory_order_relaxed);
+      repeated_alarms_.fetch_add(1, std::memory_order_relaxed);
+      fresh = false;
+      break;
+    }
+  }
+  if (fresh) {
+    for (Latch& l : latches_) {
+      std::uint32_t expected = 0;
+      if (l.state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+        l.code.store(a.code, std::memory_order_relaxed);
+        l.source.store(a.source, std::memory_order_relaxed);
+        l.first_ns.store(a.time.count(), std::memory_order_relaxed);
+        l.count.store(1, std::memory_order_relaxed);
+        l.state.store(2, std::memory_order_release);
+        break;
+      }
+    }
+    if (!alarms_.push(a)) {
+      dropped_alarms_.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+  // A repeat still enforces FAULT: a latched fault must never leave the machine running.
+  if (a.severity == AlarmSeverity::kFault) {
+    enter_fault(a.code);
+  }
+  return fresh;
+}
+
+void Machine::clear_alarm(AlarmCode code, const char* source) noexcept {
+  for (Latch& l : latches_) {
+    if (l.state.load(std::memory_order_acquire) == 2 &&
+        l.code.load(std::memory_order_relaxed) == code &&
+        same_source(l.source.load(std::memory_order_relaxed), source)) {
+      std::uint32_t expected = 2;
+      l.state.compare_exchange_strong(expected, 0, std::memory_order_acq_rel);
+    }
+  }
+}
+
+void Machine::clear_all_latches() noexcept {
+  for (Latch& l : latches_) {
+    std::uint32_t expected = 2;
+    l.state.compare_exchange_strong(expected, 0, std::memory_order_acq_rel);
+  }
+}
+
+std::size_t Machine::active_alarms(ActiveAlarm* out, std::size_t capacity) const noexcept {
+  std::size_t n = 0;
+  for (const Latch& l : latches_) {
+    if (n == capacity) {
+      break;
+    }
+    if (l.state.load(std::memory_order_acquire) != 2) {
+      continue;
+    }
+    out[n++] = ActiveAlarm{l.code.load(std::memory_order_relaxed),
+                           l.source.load(std::memory_order_relaxed),
+                           TimePoint{l.first_ns.load(std::memory_order_relaxed)},
+                           l.count.load(std::memory_order_relaxed)};
+  }
+  return n;
+}
+
+void Machine::note_release(TimePoint release) noexcept {
+  // Latest writer wins: tasks differ by less than a cycle, and a new virtual run starts at 0.
+  last_release_ns_.store(release.count(), std::memory_order_relaxed);
 }
 
 }  // namespace edm::rt

@@ -35,8 +35,13 @@ BlockStatus Program::run(const CycleContext& ctx) noexcept {
         machine_->raise(a);
       }
       worst = BlockStatus::kFault;
-    } else if (s == BlockStatus::kSaturated && worst == BlockStatus::kOk) {
-      worst = BlockStatus::kSaturated;
+    } else {
+      if (e.last == BlockStatus::kFault) {
+        machine_->clear_alarm(AlarmCode::kBlockFault, e.full_name.c_str());
+      }
+      if (s == BlockStatus::kSaturated && worst == BlockStatus::kOk) {
+        worst = BlockStatus::kSaturated;
+      }
     }
     e.last = s;
   }

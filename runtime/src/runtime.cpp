@@ -14,7 +14,8 @@
 namespace edm::rt {
 
 Runtime::~Runtime() {
-  if (retain_) {
+  // A runtime that never ran (a failed start) has nothing new to keep: it must not write.
+  if (retain_ && ran_) {
     retain_->stop();
   }
 }
@@ -39,7 +40,7 @@ std::vector<TaskStatsReport> Runtime::stats_reports() const {
 void Runtime::drain_alarms() {
   Alarm a;
   while (machine_.pop_alarm(a)) {
-    const double t_s = to_seconds(a.time);
+    const double t_s = to_seconds(a.time);  // the release time of the cycle that raised it
     if (a.severity == AlarmSeverity::kFault) {
       spdlog::error("ALARM {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
                     to_string(a.code), a.source, t_s, a.text, a.value);
@@ -58,8 +59,19 @@ RunSummary Runtime::run(const RunOptions& options) {
   for (auto& t : tasks_) {
     tasks.push_back(t.get());
   }
+  ran_ = true;
   if (machine_.state() == MachineState::kOff) {
     machine_.command(MachineCommand::kPowerOn);
+  }
+  if (startup_alarm_ != AlarmCode::kNone) {
+    // Comes up in FAULT: the operator acknowledges (reset) that retained values were lost.
+    Alarm a;
+    a.code = startup_alarm_;
+    a.severity = AlarmSeverity::kFault;
+    a.source = "retain";
+    a.text = retain_warning_.c_str();
+    machine_.raise(a);
+    startup_alarm_ = AlarmCode::kNone;
   }
   if (options.trace_out.empty()) {
     // Nobody drains the rings without a trace file: don't sample, don't count drops.

@@ -93,6 +93,10 @@ class RuntimeBuilder {
     make_trace();
     check_bridge_vars();
     diag_.throw_if_any();
+    rt_->variables_.set_machine(&rt_->machine_);
+    for (auto& t : rt_->tasks_) {
+      t->attach_forces(rt_->variables_);
+    }
     finish();
     make_retain();
     diag_.throw_if_any();
@@ -497,12 +501,47 @@ class RuntimeBuilder {
     if (!diag_.empty()) {
       return;
     }
-    if (options_.load_retain) {
-      RetainLoadResult loaded = load_retain_file(rs.file);
-      rt_->retain_warning_ = loaded.warning;
-      for (const auto& [name, value] : loaded.values) {
-        restore(name, value);
-      }
+    // Judged also by --check: a device, FIFO, directory or link is never read nor replaced.
+    if (const std::string problem = retain_target_problem(rs.file); !problem.empty()) {
+      diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc, "retain.file: " + problem);
+      return;
+    }
+    // --check and --list-vars: no store is constructed, so nothing can write the file.
+    if (!options_.load_retain) {
+      return;
+    }
+    RetainLoadResult loaded = load_retain_file(rs.file);
+    switch (loaded.status) {
+      case RetainLoadStatus::kLoaded:
+        for (const auto& [name, value] : loaded.values) {
+          restore(name, value);
+        }
+        break;
+      case RetainLoadStatus::kMissing:
+        spdlog::info("retain: {} (first start); retained variables start from their defaults",
+                     loaded.warning);
+        break;
+      case RetainLoadStatus::kNotRegular:  // replaced between the check above and the open
+        diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc, "retain.file: " + loaded.warning);
+        return;
+      case RetainLoadStatus::kCorrupt:
+      case RetainLoadStatus::kUnreadable:
+        // Never overwrite what could not be read: move it aside (evidence, manual recovery) and
+        // raise an alarm at power-on so the operator knows the retained values are defaults.
+        try {
+          const std::string aside = set_aside_retain_file(rs.file);
+          rt_->retain_warning_ = loaded.warning + "; kept as '" + aside +
+                                 "'; retained variables start from their defaults";
+          rt_->startup_alarm_ = AlarmCode::kRetainCorrupt;
+        } catch (const std::exception& e) {
+          diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc,
+                      "retain.file: " + loaded.warning +
+                          "; it cannot be moved aside either, so the runtime will not overwrite "
+                          "it: " +
+                          e.what());
+          return;
+        }
+        break;
     }
     rt_->retain_ = std::make_unique<RetainStore>(rs.file, rs.min_interval, std::move(vars));
   }

@@ -1,6 +1,7 @@
 #include "edm/runtime/task.hpp"
 
 #include "edm/runtime/trace.hpp"
+#include "edm/runtime/variables.hpp"
 
 namespace edm::rt {
 
@@ -46,12 +47,27 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   const TimePoint start = clock.now();
   apply_pending_param_writes();
 
+  machine_->note_release(release);
   const std::uint64_t epoch = machine_->safe_epoch();
   const MachineState state = machine_->state();
   if (epoch != seen_safe_epoch_) {
     seen_safe_epoch_ = epoch;
     if (is_safe_state(state)) {
       on_safe_state(state);
+    }
+  }
+  // Before the programs run and the outputs are latched: a forced velocity or generator pin
+  // never reaches the machine in a safe state, and reset finds nothing forced to bring back.
+  if (forces_ != nullptr && is_safe_state(state)) {
+    if (const std::size_t n = forces_->release_forces(); n > 0) {
+      Alarm a;
+      a.code = AlarmCode::kForcesReleased;
+      a.severity = AlarmSeverity::kWarning;
+      a.time = release;
+      a.source = spec_.name.c_str();
+      a.text = "safe state: every forced pin was released";
+      a.value = static_cast<double>(n);
+      machine_->raise(a);
     }
   }
 
@@ -69,6 +85,8 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
       a.text = f.text;
       a.value = f.code;
       machine_->raise(a);
+    } else if (f.code == 0 && driver_faulted_) {
+      machine_->clear_alarm(AlarmCode::kIoFault, "io");
     }
     driver_faulted_ = f.code != 0;
   }
@@ -88,9 +106,17 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   const TimePoint end = clock.now();
   const Duration exec = end - start;
   stats_.record_cycle(start - release, exec);
-  if (watchdog_.check(exec) == WatchdogVerdict::kTrip) {
+  if (watchdog_.check(exec) != WatchdogVerdict::kTrip) {
+    // Only a cycle in time ends the occurrence; an overload that goes on is one alarm, counted.
+    if (watchdog_tripped_ && watchdog_.consecutive() == 0) {
+      watchdog_tripped_ = false;
+      machine_->clear_alarm(AlarmCode::kWatchdog, spec_.name.c_str());
+      machine_->clear_alarm(AlarmCode::kWatchdogWarning, spec_.name.c_str());
+    }
+  } else {
+    watchdog_tripped_ = true;
     Alarm a;
-    a.time = end;
+    a.time = release;
     a.source = spec_.name.c_str();
     a.value = to_micros(exec);
     if (spec_.watchdog.action == WatchdogAction::kFault) {

@@ -207,6 +207,14 @@ VarStatus VariableRegistry::force(std::string_view name, double value) {
     return {VarResult::kWrongKind,
             "'" + std::string(name) + "' is a parameter: parameters are written, pins forced"};
   }
+  if (machine_ != nullptr) {
+    const MachineState s = machine_->state();
+    if (is_safe_state(s)) {
+      return {VarResult::kInvalidState, "'" + std::string(name) + "': no forcing in " +
+                                            std::string(to_string(s)) +
+                                            " (the safe state wins over forces; reset first)"};
+    }
+  }
   if (!std::isfinite(value)) {
     return {VarResult::kTypeMismatch, "'" + std::string(name) + "': value must be finite"};
   }
@@ -227,7 +235,34 @@ VarStatus VariableRegistry::force(std::string_view name, double value) {
       force_pin<double>(v->pin, value);
       break;
   }
+  // After the pin: a sweep that misses this force sees the flag and sweeps again next cycle.
+  maybe_forced_.store(true, std::memory_order_release);
   return {};
+}
+
+std::size_t VariableRegistry::release_forces() noexcept {
+  if (!maybe_forced_.exchange(false, std::memory_order_acq_rel)) {
+    return 0;
+  }
+  std::size_t released = 0;
+  for (const Variable& v : vars_) {
+    if (!v.is_pin() || !pin_forced(v.pin)) {
+      continue;
+    }
+    switch (v.pin.type) {
+      case PinType::kBool:
+        unforce_pin<bool>(v.pin);
+        break;
+      case PinType::kInt:
+        unforce_pin<std::int64_t>(v.pin);
+        break;
+      case PinType::kReal:
+        unforce_pin<double>(v.pin);
+        break;
+    }
+    ++released;
+  }
+  return released;
 }
 
 VarStatus VariableRegistry::unforce(std::string_view name) {

@@ -128,8 +128,13 @@ TEST(RetainKill9, file_always_loads_whole_and_from_one_iteration) {
     ::close(fds[0]);
     ASSERT_TRUE(alive) << "writer stopped reporting";
     ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "status " << status;
-    if (fs::exists(path + ".tmp." + std::to_string(pid))) {
-      ++kills_leaving_temp;
+    // The temp name is `path.tmp.<pid>.<random>`: look for the killed writer's prefix.
+    const std::string killed_prefix =
+        fs::path(path).filename().string() + ".tmp." + std::to_string(pid) + ".";
+    for (const auto& e : fs::directory_iterator(fs::path(path).parent_path())) {
+      if (e.path().filename().string().starts_with(killed_prefix)) {
+        ++kills_leaving_temp;
+      }
     }
 
     const RetainLoadResult loaded = load_retain_file(path);

@@ -2,6 +2,7 @@
 // values restored on restart, byte-identical traces under the virtual clock, bad arguments.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <filesystem>
@@ -111,13 +112,82 @@ TEST_F(EdmplcProcess, RetainedValueIsRestoredOnRestart) {
     ASSERT_TRUE(r.warning.empty()) << r.warning;
     EXPECT_NEAR(r.values.at("p.integ.out").r, expected, 1e-12);
   }
-  // A corrupt retain file: a clear warning, defaults, and the run still succeeds.
-  std::ofstream(dir_ / "retain.dat") << "edmplc-retain 1\ngarbage\n";
+  // A corrupt retain file is never overwritten with defaults: it is kept aside byte for byte,
+  // and the machine comes up in FAULT with alarm 180 (exit 1) so the loss is acknowledged.
+  const std::string corrupt = "edmplc-retain 1\ngarbage\n";
+  std::ofstream(dir_ / "retain.dat") << corrupt;
   Child c(args({"--clock", "virtual", "--run-for", "250ms"}));
-  EXPECT_EQ(c.wait(), 0) << c.output();
-  EXPECT_NE(c.output().find("starting from defaults"), std::string::npos) << c.output();
+  EXPECT_EQ(c.wait(), 1) << c.output();
+  EXPECT_NE(c.output().find("retain_corrupt"), std::string::npos) << c.output();
+  EXPECT_NE(c.output().find("retain.dat.corrupt"), std::string::npos) << c.output();
+  EXPECT_EQ(slurp(dir_ / "retain.dat.corrupt"), corrupt);
   const rt::RetainLoadResult r = rt::load_retain_file((dir_ / "retain.dat").string());
   EXPECT_NEAR(r.values.at("p.integ.out").r, 0.25, 1e-12);
+}
+
+// DESIGN §11: --check and --list-vars never write the retain file — not with good values, not
+// with a corrupt file (nothing is set aside either), and a later start restores the values.
+TEST_F(EdmplcProcess, CheckAndListVarsNeverWriteTheRetainFile) {
+  const fs::path path = dir_ / "retain.dat";
+  const std::string corrupt = "edmplc-retain 1\np.integ.out LREAL 1\nend 00000000\n";
+  std::ofstream(path, std::ios::binary) << corrupt;
+  for (const char* flag : {"--check", "--list-vars"}) {
+    Child c(args({flag}));
+    EXPECT_EQ(c.wait(), 0) << flag << ": " << c.output();
+    EXPECT_EQ(slurp(path), corrupt) << flag;
+  }
+  rt::write_retain_file_atomic(path.string(), {{"p.integ.out", rt::RetainValue::make_real(42.5)}});
+  const std::string good = slurp(path);
+  for (const char* flag : {"--check", "--list-vars", "--check"}) {
+    Child c(args({flag}));
+    EXPECT_EQ(c.wait(), 0) << flag << ": " << c.output();
+    EXPECT_EQ(slurp(path), good) << flag << " rewrote the retain file";
+  }
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) {
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2U) << "only the config and the retain file: no temp, no .corrupt";
+  Child run(args({"--clock", "virtual", "--run-for", "250ms"}));
+  ASSERT_EQ(run.wait(), 0) << run.output();
+  const rt::RetainLoadResult r = rt::load_retain_file(path.string());
+  ASSERT_EQ(r.status, rt::RetainLoadStatus::kLoaded) << r.warning;
+  EXPECT_NEAR(r.values.at("p.integ.out").r, 42.75, 1e-9) << "restored 42.5, then 250 ms of 1.0";
+}
+
+// A retain.file that is a FIFO, a directory, a device or a link is refused at load time, with
+// the file:line:col of `retain.file` (and --check does not hang on the FIFO).
+TEST_F(EdmplcProcess, RetainFileThatIsNotARegularFileIsRefusedWithItsLocation) {
+  const fs::path fifo = dir_ / "retain.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path target = dir_ / "target.dat";
+  rt::write_retain_file_atomic(target.string(), {{"p.integ.out", rt::RetainValue::make_real(1)}});
+  const std::string target_bytes = slurp(target);
+  const fs::path link = dir_ / "retain.link";
+  fs::create_symlink(target, link);
+  for (const fs::path& bad : {fifo, dir_, fs::path("/dev/null"), link}) {
+    SCOPED_TRACE(bad);
+    const fs::path cfg = dir_ / "bad.yaml";
+    std::ofstream(cfg) << "version: 1\nmachine: {name: m, io: {driver: loopback}}\n"
+                          "tasks:\n  - {name: t, interval: 1ms, programs: [p]}\n"
+                          "programs:\n  - name: p\n    blocks:\n"
+                          "      - {name: integ, type: Integrator}\n"
+                          "retain:\n  file: "
+                       << bad.string() << "\n  variables: [p.integ.out]\n";
+    for (const char* mode : {"--check", "--run-for"}) {
+      std::vector<std::string> a = {EDM_EDMPLC_PATH, "--config", cfg.string(), mode};
+      if (std::string(mode) == "--run-for") {
+        a.insert(a.end(), {"10ms", "--clock", "virtual"});
+      }
+      Child c(a);
+      EXPECT_EQ(c.wait(), 2) << c.output();
+      EXPECT_NE(c.output().find("bad.yaml:10:9: retain.file:"), std::string::npos) << c.output();
+    }
+  }
+  EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(slurp(target), target_bytes);
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
 }
 
 TEST_F(EdmplcProcess, RetainedValueOfTheWrongTypeOrNonFiniteIsNotRestored) {

@@ -10,8 +10,15 @@
 // Entering FAULT or ESTOP bumps safe_epoch(); every task sees the new epoch at the start of its
 // next cycle and calls the safe-state hooks of its programs and (for the I/O task) the driver.
 //
+// Alarms are latched (DESIGN §11: raised once per occurrence, then counted): the first raise()
+// of a (code, source) pair is queued for the log and the bridge; raising it again while it is
+// latched only counts (ActiveAlarm::count, repeated_alarms()). The latch opens when the raiser
+// says the condition is gone (clear_alarm) or at reset, whichever comes first; the next raise
+// after that is a new occurrence. A raiser that never calls clear_alarm gets one alarm per reset.
+//
 // Thread-safety: every member is lock-free and may be called from any thread, RT included.
 
+#include <array>
 #include <atomic>
 #include <boost/lockfree/queue.hpp>
 #include <cstdint>
@@ -54,6 +61,8 @@ enum class AlarmCode : std::uint16_t {
   kShortCircuit = 150,     // reserved: sustained short circuit after N retracts
   kElectrodeUsedUp = 160,  // reserved: electrode length exhausted
   kWireBreak = 170,        // reserved: wire EDM wire break
+  kRetainCorrupt = 180,    // the retain file could not be read: set aside, defaults in use
+  kForcesReleased = 181,   // a safe state released forced pins (value: how many)
 };
 
 std::string_view to_string(AlarmCode c) noexcept;
@@ -68,6 +77,14 @@ struct Alarm {
   const char* source{""};  // e.g. task or "program.block" name
   const char* text{""};    // static text
   double value{0.0};       // the measured quantity that tripped it (e.g. exec time in µs)
+};
+
+/// A latched alarm: the first occurrence's record and how many times it was raised since.
+struct ActiveAlarm {
+  AlarmCode code{AlarmCode::kNone};
+  const char* source{""};
+  TimePoint first{};       // release time of the cycle that first raised it
+  std::uint64_t count{0};  // raises while latched, the first included
 };
 
 /// What a safe-state hook is told.
@@ -90,6 +107,8 @@ enum class CommandResult : std::uint8_t { kOk, kInvalidState };
 class Machine {
  public:
   static constexpr std::size_t kAlarmCapacity = 256;
+  /// Distinct alarms latched at once; beyond that a raise is queued unlatched (never lost).
+  static constexpr std::size_t kLatchCapacity = 64;
 
   Machine() = default;
   Machine(const Machine&) = delete;
@@ -99,10 +118,30 @@ class Machine {
     return state_.load(std::memory_order_acquire);
   }
   /// Applies an operator command if the current state allows it. Lock-free, any thread.
+  /// `now` stamps the E-stop alarm; the default (zero) means "the latest cycle's release time"
+  /// (callers off the RT threads, e.g. the bridge, have no cycle time of their own). Reset
+  /// opens every alarm latch.
   CommandResult command(MachineCommand c, TimePoint now = {}) noexcept;
-  /// Raises an alarm. A fault-severity alarm moves the machine to FAULT (unless in ESTOP or OFF).
-  /// RT-safe. If the alarm queue is full the alarm is counted in dropped_alarms().
-  void raise(const Alarm& a) noexcept;
+  /// Raises an alarm. A fault-severity alarm moves the machine to FAULT (unless in ESTOP or OFF),
+  /// also when it is a repeat. Returns true for a new occurrence (queued; counted in
+  /// dropped_alarms() if the queue is full), false for a repeat of a latched one (only
+  /// counted). A zero a.time is stamped with the latest cycle's release time. RT-safe.
+  bool raise(const Alarm& a) noexcept;
+  /// The raiser's condition is gone: the next raise of (code, source) is a new occurrence.
+  /// Sources compare by text. RT-safe; a no-op when nothing is latched.
+  void clear_alarm(AlarmCode code, const char* source) noexcept;
+  /// Copies the latched alarms into `out` (at most out.size()); returns how many. Non-RT
+  /// readers (status, tests); a snapshot, racing benignly with raisers.
+  std::size_t active_alarms(ActiveAlarm* out, std::size_t capacity) const noexcept;
+  /// Raises that were repeats of a latched alarm (not queued), since start.
+  [[nodiscard]] std::uint64_t repeated_alarms() const noexcept {
+    return repeated_alarms_.load(std::memory_order_relaxed);
+  }
+  /// Tasks publish each cycle's release time (the last writer wins). RT-safe.
+  void note_release(TimePoint release) noexcept;
+  [[nodiscard]] TimePoint last_release() const noexcept {
+    return TimePoint{last_release_ns_.load(std::memory_order_relaxed)};
+  }
 
   /// Increments on every entry into FAULT or ESTOP.
   [[nodiscard]] std::uint64_t safe_epoch() const noexcept {
@@ -120,12 +159,26 @@ class Machine {
 
  private:
   bool transition(MachineState from, MachineState to, AlarmCode cause) noexcept;
+  void enter_fault(AlarmCode cause) noexcept;
+  void clear_all_latches() noexcept;
+
+  // state: 0 free, 1 being filled, 2 latched. code/source/first are written only in state 1.
+  struct Latch {
+    std::atomic<std::uint32_t> state{0};
+    std::atomic<AlarmCode> code{AlarmCode::kNone};
+    std::atomic<const char*> source{""};
+    std::atomic<Duration::rep> first_ns{0};
+    std::atomic<std::uint64_t> count{0};
+  };
 
   std::atomic<MachineState> state_{MachineState::kOff};
   std::atomic<std::uint64_t> safe_epoch_{0};
   std::atomic<AlarmCode> last_cause_{AlarmCode::kNone};
   boost::lockfree::queue<Alarm, boost::lockfree::capacity<kAlarmCapacity>> alarms_;
   std::atomic<std::uint64_t> dropped_alarms_{0};
+  std::array<Latch, kLatchCapacity> latches_{};
+  std::atomic<std::uint64_t> repeated_alarms_{0};
+  std::atomic<Duration::rep> last_release_ns_{0};
 };
 
 }  // namespace edm::rt

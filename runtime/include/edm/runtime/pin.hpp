@@ -10,8 +10,10 @@
 //  - forced Output: every set() by the owning block stores the forced value instead, so every
 //    reader (wires, trace, bridge, I/O) sees the forced value from the next cycle on;
 //  - forced Input: get() returns the forced value; the wire is not read.
-// unforce() returns the pin to its computed value: at the next set() for outputs, at once for
-// inputs.
+// unforce() returns the pin to its computed value at once: an output goes back to the value of
+// the block's last set() (kept aside while forced), an input reads its wire again.
+// The runtime releases every force when the machine enters FAULT or ESTOP (the safe state
+// wins over forces; docs/runtime.md "Forcing").
 //
 // RT-safe: get(), set(). Non-RT: connect(), set_constant(). force()/unforce() may be called from
 // any thread. Pins are neither copyable nor movable (wires point at them).
@@ -50,12 +52,13 @@ concept PinValue = requires {
 template <PinValue T>
 class Output {
  public:
-  explicit Output(T initial = T{}) noexcept : value_(initial) {}
+  explicit Output(T initial = T{}) noexcept : value_(initial), computed_(initial) {}
   Output(const Output&) = delete;
   Output& operator=(const Output&) = delete;
 
   /// Writes the block's result (or the forced value while forced). RT-safe.
   void set(T v) noexcept {
+    computed_.store(v, std::memory_order_relaxed);
     value_.store(
         forced_.load(std::memory_order_acquire) ? force_value_.load(std::memory_order_relaxed) : v,
         std::memory_order_relaxed);
@@ -68,13 +71,19 @@ class Output {
     forced_.store(true, std::memory_order_release);
     value_.store(v, std::memory_order_relaxed);
   }
-  void unforce() noexcept { forced_.store(false, std::memory_order_release); }
+  /// Back to the computed value now, not at the owner's next set(): a released force must not
+  /// linger on a wire whose block stopped setting it.
+  void unforce() noexcept {
+    forced_.store(false, std::memory_order_release);
+    value_.store(computed_.load(std::memory_order_relaxed), std::memory_order_relaxed);
+  }
   [[nodiscard]] bool forced() const noexcept { return forced_.load(std::memory_order_acquire); }
 
   [[nodiscard]] const std::atomic<T>& cell() const noexcept { return value_; }
 
  private:
   std::atomic<T> value_;
+  std::atomic<T> computed_;  // the block's last set(), restored by unforce()
   std::atomic<T> force_value_{};
   std::atomic<bool> forced_{false};
 };

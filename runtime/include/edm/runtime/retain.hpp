@@ -15,8 +15,11 @@
 //
 // RT-safety: nothing here is RT-safe (everything allocates and does file I/O). The RT side only
 // owns the atomics that RetainStore::Variable::read() loads.
-// Thread-safety: the free functions are reentrant (one writer per path at a time: the temp name
-// is derived from the pid). RetainStore: see the class comment.
+// Thread-safety: the free functions are reentrant (concurrent writers of one path each use their
+// own unpredictable temp name; the last rename wins). RetainStore: see the class comment.
+//
+// Only a running runtime writes the retain file: `edmplc --check` and `--list-vars` build the
+// runtime with BuildOptions::load_retain = false, which constructs no RetainStore at all.
 
 #include <atomic>
 #include <condition_variable>
@@ -63,9 +66,24 @@ struct RetainValue {
 /// Name → value, sorted so the file is byte-for-byte deterministic.
 using RetainMap = std::map<std::string, RetainValue>;
 
+/// Largest retain file read or parsed (a real set is a few KB); anything bigger is refused
+/// unread, so a wrong path (a disk image, /dev/zero) cannot exhaust memory.
+inline constexpr std::size_t kMaxRetainFileBytes = std::size_t{4} << 20;
+
+/// How a load ended. kMissing is a first start; kCorrupt and kUnreadable mean the file holds
+/// something that must not be silently replaced by defaults (the runtime sets it aside).
+enum class RetainLoadStatus : std::uint8_t {
+  kLoaded,      // every value read, checksum good
+  kMissing,     // no such file (first start)
+  kCorrupt,     // read, but truncated, garbled, too large or of another version
+  kUnreadable,  // exists but cannot be opened/read (permissions, I/O error)
+  kNotRegular,  // a directory, FIFO, device, socket or symbolic link: never read nor replaced
+};
+
 struct RetainLoadResult {
   RetainMap values;
   std::string warning;  // empty when the file was read completely; else says path and problem
+  RetainLoadStatus status{RetainLoadStatus::kLoaded};
 };
 
 /// A name is valid when non-empty and made only of printable ASCII other than space.
@@ -78,23 +96,39 @@ struct RetainLoadResult {
 /// The exact bytes of the file for `values`. Throws std::invalid_argument on an invalid name.
 [[nodiscard]] std::string format_retain_file(const RetainMap& values);
 
-/// Parses file bytes. Never throws; on any problem returns an empty map and a warning such as
+/// Parses file bytes: the pure retain reader (no I/O; the fuzz target calls it with any bytes).
+/// Never throws, never reads beyond `text`; text over kMaxRetainFileBytes is refused unparsed.
+/// On any problem returns an empty map, status kCorrupt and a warning such as
 /// "checksum mismatch (...)" or "line 3: bad LINT value 'x'" (no path; see load_retain_file).
 [[nodiscard]] RetainLoadResult parse_retain_file(std::string_view text) noexcept;
 
-/// Loads `path`. Never throws: a missing, unreadable or corrupt file gives an empty map and a
-/// warning "retain file '<path>': <problem>; using defaults" — the caller logs it and keeps its
-/// defaults. Nothing is half-applied: either every value or none.
+/// Loads `path`. Never throws, never blocks on a FIFO, never follows a symbolic link and reads at
+/// most kMaxRetainFileBytes + 1 bytes. A missing, unreadable, irregular or corrupt file gives an
+/// empty map, its status and a warning "retain file '<path>': <problem>" — the caller decides
+/// (the runtime: see docs/runtime.md, "Retained variables"). Nothing is half-applied.
 [[nodiscard]] RetainLoadResult load_retain_file(const std::string& path) noexcept;
 
-/// Writes `values` to `path` atomically: `path.tmp.<pid>` in the same directory, write, fsync,
-/// rename over `path`, fsync the directory. After a crash at any point `path` holds either the
+/// Why `path` must not be used as a retain file, or "" if it may: it is a regular file or does
+/// not exist yet. Symbolic links, directories, FIFOs, devices and sockets are refused (lstat, so
+/// the link itself is judged). Never throws.
+[[nodiscard]] std::string retain_target_problem(const std::string& path) noexcept;
+
+/// Writes `values` to `path` atomically: a temp file `path.tmp.<pid>.<16 random hex>` created in
+/// the same directory with O_CREAT|O_EXCL|O_NOFOLLOW (never an existing file or link), mode
+/// 0600; write, fsync, rename over `path`, fsync the directory. Refuses (before renaming) when
+/// `path` exists and is not a regular file. After a crash at any point `path` holds either the
 /// previous or the new complete file. Throws std::system_error (what() names the path and the
 /// step) on failure, after removing the temp file; std::invalid_argument on an invalid name.
 void write_retain_file_atomic(const std::string& path, const RetainMap& values);
 
-/// Removes `path.tmp.<pid>` files left by a writer killed mid-write (any pid but ours). Returns
-/// how many were removed. Never throws; errors are ignored (a leftover temp file is harmless).
+/// Moves a corrupt or unreadable retain file out of the way, to `path.corrupt` (or
+/// `path.corrupt.1` … `.corrupt.99` when taken), so the runtime may write a new one without
+/// destroying the evidence. Returns the new name. Throws std::system_error when it cannot.
+std::string set_aside_retain_file(const std::string& path);
+
+/// Removes `path.tmp.<pid>[.<hex>]` files left by a writer killed mid-write (any pid but ours).
+/// Returns how many were removed. Never throws; errors are ignored (a leftover temp file is
+/// harmless).
 std::size_t remove_stale_retain_temps(const std::string& path) noexcept;
 
 /// Owns the retain file of one runtime and the non-RT thread that keeps it up to date.

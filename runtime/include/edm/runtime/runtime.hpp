@@ -31,7 +31,9 @@ namespace edm::rt {
 
 struct BuildOptions {
   std::optional<std::uint64_t> seed;  // overrides the driver's seed (--seed)
-  bool load_retain{true};             // read the retain file (and start the store) at build
+  /// Read the retain file at build and keep the store that writes it. false (--check,
+  /// --list-vars, offline tools): no store is constructed, so nothing can write the file.
+  bool load_retain{true};
 };
 
 struct RunOptions {
@@ -73,6 +75,7 @@ class Runtime {
   [[nodiscard]] Program* program(std::string_view name) const;
   [[nodiscard]] TraceRecorder& trace() noexcept { return trace_; }
   [[nodiscard]] RetainStore* retain() noexcept { return retain_.get(); }
+  /// Why the retained values are defaults (a corrupt file was set aside), or "".
   [[nodiscard]] const std::string& retain_warning() const noexcept { return retain_warning_; }
   [[nodiscard]] std::vector<TaskStatsReport> stats_reports() const;
   [[nodiscard]] const Config& config() const noexcept { return config_; }
@@ -105,6 +108,8 @@ class Runtime {
   bool has_trace_{false};
   std::unique_ptr<RetainStore> retain_;
   std::string retain_warning_;
+  AlarmCode startup_alarm_{AlarmCode::kNone};  // raised at power-on in run() (retain lost)
+  bool ran_{false};  // only a runtime that ran flushes the retain file when destroyed
   std::vector<std::function<void(const Alarm&)>> alarm_listeners_;
 };
 

@@ -2,6 +2,7 @@
 // A task: an IEC 61131-3 cyclic task — interval, priority, watchdog, overrun policy and an
 // ordered list of programs. run_cycle() is one scan:
 //   apply queued parameter writes → safe-state hooks if the machine just entered FAULT/ESTOP →
+//   release every force while in FAULT/ESTOP (the safe state wins at the output latch) →
 //   latch inputs (I/O task only) → programs in order → publish outputs (I/O task only) →
 //   trace sample → statistics → watchdog.
 // The schedulers (scheduler.hpp) decide when run_cycle() is called.
@@ -28,6 +29,7 @@
 namespace edm::rt {
 
 class TraceRecorder;
+class VariableRegistry;
 
 /// A runtime parameter write, validated on the non-RT side, applied at the next cycle start.
 struct ParamWrite {
@@ -56,6 +58,8 @@ class Task {
   void add_observer(CycleObserver& o) { observers_.push_back(&o); }
   /// Stops sampling the trace (no --trace-out: nothing would drain the ring). Non-RT, before run.
   void detach_trace() noexcept { trace_ = nullptr; }
+  /// The registry whose forces this task releases in FAULT/ESTOP. Non-RT, before run.
+  void attach_forces(VariableRegistry& r) noexcept { forces_ = &r; }
 
   /// One scan for the cycle scheduled at `release`. Returns the time the cycle ended. RT-safe.
   TimePoint run_cycle(TimePoint release, const Clock& clock) noexcept;
@@ -92,6 +96,7 @@ class Task {
   IoDriver* driver_{nullptr};
   TraceRecorder* trace_{nullptr};
   std::uint32_t trace_channel_{0};
+  VariableRegistry* forces_{nullptr};
   std::vector<CycleObserver*> observers_;
   TaskStats stats_;
   Watchdog watchdog_;
@@ -99,6 +104,7 @@ class Task {
   std::atomic<std::uint64_t> watchdog_warnings_{0};
   std::uint64_t seen_safe_epoch_{0};
   bool driver_faulted_{false};
+  bool watchdog_tripped_{false};
   double dt_s_;
 
   std::mutex producer_mutex_;  // serialises non-RT producers; the RT consumer never takes it

@@ -5,11 +5,18 @@
 //
 // Reads of pins are lock-free atomic loads. Parameter reads and writes go through the block's
 // shadow parameter copy under a mutex (non-RT threads only); an accepted write is queued to the
-// owning task and applied at the start of its next cycle. The RT threads never touch this
-// registry. Forcing semantics: see pin.hpp.
+// owning task and applied at the start of its next cycle. The RT threads touch this registry
+// only through release_forces() (lock-free, no allocation). Forcing semantics: see pin.hpp.
 //
-// Thread-safety: all members are thread-safe for non-RT callers once the runtime is built.
+// The safe state wins over forces: in FAULT and ESTOP force() is refused, and the tasks
+// call release_forces() at the start of every cycle in those states, so a force that raced in
+// is gone before the outputs are latched. Forces are released, not masked: reset never brings a
+// forced motion back; the operator must force again, deliberately (docs/runtime.md "Forcing").
+//
+// Thread-safety: all members are thread-safe for non-RT callers once the runtime is built;
+// release_forces() also from the RT threads.
 
+#include <atomic>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -24,6 +31,7 @@
 namespace edm::rt {
 
 class Task;
+class Machine;
 
 enum class VarKind : std::uint8_t { kInput, kOutput, kParam };
 std::string_view to_string(VarKind k) noexcept;
@@ -50,6 +58,7 @@ enum class VarResult : std::uint8_t {
   kTypeMismatch,  // value does not fit the variable's type
   kInvalid,       // the block's validate() refused it (message says why)
   kBusy,          // the task's write queue is full
+  kInvalidState,  // refused in this machine state (forcing in FAULT or ESTOP)
 };
 
 struct VarStatus {
@@ -81,6 +90,12 @@ class VariableRegistry {
   VarStatus unforce(std::string_view name);
   [[nodiscard]] std::vector<std::string> forced() const;
 
+  /// The machine whose state gates force(). Non-RT, build time; nullptr: never refused.
+  void set_machine(const Machine* m) noexcept { machine_ = m; }
+  /// Unforces every forced pin; returns how many were forced. Cheap when none is (one atomic
+  /// exchange). RT-safe: no allocation, no lock; any thread.
+  std::size_t release_forces() noexcept;
+
  private:
   /// The parameter called name, or nullptr with status saying why not.
   const Variable* find_param(std::string_view name, VarStatus& status) const;
@@ -88,6 +103,8 @@ class VariableRegistry {
   std::vector<Variable> vars_;
   std::unordered_map<std::string, std::size_t> index_;
   mutable std::mutex param_mutex_;  // non-RT only: guards the blocks' shadow parameters
+  const Machine* machine_{nullptr};
+  std::atomic<bool> maybe_forced_{false};  // set after every force(); cleared by a full sweep
 };
 
 }  // namespace edm::rt
