@@ -1,0 +1,106 @@
+// Starts what the browser tests need: edmplc (drill-sim.yaml with an operator and a viewer token,
+// virtual clock paced to 10x, free ports), `edmhmi serve`, and Debian's Chromium through
+// playwright-core (no browser download). Every wait is on a condition with a timeout.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, writeFileSync, chmodSync, mkdirSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import net from 'node:net';
+import { randomBytes } from 'node:crypto';
+import { createRequire } from 'node:module';
+
+export const ROOT = resolve(dirname(fileURLToPath(import.meta.url)), '../..');
+export const BUILD = process.env.EDM_BUILD_DIR || join(ROOT, 'build');
+export const OUT = process.env.EDM_WEB_ARTIFACTS || join(ROOT, 'out/web');
+// playwright-core is a dev dependency of web/ (pinned in web/package.json, installed by npm ci).
+const { chromium } = createRequire(join(ROOT, 'web/package.json'))('playwright-core');
+export const CHROMIUM = process.env.EDM_CHROMIUM || '/usr/bin/chromium';
+
+export function freePort() {
+  return new Promise((res, rej) => {
+    const s = net.createServer();
+    s.on('error', rej);
+    s.listen(0, '127.0.0.1', () => { const { port } = s.address(); s.close(() => res(port)); });
+  });
+}
+
+/** Resolves with the first match of `re` in the child's output, rejects on exit or timeout. */
+function waitForOutput(child, re, what, timeoutMs = 20000) {
+  return new Promise((res, rej) => {
+    let seen = '';
+    const timer = setTimeout(() => rej(new Error(`${what}: no '${re}' within ${timeoutMs} ms:\n${seen}`)), timeoutMs);
+    const on = (d) => {
+      seen += d.toString();
+      const m = re.exec(seen);
+      if (m) { clearTimeout(timer); res(m); }
+    };
+    child.stdout.on('data', on);
+    child.stderr.on('data', on);
+    child.on('exit', (code) => { clearTimeout(timer); rej(new Error(`${what} exited (${code}):\n${seen}`)); });
+  });
+}
+
+export async function startStack({ speed = '10' } = {}) {
+  const dir = mkdtempSync(join(tmpdir(), 'edm-web-'));
+  const op = join(dir, 'operator.token');
+  const vw = join(dir, 'viewer.token');
+  const tokens = { operator: randomBytes(16).toString('hex'), viewer: randomBytes(16).toString('hex') };
+  writeFileSync(op, `${tokens.operator}\n`); chmodSync(op, 0o600);
+  writeFileSync(vw, `${tokens.viewer}\n`); chmodSync(vw, 0o600);
+  const base = readFileSync(join(ROOT, 'config/machines/drill-sim.yaml'), 'utf8');
+  const config = join(dir, 'drill-sim-tokens.yaml');
+  const withTokens = base.replace(/^bridge:.*$/m,
+    `bridge:\n  token_file: ${op}\n  viewer_token_file: ${vw}`);
+  if (withTokens === base) throw new Error('drill-sim.yaml has no bridge: section');
+  writeFileSync(config, withTokens);
+  const bridgePort = await freePort();
+  const procs = [];
+  const plc = spawn(join(BUILD, 'bin/edmplc'), ['--config', config, '--clock', 'virtual',
+    '--speed', speed, '--bridge-port', String(bridgePort)], { stdio: ['ignore', 'pipe', 'pipe'] });
+  procs.push(plc);
+  const stack = { dir, tokens, procs, plc, bridgePort };
+  try {
+    await waitForOutput(plc, /bridge: listening on/, 'edmplc');
+    const serve = spawn(join(BUILD, 'bin/edmhmi'), ['--port', String(bridgePort), '--token-file', op,
+      'serve', '--listen', '127.0.0.1:0', '--web-root', join(BUILD, 'web')],
+    { stdio: ['ignore', 'pipe', 'pipe'] });
+    procs.push(serve);
+    stack.serve = serve;
+    const m = await waitForOutput(serve, /listening on (http:\/\/[0-9.:]+\/)/, 'edmhmi serve');
+    stack.url = m[1];
+  } catch (e) {
+    stopStack(stack);
+    throw e;
+  }
+  return stack;
+}
+
+export function stopStack(stack) {
+  for (const p of [...stack.procs].reverse()) {
+    if (p.exitCode === null && p.signalCode === null) p.kill('SIGINT');
+  }
+}
+
+// playwright's launch() gives Chromium a new empty profile directory of its own every time (it
+// refuses a --user-data-dir argument), which is the fresh --user-data-dir the flags below expect.
+export async function launchBrowser() {
+  return chromium.launch({
+    executablePath: CHROMIUM,
+    headless: true,
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+}
+
+export function artifacts() {
+  mkdirSync(OUT, { recursive: true });
+  return OUT;
+}
+
+export async function login(page, url, token) {
+  await page.goto(url);
+  await page.locator('#token').fill(token);
+  await page.locator('#login-btn').click();
+  await page.locator('#app').waitFor({ state: 'visible', timeout: 10000 });
+}
