@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -193,6 +194,20 @@ int main(int argc, char** argv) {
   }
 
   if (opt.check) {
+    // What the bridge would refuse at start (token files, bind policy, TLS files), --check
+    // refuses too, at the bridge section.
+    const auto& bs = rt->config().bridge;
+    if (opt.bridge_port.value_or(bs.loc.line != 0 ? bs.port : 0) != 0) {
+      try {
+        edm::bridge::validate_options(edm::bridge::options_from_config(bs));
+      } catch (const edm::bridge::BridgeError& e) {
+        edm::rt::shutdown_logging();
+        std::cerr << (bs.loc.file.empty() ? opt.config : bs.loc.file) << ":"
+                  << std::max(bs.loc.line, 1) << ":" << std::max(bs.loc.col, 1) << ": "
+                  << e.what() << "\n";
+        return kExitBadInput;
+      }
+    }
     std::size_t n_blocks = 0;
     for (const auto& t : rt->tasks()) {
       for (const auto* p : t->programs()) {

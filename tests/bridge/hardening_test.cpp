@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -275,6 +277,45 @@ TEST_F(Hardening, trace_start_traces_a_repeated_name_once) {
   const Reply r = c.trace_start(vars);
   ASSERT_TRUE(r) << r.message;
   EXPECT_EQ(r.body["vars"], Json::array({"io.ai0", "chain.g.out"}));
+}
+
+// ---- 6. out of descriptors: accept backs off instead of spinning ------------------------------
+
+TEST_F(Hardening, running_out_of_descriptors_backs_off_and_recovers) {
+  start();
+  // Connections come from another process, so only the server's accept() runs out.
+  FILE* clients =
+      ::popen(("python3 -c \"import socket,sys; sys.stdin.readline(); "
+               "s=[socket.create_connection(('127.0.0.1'," +
+               std::to_string(server_->port()) + ")) for _ in range(20)]; sys.stdin.read()\"")
+                  .c_str(),
+              "w");
+  ASSERT_NE(clients, nullptr);
+  rlimit old{};
+  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &old), 0);
+  // New descriptors take the lowest free number, and the limit caps numbers: capping at the
+  // lowest free one leaves none.
+  const int lowest_free = ::dup(0);
+  ASSERT_GE(lowest_free, 0);
+  ::close(lowest_free);
+  rlimit low = old;
+  low.rlim_cur = static_cast<rlim_t>(lowest_free);
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &low), 0);
+  std::fputs("go\n", clients);
+  std::fflush(clients);
+  const auto first_error_by = std::chrono::steady_clock::now();
+  const bool errors = eventually([&] { return server_->stats().accept_errors >= 6; });
+  const auto sixth = std::chrono::steady_clock::now();
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &old), 0);
+  ASSERT_TRUE(errors) << "accept never failed (" << server_->stats().accept_errors << ")";
+  // Backing off from 10 ms, doubling: six failures take at least 10+20+40+80+160 ms.
+  EXPECT_GE(sixth - first_error_by, 310ms - 20ms);
+  // With descriptors again, the waiting connections are accepted and new clients served.
+  Client c;
+  ASSERT_EQ(c.connect(client_opts()), Role::kOperator);
+  EXPECT_TRUE(c.request("ping"));
+  std::fputs("done\n", clients);
+  ::pclose(clients);
 }
 
 // ---- 7. unauthenticated connections: a deadline and a cap of their own -------------------

@@ -1,6 +1,10 @@
 // TLS transport of a bridge session (Boost.Asio SSL over OpenSSL), and the server's context.
+#include <unistd.h>
+
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/write.hpp>
+#include <cerrno>
+#include <cstring>
 
 #include "edm/bridge/auth.hpp"
 #include "edm/bridge/transport.hpp"
@@ -92,6 +96,12 @@ std::unique_ptr<Transport> make_tls_transport(tcp::socket socket, ssl::context& 
 
 std::shared_ptr<ssl::context> make_tls_server_context(const std::string& cert_file,
                                                       const std::string& key_file) {
+  for (const auto& [file, key] : {std::pair{&cert_file, "cert"}, std::pair{&key_file, "key"}}) {
+    if (::access(file->c_str(), R_OK) != 0) {
+      throw BridgeError(std::string("bridge.tls.") + key + " " + *file + ": " +
+                        std::strerror(errno));
+    }
+  }
   auto ctx = std::make_shared<ssl::context>(ssl::context::tls_server);
   ctx->set_options(ssl::context::default_workarounds | ssl::context::no_sslv2 |
                    ssl::context::no_sslv3 | ssl::context::no_tlsv1 | ssl::context::no_tlsv1_1 |
