@@ -406,6 +406,12 @@ Body op_tasks_stats(Session& s) {
   Json doc = Json::parse(rt::stats_to_json(srv.rt.stats_reports()));
   const ServerStats st = srv.stats_snapshot();
   doc["bridge"] = {{"sessions_open", st.sessions_open},
+                   {"sessions_pending", st.sessions_pending},
+                   {"pending_evicted", st.pending_evicted},
+                   {"hello_timeouts", st.hello_timeouts},
+                   {"hello_failures", st.hello_failures},
+                   {"accept_errors", st.accept_errors},
+                   {"queue_bytes_peak", st.queue_bytes_peak},
                    {"sessions_accepted", st.sessions_accepted},
                    {"sessions_refused", st.sessions_refused},
                    {"requests", st.requests},
