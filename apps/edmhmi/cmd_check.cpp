@@ -3,6 +3,7 @@
 
 #include "cli.hpp"
 #include "edm/hmi/gcode.hpp"
+#include "edm/machining/bounded_read.hpp"
 #include "edm/machining/machine_config.hpp"
 
 namespace edmhmi {
@@ -31,9 +32,14 @@ int cmd_check(const Args& args) {
     for (const std::string& m : e.messages()) std::fprintf(stderr, "%s\n", m.c_str());
     return kExitBadInput;
   }
-  std::string text;
-  if (!read_text_file(part, text)) return kExitBadInput;
-  const edm::hmi::GcodeResult r = edm::hmi::interpret_gcode(text, part, tables);
+  // Bounded, regular files only: /dev/zero, a FIFO or a directory is a located error, exit 2.
+  const edm::machining::BoundedRead file =
+      edm::machining::read_bounded_file(part, edm::machining::kMaxPartProgramBytes, "part program");
+  if (!file.ok()) {
+    std::fprintf(stderr, "%s\n", file.error.c_str());
+    return kExitBadInput;
+  }
+  const edm::hmi::GcodeResult r = edm::hmi::interpret_gcode(file.text, part, tables);
   if (!r.ok()) {
     for (const std::string& m : r.messages()) std::fprintf(stderr, "%s\n", m.c_str());
     return kExitBadInput;

@@ -1,7 +1,8 @@
 #include "edm/hmi/connection.hpp"
 
 #include <charconv>
-#include <fstream>
+
+#include "edm/machining/bounded_read.hpp"
 
 namespace edm::hmi {
 
@@ -33,10 +34,11 @@ std::uint16_t parse_port(std::string_view text, std::string_view what) {
 }
 
 std::string read_token_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw SettingsError("token file '" + path + "': cannot be read");
-  std::string line;
-  std::getline(in, line);
+  // Bounded and regular files only: a FIFO or /dev/zero as --token-file cannot hang or fill us.
+  const edm::machining::BoundedRead file =
+      edm::machining::read_bounded_file(path, edm::machining::kMaxTokenFileBytes, "token file");
+  if (!file.ok()) throw SettingsError("token file '" + path + "': cannot be read: " + file.problem);
+  std::string line = file.text.substr(0, file.text.find('\n'));
   line = trim(line);
   if (line.empty()) throw SettingsError("token file '" + path + "': empty first line");
   return line;

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <utility>
 
+#include "edm/machining/bounded_read.hpp"
 #include "edm/machining/diagnostics.hpp"
 #include "edm/machining/located_yaml.hpp"
 #include "edm/machining/machine_sections.hpp"
@@ -71,15 +72,9 @@ MachineTables parse_machine_tables(std::string_view yaml_text, const std::string
 }
 
 MachineTables read_machine_tables(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int err = errno;
-    throw MachineConfigError(
-        {path + ": cannot open: " + std::string(err != 0 ? std::strerror(err) : "error")});
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_machine_tables(ss.str(), path);
+  const BoundedRead file = read_bounded_file(path, kMaxConfigBytes, "config");
+  if (!file.ok()) throw MachineConfigError({file.error});
+  return parse_machine_tables(file.text, path);
 }
 
 }  // namespace edm::machining

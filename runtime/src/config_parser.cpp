@@ -13,6 +13,7 @@
 #include <unordered_set>
 
 #include "config_parser_impl.hpp"
+#include "edm/machining/bounded_read.hpp"
 #include "edm/machining/machine_sections.hpp"
 
 namespace edm::rt {
@@ -189,11 +190,16 @@ std::optional<YAML::Mark> second_document_mark(const std::string& text) {
 // Past this, more messages only bury the first ones, which are usually the cause.
 constexpr std::size_t kMaxDiagnostics = 100;
 // A config is a few KiB; anything this large is the wrong file.
-constexpr std::size_t kMaxFileBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxConfigFileBytes = machining::kMaxConfigBytes;
 
 }  // namespace
 
 Config parse_config_text(const std::string& text, const std::string& path) {
+  if (text.size() > kMaxConfigFileBytes) {  // the same bound for text that came another way
+    throw ConfigError({{{path, 1, 1},
+                        "config is " + std::to_string(text.size()) + " bytes; the limit is " +
+                            std::to_string(kMaxConfigFileBytes >> 20) + " MiB"}});
+  }
   DiagnosticSink sink;
   Config cfg;
   cfg.path = path;
@@ -234,30 +240,12 @@ Config parse_config_text(const std::string& text, const std::string& path) {
 }
 
 Config parse_config_file(const std::string& path) {
-  const auto fail = [&](const std::string& what, int err) {
-    throw ConfigError({{{path, 0, 0}, what + ": " + std::generic_category().message(err)}});
-  };
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                       &std::fclose);
-  if (!file) {
-    fail("cannot open", errno);
+  // Bounded and type-checked before reading: a FIFO, a device or a huge file is refused at 1:1.
+  machining::BoundedRead file = machining::read_bounded_file(path, kMaxConfigFileBytes, "config");
+  if (!file.ok()) {
+    throw ConfigError({{{path, 1, 1}, file.problem}});
   }
-  std::string text;
-  char buf[65536];
-  while (true) {
-    const std::size_t n = std::fread(buf, 1, sizeof buf, file.get());
-    text.append(buf, n);
-    if (text.size() > kMaxFileBytes) {
-      throw ConfigError({{{path, 0, 0}, "file is larger than 16 MiB; is this a config?"}});
-    }
-    if (n < sizeof buf) {
-      if (std::ferror(file.get()) != 0) {
-        fail("cannot read", errno);
-      }
-      break;
-    }
-  }
-  return parse_config_text(text, path);
+  return parse_config_text(file.text, path);
 }
 
 machining::MachineTables to_machine_tables(const Config& cfg) {

@@ -23,7 +23,9 @@ using yaml_util::ScalarKind;
 using yaml_util::Value;
 
 constexpr std::int64_t kMaxInt = INT_MAX;
-constexpr std::int64_t kMaxLineBytes = std::int64_t{16} << 20;
+// DESIGN §9: a protocol line is at most 1 MiB; a bigger limit would only let one request hold
+// more of the bridge's memory.
+constexpr std::int64_t kMaxLineBytes = std::int64_t{1} << 20;
 
 inline std::string line_of(const SourceLoc& loc) { return std::to_string(loc.line); }
 

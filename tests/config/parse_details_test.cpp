@@ -1,12 +1,17 @@
 // Diagnostics formatting, error collection and ordering, scalar typing, and hostile inputs.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "edm/runtime/config.hpp"
+#include "support/temp_dir.hpp"
 
 namespace edm::rt {
 namespace {
@@ -60,8 +65,8 @@ TEST(ParseFile, missing_file_names_path_and_reason) {
   } catch (const ConfigError& e) {
     ASSERT_EQ(e.diagnostics().size(), 1u);
     EXPECT_EQ(e.diagnostics()[0].loc.file, path);
-    EXPECT_EQ(e.diagnostics()[0].loc.line, 0);
-    EXPECT_EQ(std::string(e.what()), path + ": cannot open: No such file or directory");
+    EXPECT_EQ(e.diagnostics()[0].loc.line, 1);
+    EXPECT_EQ(std::string(e.what()), path + ":1:1: cannot open: No such file or directory");
   }
 }
 
@@ -70,7 +75,40 @@ TEST(ParseFile, directory_is_an_error_not_an_empty_config) {
     parse_config_file(EDM_TEST_DATA_DIR);
     FAIL();
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("Is a directory"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()),
+              std::string(EDM_TEST_DATA_DIR) + ":1:1: not a regular file (a directory)");
+  }
+}
+
+// Issue 17 item 10: a FIFO must not hang the check (no writer ever comes), a device must not be
+// read (/dev/zero never ends), a file over the 4 MiB limit is refused unread.
+TEST(ParseFile, fifo_device_and_huge_files_are_refused_at_1_1) {
+  edm::test::TempDir dir;
+  const std::string fifo = dir.file("machine.yaml");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string huge = dir.file("huge.yaml");
+  { std::ofstream(huge) << "version: 1\n"; }
+  std::filesystem::resize_file(huge, std::uintmax_t{1} << 40);  // sparse: reading would not end
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {fifo, fifo + ":1:1: not a regular file (a FIFO)"},
+      {"/dev/zero", "/dev/zero:1:1: not a regular file (a device)"},
+      {huge, huge + ":1:1: config is 1099511627776 bytes; the limit is 4 MiB"},
+  };
+  for (const auto& [path, message] : cases) {
+    try {
+      parse_config_file(path);
+      ADD_FAILURE() << path << " accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), message);
+    }
+  }
+  try {
+    parse_config_text(std::string((std::size_t{4} << 20) + 1, '#'), "big.yaml");
+    ADD_FAILURE() << "a 4 MiB + 1 text accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("big.yaml:1:1: config is 4194305 bytes"),
+              std::string::npos)
+        << e.what();
   }
 }
 

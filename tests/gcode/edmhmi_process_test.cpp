@@ -1,9 +1,12 @@
 // Runs the edmhmi binary: `check` on good and bad part programs, the not-yet-available bridge
 // commands and bad arguments, checking exit codes and output (DESIGN §4).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/subprocess.hpp"
@@ -63,13 +66,42 @@ TEST(EdmhmiCheck, MachineOptionSelectsTheConditionTable) {
   const Outcome bad =
       edmhmi({"check", "--machine", "/nonexistent/m.yaml", kParts + "blind-hole.nc"});
   EXPECT_EQ(bad.code, 2);
-  EXPECT_NE(bad.output.find("/nonexistent/m.yaml: cannot open"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("/nonexistent/m.yaml:1:1: cannot open"), std::string::npos)
+      << bad.output;
 }
 
 TEST(EdmhmiCheck, MissingPartFileIsBadInput) {
   const Outcome r = edmhmi({"check", "/nonexistent/part.nc"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find("/nonexistent/part.nc: cannot open"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/part.nc:1:1: cannot open"), std::string::npos) << r.output;
+}
+
+// Issue 17 item 10: whatever the path names, `check` answers at once with a located error and
+// exit 2: a directory, a FIFO (no writer: a blocking open would hang), a device that never ends
+// (/dev/zero: reading it whole would exhaust memory), a part program over 64 MiB, and the same
+// kinds of file given as --machine.
+TEST(EdmhmiCheck, NonRegularOrHugeInputIsALocatedErrorNotAHangOrACrash) {
+  edm::test::TempDir dir;
+  const std::string fifo = dir.file("part.nc");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string huge = dir.file("huge.nc");
+  { std::ofstream(huge) << "G00 X0\n"; }
+  std::filesystem::resize_file(huge, std::uintmax_t{1} << 40);  // sparse 1 TiB
+  const std::string d = dir.path().string();
+  const std::vector<std::pair<std::string, std::string>> parts = {
+      {d, d + ":1:1: not a regular file (a directory)"},
+      {fifo, fifo + ":1:1: not a regular file (a FIFO)"},
+      {"/dev/zero", "/dev/zero:1:1: not a regular file (a device)"},
+      {huge, huge + ":1:1: part program is 1099511627776 bytes; the limit is 64 MiB"},
+  };
+  for (const auto& [path, message] : parts) {
+    const Outcome r = edmhmi({"check", path});
+    EXPECT_EQ(r.code, 2) << path << ": " << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+    const Outcome m = edmhmi({"check", "--machine", path, kParts + "blind-hole.nc"});
+    EXPECT_EQ(m.code, 2) << path << ": " << m.output;
+    EXPECT_NE(m.output.find(path + ":1:1: "), std::string::npos) << m.output;
+  }
 }
 
 TEST(EdmhmiCommands, BridgeCommandsWithoutEdmplcFailWithExitOne) {

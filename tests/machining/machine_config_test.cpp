@@ -118,7 +118,8 @@ TEST(MachineConfig, UnreadableFile) {
     FAIL() << "no exception";
   } catch (const MachineConfigError& e) {
     ASSERT_EQ(e.messages().size(), 1u);
-    EXPECT_EQ(e.messages()[0], "/nonexistent/machine.yaml: cannot open: No such file or directory");
+    EXPECT_EQ(e.messages()[0],
+              "/nonexistent/machine.yaml:1:1: cannot open: No such file or directory");
   }
 }
 

@@ -220,6 +220,21 @@ TEST_F(EdmplcProcess, VirtualClockTracesAreByteIdentical) {
   }
 }
 
+// Issue 17 item 10: a FIFO as the config must not hang --check (no writer ever opens it), nor a
+// device or a directory be read: each is a located error and exit 2.
+TEST_F(EdmplcProcess, ConfigThatIsNotARegularFileIsRefusedAtOnce) {
+  const fs::path fifo = dir_ / "config.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const fs::path& p : {fifo, fs::path("/dev/zero"), dir_}) {
+    for (const char* mode : {"--check", "--list-vars"}) {
+      Child c({EDM_EDMPLC_PATH, "--config", p.string(), mode});
+      EXPECT_EQ(c.wait(), 2) << c.output();
+      EXPECT_NE(c.output().find(p.string() + ":1:1: not a regular file"), std::string::npos)
+          << c.output();
+    }
+  }
+}
+
 TEST_F(EdmplcProcess, BadArgumentsExitTwoWithAMessage) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--clock", "wall"}, "--clock takes real or virtual"},
