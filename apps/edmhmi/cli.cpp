@@ -14,6 +14,9 @@ bool connect(edm::bridge::Client& client, const edm::hmi::ConnectionSettings& s,
   o.port = s.port;
   o.token = s.token;
   o.auto_reconnect = auto_reconnect;
+  o.tls.enabled = !s.tls_ca_file.empty() || !s.tls_fingerprint.empty();
+  o.tls.ca_file = s.tls_ca_file;
+  o.tls.fingerprint = s.tls_fingerprint;
   try {
     client.connect(o);
     return true;

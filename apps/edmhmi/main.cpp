@@ -15,9 +15,12 @@ namespace edmhmi {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: edmhmi [--host H] [--port P] [--token-file F] COMMAND ...\n"
+    "usage: edmhmi [--host H] [--port P] [--token-file F] [--tls-ca F | --tls-fingerprint FP]\n"
+    "              COMMAND ...\n"
     "  connection: --host (else $EDM_HOST, 127.0.0.1), --port (else $EDM_PORT, 7730),\n"
-    "              --token-file (else $EDM_TOKEN_FILE, else the token in $EDM_TOKEN)\n"
+    "              --token-file (else $EDM_TOKEN_FILE, else the token in $EDM_TOKEN),\n"
+    "              TLS verified by --tls-ca (else $EDM_TLS_CA) or the server certificate's\n"
+    "              SHA-256 --tls-fingerprint (else $EDM_TLS_FINGERPRINT)\n"
     "commands:\n"
     "  check [--machine CONFIG] PART.nc   interpret offline against CONFIG (default\n"
     "                                     config/machines/drill-sim.yaml); nothing is sent\n"
@@ -44,10 +47,12 @@ int run(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return kExitOk;
     }
-    std::string* target = args[i] == "--host"         ? &flags.host
-                          : args[i] == "--port"       ? &flags.port
-                          : args[i] == "--token-file" ? &flags.token_file
-                                                      : nullptr;
+    std::string* target = args[i] == "--host"              ? &flags.host
+                          : args[i] == "--port"            ? &flags.port
+                          : args[i] == "--token-file"      ? &flags.token_file
+                          : args[i] == "--tls-ca"          ? &flags.tls_ca_file
+                          : args[i] == "--tls-fingerprint" ? &flags.tls_fingerprint
+                                                           : nullptr;
     if (target == nullptr) return usage("unknown option '" + std::string(args[i]) + "'");
     if (i + 1 >= args.size()) return usage(std::string(args[i]) + " needs a value");
     *target = std::string(args[i + 1]);

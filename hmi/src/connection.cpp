@@ -66,6 +66,17 @@ ConnectionSettings resolve_connection(const ConnectionFlags& flags, EnvLookup en
     s.token = trim(t);
     s.token_source = "$EDM_TOKEN";
   }
+  s.tls_ca_file = flags.tls_ca_file;
+  if (s.tls_ca_file.empty()) {
+    if (const char* f = env_or_null(env, "EDM_TLS_CA")) s.tls_ca_file = f;
+  }
+  s.tls_fingerprint = flags.tls_fingerprint;
+  if (s.tls_fingerprint.empty()) {
+    if (const char* f = env_or_null(env, "EDM_TLS_FINGERPRINT")) s.tls_fingerprint = f;
+  }
+  if (!s.tls_ca_file.empty() && !s.tls_fingerprint.empty()) {
+    throw SettingsError("give either a TLS CA file or a fingerprint, not both");
+  }
   return s;
 }
 

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -249,6 +250,64 @@ TEST_F(EdmhmiTokenTest, WrongOrMissingTokenIsUnauthorized) {
   const Outcome bad = edmhmi({"--token-file", empty, "status"});
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_NE(bad.err.find("empty first line"), std::string::npos) << bad.err;
+}
+
+/// drill-sim.yaml serving TLS with a self-signed certificate made for the test, and a token.
+class EdmhmiTlsTest : public EdmhmiTokenTest {
+ protected:
+  void SetUp() override {
+    const std::string made = run_shell(
+        "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 "
+        "-subj /CN=edm-test -addext subjectAltName=IP:127.0.0.1 -keyout " +
+        key_ + " -out " + cert_ + " 2>/dev/null && chmod 600 " + key_ + " && openssl x509 -in " +
+        cert_ + " -noout -fingerprint -sha256");
+    ASSERT_NE(made.find('='), std::string::npos) << "openssl could not make a certificate";
+    fingerprint_ = made.substr(made.find('=') + 1);
+    fingerprint_.erase(fingerprint_.find_last_not_of('\n') + 1);
+    write_token(op_, "op-3c1d77a0b1c2d3e4");
+    std::string cfg = read_file(kDrillSim);
+    const std::string anchor = "\n  port: 7730\n";
+    const auto at = cfg.find(anchor);
+    ASSERT_NE(at, std::string::npos) << "drill-sim.yaml has no bridge port line";
+    cfg.insert(at + anchor.size(),
+               "  token_file: " + op_ + "\n  tls: {cert: " + cert_ + ", key: " + key_ + "}\n");
+    std::ofstream(config_) << cfg;
+    edm::bridge::ClientTls tls;
+    tls.enabled = true;
+    tls.ca_file = cert_;
+    start_plc(config_, "op-3c1d77a0b1c2d3e4", tls);
+  }
+  static std::string run_shell(const std::string& cmd) {
+    std::string out;
+    if (FILE* p = ::popen(cmd.c_str(), "r")) {
+      char buf[256];
+      while (std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+      if (::pclose(p) != 0) out.clear();
+    }
+    return out;
+  }
+  std::string cert_ = dir_.file("bridge.crt");
+  std::string key_ = dir_.file("bridge.key");
+  std::string fingerprint_;
+};
+
+TEST_F(EdmhmiTlsTest, EdmhmiVerifiesTheServerByCaOrFingerprintAndPlainTcpIsRefused) {
+  const Outcome by_ca = edmhmi({"--token-file", op_, "--tls-ca", cert_, "status"});
+  EXPECT_EQ(by_ca.code, 0) << by_ca.out << by_ca.err;
+  EXPECT_NE(by_ca.out.find("state READY"), std::string::npos) << by_ca.out;
+  const Outcome by_pin =
+      edmhmi({"status"}, {{"EDM_TOKEN_FILE", op_}, {"EDM_TLS_FINGERPRINT", fingerprint_}});
+  EXPECT_EQ(by_pin.code, 0) << by_pin.out << by_pin.err;
+  std::string wrong = fingerprint_;
+  wrong[0] = wrong[0] == 'A' ? 'B' : 'A';
+  const Outcome bad_pin = edmhmi({"--token-file", op_, "--tls-fingerprint", wrong, "status"});
+  EXPECT_EQ(bad_pin.code, 1) << bad_pin.out << bad_pin.err;
+  EXPECT_NE(bad_pin.err.find("not the pinned one"), std::string::npos) << bad_pin.err;
+  const Outcome plain = edmhmi({"--token-file", op_, "status"});
+  EXPECT_EQ(plain.code, 1) << plain.out << plain.err;
+  EXPECT_NE(plain.err.find("this port speaks TLS"), std::string::npos) << plain.err;
+  const Outcome both = edmhmi({"--tls-ca", cert_, "--tls-fingerprint", fingerprint_, "status"});
+  EXPECT_EQ(both.code, 2) << both.err;
 }
 
 TEST_F(EdmhmiProcessTest, HoldAndResumeWhenIdleAreInvalidState) {

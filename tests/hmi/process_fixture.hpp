@@ -165,7 +165,8 @@ class EdmhmiProcessTest : public ::testing::Test {
 
   /// Starts edmplc on `config` and waits until its bridge listens and says hello (deadline, no
   /// fixed sleep). Another port is tried when the free one was taken in between.
-  void start_plc(const std::string& config = kDrillSim, const std::string& token = "") {
+  void start_plc(const std::string& config = kDrillSim, const std::string& token = "",
+                 const edm::bridge::ClientTls& tls = {}) {
     for (int attempt = 0; attempt < 3; ++attempt) {
       port_ = free_port();
       plc_ = std::make_unique<Proc>(
@@ -183,6 +184,7 @@ class EdmhmiProcessTest : public ::testing::Test {
             edm::bridge::ClientOptions o;
             o.port = static_cast<std::uint16_t>(port_);
             o.token = token;
+            o.tls = tls;
             o.timeout = 2000ms;
             try {
               c.connect(o);

@@ -3,6 +3,9 @@
 //   host   --host H        else $EDM_HOST        else 127.0.0.1
 //   port   --port P        else $EDM_PORT        else 7730
 //   token  --token-file F  else $EDM_TOKEN_FILE  else $EDM_TOKEN (the token itself) else none
+//   TLS    --tls-ca F (verify the chain and host name) else $EDM_TLS_CA, or
+//          --tls-fingerprint FP (pin the certificate's SHA-256) else $EDM_TLS_FINGERPRINT;
+//          either one turns TLS on, else plain TCP
 // A token file holds the token on its first line (surrounding white space is ignored). Without a
 // token only a loopback edmplc without configured tokens answers (as operator).
 //
@@ -20,6 +23,8 @@ struct ConnectionSettings {
   std::uint16_t port{7730};
   std::string token;         // empty: none
   std::string token_source;  // "--token-file F", "$EDM_TOKEN_FILE F", "$EDM_TOKEN" or ""
+  std::string tls_ca_file;      // TLS on when this or tls_fingerprint is set
+  std::string tls_fingerprint;  // SHA-256, hex, colons optional
 };
 
 /// A bad flag value, an unreadable or empty token file. what() is the whole message.
@@ -33,6 +38,8 @@ struct ConnectionFlags {
   std::string host;
   std::string port;
   std::string token_file;
+  std::string tls_ca_file;
+  std::string tls_fingerprint;
 };
 using EnvLookup = const char* (*)(const char* name);
 
