@@ -179,6 +179,16 @@ void unforce_pin(const PinRef& ref) {
   }
 }
 
+// The safe state's release: an output gets its block's last computed value back at once.
+template <class T>
+void release_pin(const PinRef& ref) {
+  if (ref.dir == PinDir::kInput) {
+    ref.as_input<T>()->unforce();
+  } else {
+    ref.as_output<T>()->release();
+  }
+}
+
 template <class T>
 bool is_forced(const PinRef& ref) {
   return ref.dir == PinDir::kInput ? ref.as_input<T>()->forced() : ref.as_output<T>()->forced();
@@ -251,13 +261,13 @@ std::size_t VariableRegistry::release_forces() noexcept {
     }
     switch (v.pin.type) {
       case PinType::kBool:
-        unforce_pin<bool>(v.pin);
+        release_pin<bool>(v.pin);
         break;
       case PinType::kInt:
-        unforce_pin<std::int64_t>(v.pin);
+        release_pin<std::int64_t>(v.pin);
         break;
       case PinType::kReal:
-        unforce_pin<double>(v.pin);
+        release_pin<double>(v.pin);
         break;
     }
     ++released;

@@ -10,8 +10,8 @@
 //  - forced Output: every set() by the owning block stores the forced value instead, so every
 //    reader (wires, trace, bridge, I/O) sees the forced value from the next cycle on;
 //  - forced Input: get() returns the forced value; the wire is not read.
-// unforce() returns the pin to its computed value at once: an output goes back to the value of
-// the block's last set() (kept aside while forced), an input reads its wire again.
+// unforce() returns the pin to its computed value: at the next set() for outputs, at once for
+// inputs. release() (outputs) also puts the block's last computed value back at once.
 // The runtime releases every force when the machine enters FAULT or ESTOP (the safe state
 // wins over forces; docs/runtime.md "Forcing").
 //
@@ -71,9 +71,12 @@ class Output {
     forced_.store(true, std::memory_order_release);
     value_.store(v, std::memory_order_relaxed);
   }
-  /// Back to the computed value now, not at the owner's next set(): a released force must not
-  /// linger on a wire whose block stopped setting it.
-  void unforce() noexcept {
+  /// Ends the force; readers see the computed value from the owner's next set() (a block whose
+  /// output is its state, e.g. an integrator, continues from the forced value).
+  void unforce() noexcept { forced_.store(false, std::memory_order_release); }
+  /// Ends the force and puts the block's last computed value back at once: the safe state's
+  /// release, which must not leave a forced value on a wire until a slower task's next cycle.
+  void release() noexcept {
     forced_.store(false, std::memory_order_release);
     value_.store(computed_.load(std::memory_order_relaxed), std::memory_order_relaxed);
   }
