@@ -182,6 +182,8 @@ class Runner {
     Phase ph;
     ph.name = name;
     const fs::path dir = out_ / name;
+    std::error_code ec;
+    fs::remove_all(dir, ec);  // no job files of an earlier, longer run left behind
     fs::create_directories(dir);
     const std::uint16_t port = free_port();
     soak::PlcProcess plc;
@@ -540,9 +542,9 @@ int main(int argc, char** argv) {
   }
   fmt::print("  {} alive at the end, answered, stopped cleanly on SIGINT\n", pf(alive));
   fmt::print(
-      "  {} every job reached its depth (|reached - program| and |measured - program| <= "
-      "{} mm)\n",
-      pf(depths), soak::kDepthToleranceMm);
+      "  {} every job reached its depth (|reached - program| <= {} mm, measured >= program - {} "
+      "mm)\n",
+      pf(depths), soak::kDepthToleranceMm, soak::kMeasuredShortMm);
   fmt::print("  {} VmRSS flat: end {} MiB <= after job 1 {} MiB + max(10 %, 8 MiB) = {} MiB\n",
              pf(rss_flat), mib(sm.rss_end_kb), mib(sm.rss_ref_kb), mib(rss_limit));
   fmt::print("  {} fds flat: end {} <= start {} + {} (both with nobody connected)\n", pf(fd_flat),

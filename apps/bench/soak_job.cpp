@@ -74,7 +74,7 @@ std::string job_program(const std::string& demo_nc, int k, double worn_mm, std::
 bool JobFigures::at_depth() const {
   return outcome == "finished" && reached_mm && program_mm && measured_mm &&
          std::abs(*reached_mm - *program_mm) <= kDepthToleranceMm &&
-         std::abs(*measured_mm - *program_mm) <= kDepthToleranceMm;
+         *measured_mm >= *program_mm - kMeasuredShortMm;
 }
 
 JobFigures parse_report(const std::string& report) {
