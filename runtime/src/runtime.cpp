@@ -70,6 +70,8 @@ RunSummary Runtime::run(const RunOptions& options) {
     a.severity = AlarmSeverity::kFault;
     a.source = "retain";
     a.text = retain_warning_.c_str();
+    // Before the first cycle: the start time on the clock the tasks will use (virtual: 0).
+    a.time = options.clock == ClockKind::kReal ? RealClock{}.now() : TimePoint{};
     machine_.raise(a);
     startup_alarm_ = AlarmCode::kNone;
   }
