@@ -217,6 +217,7 @@ std::string WebHub::welcome(bridge::Role role) const {
                   {"frame_hz", kFrameHz},
                   {"job", job_.snapshot()},
                   {"alarms", alarms_json_locked()},
+                  {"history", Json(history_)},
                   {"status", last_status_},
                   {"bridge", bridge_up_}};
   return w.dump(-1, ' ', false, Json::error_handler_t::replace);
@@ -355,6 +356,8 @@ void WebHub::on_timer() {
         }
       }
       rows_.clear();
+      for (const Json& r : rows) history_.push_back(r);
+      while (history_.size() > kHistoryRows) history_.pop_front();
       frame["rows"] = std::move(rows);
       any = true;
     }

@@ -213,12 +213,15 @@ void WebJob::on_status(const bridge::StatusMessage& s) {
   if (s.job_outcome == "finished" || s.job_outcome == "aborted") {
     fill_from_status(report_, s);
     report_done_ = true;
+    report_done_at_ = std::chrono::steady_clock::now();
   }
 }
 
 void WebJob::on_alarm(const Json& ev) {
   std::lock_guard lock(mutex_);
-  if (!started_ || report_done_) return;
+  constexpr auto kLateAlarm = std::chrono::seconds(2);
+  if (!started_) return;
+  if (report_done_ && std::chrono::steady_clock::now() - report_done_at_ > kLateAlarm) return;
   report_.alarms.push_back(describe_alarm(ev));
   report_.fault_alarms += ev.value("severity", std::string()) == "fault" ? 1 : 0;
 }

@@ -109,6 +109,8 @@ test('a viewer sees no control buttons and cannot act', async () => {
   assert.equal(reply.ok, false);
   assert.equal(reply.code, 'forbidden');
   await v.screenshot({ path: join(out, 'viewer-1024x768.png') });
+  await v.setViewportSize({ width: 800, height: 1280 });  // a tablet held upright
+  await v.screenshot({ path: join(out, 'viewer-tablet-800x1280.png'), fullPage: true });
   await v.close();
   assert.match(await state().textContent(), /RUNNING|HOLD/);
 });
@@ -119,12 +121,19 @@ test('a reload in the middle of the job leaves it running', async () => {
   await page.locator('#app').waitFor({ state: 'visible', timeout: T });
   await state().filter({ hasText: 'RUNNING' }).waitFor({ timeout: T });
   const after = await page.evaluate(() => window.edm.status.job);
+  // The charts keep their recent past across the reload (the server's history).
+  assert.ok(Number(await page.locator('#chart-z').getAttribute('data-points')) > 20);
   assert.equal(after.generation, before.generation);
   assert.equal(after.outcome, 'running');
   assert.ok(after.block >= before.block);
 });
 
 test('hold, resume, finish and read the job report', async () => {
+  await page.waitForFunction(() => {
+    const last = document.getElementById('chart-z').dataset.last;
+    return last && JSON.parse(last).depth_est > 4;
+  }, null, { timeout: 60000, polling: 100 });
+  await page.screenshot({ path: join(out, 'drilling.png') });  // README's picture
   await page.locator('#btn-hold').click();
   await state().filter({ hasText: 'HOLD' }).waitFor({ timeout: T });
   await page.locator('#btn-resume').click();

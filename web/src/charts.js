@@ -68,7 +68,7 @@ export class Charts {
   }
 
   /** rows: [[t, v0, v1, …], …] from one frame. */
-  push(rows) {
+  push(rows, redraw = false) {
     for (const row of rows) {
       const n = this.count < WINDOW ? this.count : WINDOW;
       for (const c of this.charts) {
@@ -85,7 +85,7 @@ export class Charts {
     }
     this.dirty = rows.length > 0 || this.dirty;
     const now = performance.now();
-    if (this.dirty && now - this.last >= REDRAW_MS) {
+    if (this.dirty && (redraw || now - this.last >= REDRAW_MS)) {
       this.last = now;
       this.dirty = false;
       this.draw();

@@ -50,6 +50,7 @@ const conn = new Connection({
     $('machine-name').textContent = m.machine?.name ?? '?';
     editor.readOnly = m.role !== 'operator';
     charts.setup(m.series || []);
+    if (m.history) charts.push(m.history, true);
     renderOperatorFunctions(m.caps);
     ui.alarms = m.alarms || [];
     renderAlarms(ui.alarms, m.role === 'operator');
@@ -68,6 +69,8 @@ const conn = new Connection({
     if (f.alarms) {
       ui.alarms = ui.alarms.concat(f.alarms).slice(-200);
       renderAlarms(ui.alarms, ui.role === 'operator');
+      // An alarm that came with the end of the job belongs to its report: fetch it again.
+      if (ui.job && ui.job.report) conn.cmd('job').then((r) => { if (r.ok) showJob(r.body, false); });
     }
     if (f.bridge === false) $('conn').textContent = 'edmhmi online, edmplc unreachable';
   },

@@ -54,6 +54,8 @@ class WebHub {
   static constexpr std::size_t kMaxRowsPerFrame = 4;
   static constexpr double kRowPeriodS = 0.02;  // machine time between telemetry rows
   static constexpr std::size_t kMaxAlarms = 200;
+  /// Rows sent lately, given to a browser that logs in (a reload keeps the charts' recent past).
+  static constexpr std::size_t kHistoryRows = 1500;
   static constexpr std::size_t kWorkQueue = 64;
 
   WebHub(boost::asio::io_context& ioc, bridge::Client& client, ConnectionSettings settings);
@@ -131,7 +133,8 @@ class WebHub {
   bool bridge_changed_{false};
   std::vector<double> row_;  // latest value per series (NaN: none yet)
   double last_row_t_{-1.0};
-  std::vector<bridge::Json> rows_;  // pending for the next frame
+  std::vector<bridge::Json> rows_;    // pending for the next frame
+  std::deque<bridge::Json> history_;  // the last kHistoryRows rows sent
   std::deque<bridge::Json> alarms_;
   std::vector<bridge::Json> new_alarms_;
   std::uint64_t alarm_seq_{0};

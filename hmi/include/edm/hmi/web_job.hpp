@@ -11,6 +11,7 @@
 // or a bridge event handler. on_status() / on_alarm() are cheap and may be called from the
 // client's event thread.
 
+#include <chrono>
 #include <cstdint>
 #include <mutex>
 #include <optional>
@@ -74,6 +75,8 @@ class WebJob {
   bool started_{false};
   JobReport report_;
   bool report_done_{false};
+  // Alarms that come with the end (after the last status) still belong to the report.
+  std::chrono::steady_clock::time_point report_done_at_{};
 };
 
 /// The preview of a program: the tool tip's path as points (arcs and orbits as chords of at most
