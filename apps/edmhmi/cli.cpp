@@ -2,8 +2,8 @@
 #include "cli.hpp"
 
 #include <cstdio>
-#include <fstream>
-#include <iterator>
+
+#include "edm/machining/bounded_read.hpp"
 
 namespace edmhmi {
 
@@ -39,17 +39,15 @@ int report_error(std::string_view op, const edm::bridge::Reply& r) {
 }
 
 bool read_text_file(const std::string& path, std::string& out) {
-  constexpr std::size_t kMaxBytes = 64u << 20;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "%s: cannot open\n", path.c_str());
+  // Regular files only, bounded: a FIFO, /dev/zero or a huge file is a located error, never a
+  // hang or an exhausted memory.
+  edm::machining::BoundedRead file =
+      edm::machining::read_bounded_file(path, edm::machining::kMaxPartProgramBytes, "part program");
+  if (!file.ok()) {
+    std::fprintf(stderr, "%s\n", file.error.c_str());
     return false;
   }
-  out.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad() || out.size() > kMaxBytes) {
-    std::fprintf(stderr, "%s: unreadable or larger than %zu bytes\n", path.c_str(), kMaxBytes);
-    return false;
-  }
+  out = std::move(file.text);
   return true;
 }
 

@@ -310,6 +310,16 @@ TEST_F(EdmhmiTlsTest, EdmhmiVerifiesTheServerByCaOrFingerprintAndPlainTcpIsRefus
   EXPECT_EQ(both.code, 2) << both.err;
 }
 
+TEST_F(EdmhmiProcessTest, RunRefusesAPartProgramThatIsNotARegularFileBeforeConnecting) {
+  const std::string fifo = dir_.file("part.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& part : {dir_.file(""), fifo, std::string("/dev/zero")}) {
+    const Outcome r = edmhmi({"run", part}, {}, /*flags=*/false);
+    EXPECT_EQ(r.code, 2) << part << ": " << r.err;
+    EXPECT_NE(r.err.find(part + ":1:1: "), std::string::npos) << r.err;
+  }
+}
+
 TEST_F(EdmhmiProcessTest, HoldAndResumeWhenIdleAreInvalidState) {
   start_plc();
   for (const std::string c : {"hold", "resume"}) {

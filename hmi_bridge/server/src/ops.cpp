@@ -55,6 +55,8 @@ ErrorCode var_error(rt::VarResult r) {
       return ErrorCode::kNotFound;
     case rt::VarResult::kBusy:
       return ErrorCode::kBusy;
+    case rt::VarResult::kInvalidState:
+      return ErrorCode::kInvalidState;  // e.g. a force refused in FAULT or ESTOP
     default:
       return ErrorCode::kBadRequest;
   }
