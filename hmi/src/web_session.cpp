@@ -43,15 +43,21 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession>
   ~WsSession() override { hub_.detach(this); }
 
   void run(beast::http::request<beast::http::string_body> req) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    // Beast's server defaults (pings, 300 s idle), but a close handshake the peer does not answer
+    // ends after 5 s instead of 30.
+    auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.handshake_timeout = std::chrono::seconds(5);
+    ws_.set_option(timeouts);
     ws_.set_option(websocket::stream_base::decorator(
         [](websocket::response_type& res) { res.set(beast::http::field::server, "edmhmi"); }));
     ws_.read_message_max(kMaxWebMessageBytes);
     login_timer_.expires_after(kLoginTimeout);
     login_timer_.async_wait([weak = weak_from_this()](beast::error_code ec) {
       const auto self = weak.lock();
-      if (ec || !self || self->role_) return;
-      self->close(websocket::close_code::policy_error, "log-in timeout");
+      if (ec || !self || self->role_ || self->closing_) return;
+      // No log-in in time: a client that may not answer a close handshake either.
+      self->closing_ = true;
+      beast::get_lowest_layer(self->ws_).close();
     });
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
