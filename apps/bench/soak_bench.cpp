@@ -175,6 +175,21 @@ class Runner {
     }
     config_ = out_ / "drill-sim-soak.yaml";
     std::ofstream(config_) << cfg;
+    // Copies of the two programs: build/ is shared, and a rebuild of edmhmi mid-run made its
+    // binary unrunnable for seconds (jobs that never started).
+    const fs::path bin = out_ / "bin";
+    fs::create_directories(bin);
+    std::error_code ec;
+    stamp_ = "edmplc " + binary_stamp(edmplc_) + "; edmhmi " + binary_stamp(edmhmi_);
+    for (std::string* exe : {&edmplc_, &edmhmi_}) {
+      const fs::path copy = bin / fs::path(*exe).filename();
+      fs::copy_file(*exe, copy, fs::copy_options::overwrite_existing, ec);
+      if (ec) {
+        fmt::print(stderr, "edm-bench-soak: cannot copy {}: {}\n", *exe, ec.message());
+        return false;
+      }
+      *exe = copy.string();
+    }
     return true;
   }
 
@@ -189,9 +204,8 @@ class Runner {
     soak::PlcProcess plc;
     const auto t0 = soak::Clock::now();
     auto since = [t0] { return std::chrono::duration<double>(soak::Clock::now() - t0).count(); };
-    fmt::print("[{}] edmplc --config {} --clock real --bridge-port {} ({} min{}); binary {}\n",
-               name, config_.string(), port, minutes, hostile ? ", 16 hostile clients" : "",
-               binary_stamp(edmplc_));
+    fmt::print("[{}] edmplc --config {} --clock real --bridge-port {} ({} min{}); {}\n", name,
+               config_.string(), port, minutes, hostile ? ", 16 hostile clients" : "", stamp_);
     std::fflush(stdout);
     const std::string started =
         plc.start({edmplc_, "--config", config_.string(), "--clock", "real", "--bridge-port",
@@ -374,7 +388,7 @@ class Runner {
   Options o_;
   fs::path out_;
   fs::path config_;
-  std::string edmplc_, edmhmi_, demo_;
+  std::string edmplc_, edmhmi_, demo_, stamp_;
 };
 
 struct MemFigures {
