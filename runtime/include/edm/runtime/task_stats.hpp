@@ -7,10 +7,10 @@
 // RT safety: record_cycle() and record_overrun() are RT-safe (noexcept, O(1), no allocation, no
 // locks, never wait for readers). snapshot() is not RT (scans the histograms; may retry).
 
-#include <atomic>
 #include <cstdint>
 
 #include "edm/runtime/histogram.hpp"
+#include "edm/runtime/seqlock.hpp"
 #include "edm/runtime/time.hpp"
 
 namespace edm::rt {
@@ -32,8 +32,8 @@ struct TaskStatsSnapshot {
   DurationSummary latency;
 };
 
-/// Counters and min/max/sum are published through a seqlock, so a snapshot is never torn;
-/// p50/p99 come from two LatencyHistograms read after the scalars, so they may include a few
+/// Counters and min/max/sum are published through a Seqlock (seqlock.hpp), so a snapshot is never
+/// torn; p50/p99 come from two LatencyHistograms read after the scalars, so they may include a few
 /// cycles newer than `cycles` (they are clamped into the snapshot's [min, max]).
 /// Not copyable or movable (atomics; about 37 KiB, no heap).
 class TaskStats {
@@ -59,22 +59,23 @@ class TaskStats {
   void reset() noexcept;
 
  private:
-  /// Scalars of one measured quantity (ns). Written only inside the seqlock's write section.
+  /// Scalars of one measured quantity (ns).
   struct Extremes {
-    std::atomic<std::int64_t> min_ns{0};  // valid only when cycles_ > 0
-    std::atomic<std::int64_t> max_ns{0};
-    std::atomic<std::int64_t> sum_ns{0};
+    std::int64_t min_ns{0};  // valid only when cycles > 0
+    std::int64_t max_ns{0};
+    std::int64_t sum_ns{0};
+  };
+  /// Everything but the histograms, published as one value.
+  struct Scalars {
+    std::uint64_t cycles{0};
+    std::uint64_t overruns{0};
+    std::uint64_t omitted_cycles{0};
+    Extremes exec;
+    Extremes latency;
   };
 
-  void begin_write() noexcept;
-  void end_write() noexcept;
-
-  std::atomic<std::uint64_t> seq_{0};  // odd while the writer is inside a write section
-  std::atomic<std::uint64_t> cycles_{0};
-  std::atomic<std::uint64_t> overruns_{0};
-  std::atomic<std::uint64_t> omitted_cycles_{0};
-  Extremes exec_;
-  Extremes latency_;
+  Scalars own_;                 // the writer's working copy, read and written by the writer only
+  Seqlock<Scalars> published_;  // what snapshot() reads
   LatencyHistogram exec_histogram_;
   LatencyHistogram latency_histogram_;
 };
