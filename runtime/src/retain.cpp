@@ -10,6 +10,7 @@
 
 #include <array>
 #include <bit>
+#include <boost/crc.hpp>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
@@ -25,20 +26,6 @@ namespace {
 constexpr std::string_view kHeader = "edmplc-retain 1";
 constexpr std::string_view kHeaderMagic = "edmplc-retain ";
 constexpr std::string_view kEndPrefix = "end ";
-
-// Nibble table: 16 entries are enough for a few KB written at most once a second.
-constexpr std::array<std::uint32_t, 16> make_crc_table() {
-  std::array<std::uint32_t, 16> t{};
-  for (std::uint32_t n = 0; n < 16; ++n) {
-    std::uint32_t c = n;
-    for (int k = 0; k < 4; ++k) {
-      c = (c & 1U) != 0 ? 0xEDB88320U ^ (c >> 1) : c >> 1;
-    }
-    t[n] = c;
-  }
-  return t;
-}
-constexpr std::array<std::uint32_t, 16> kCrcTable = make_crc_table();
 
 std::optional<RetainType> parse_type(std::string_view s) {
   if (s == "BOOL") {
@@ -238,13 +225,9 @@ bool is_valid_retain_name(std::string_view name) noexcept {
 }
 
 std::uint32_t crc32_ieee(std::string_view data) noexcept {
-  std::uint32_t crc = 0xFFFFFFFFU;
-  for (const char ch : data) {
-    crc ^= static_cast<unsigned char>(ch);
-    crc = kCrcTable[crc & 0x0FU] ^ (crc >> 4);
-    crc = kCrcTable[crc & 0x0FU] ^ (crc >> 4);
-  }
-  return crc ^ 0xFFFFFFFFU;
+  boost::crc_32_type crc;
+  crc.process_bytes(data.data(), data.size());
+  return crc.checksum();
 }
 
 std::string format_retain_file(const RetainMap& values) {

@@ -84,6 +84,17 @@ TEST(Codec, crc32_is_the_zlib_crc) {
   EXPECT_EQ(c.value(), 0xCBF43926u);  // the standard check value of CRC-32/ISO-HDLC
 }
 
+TEST(Codec, crc32_in_pieces_is_the_crc_of_the_whole) {
+  Crc32 c;
+  const std::string s = "123456789";
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(s.data());
+  c.update(std::span(bytes, 4));
+  c.update(std::span(bytes, 0));
+  c.update(std::span(bytes + 4, s.size() - 4));
+  EXPECT_EQ(c.value(), 0xCBF43926u);
+  EXPECT_EQ(Crc32{}.value(), 0x00000000u);
+}
+
 TEST(Codec, program_checksum_covers_order_and_values) {
   std::mt19937_64 rng(7);
   std::vector<MotionBlock> p;

@@ -57,6 +57,21 @@ TEST(RetainCrc, matches_the_ieee_check_value) {
   EXPECT_EQ(crc32_ieee("a"), 0xE8B7BE43U);
 }
 
+// Bytes written before the CRC moved to Boost.CRC (issue 18): files already on disk must load.
+TEST(RetainCrc, a_file_written_by_the_hand_written_crc_still_loads) {
+  const TempDir dir;
+  const std::string path = dir.file("old.retain");
+  write_bytes(path,
+              "edmplc-retain 1\n"
+              "drill.counter.holes LINT 17\n"
+              "drill.electrode.length_left LREAL 123.456\n"
+              "drill.seq.done BOOL 1\n"
+              "end 5ad6925c\n");
+  const RetainLoadResult r = load_retain_file(path);
+  EXPECT_EQ(r.status, RetainLoadStatus::kLoaded) << r.warning;
+  EXPECT_EQ(r.values, sample_map());
+}
+
 TEST(RetainValueEq, compares_reals_bit_for_bit_and_ignores_inactive_fields) {
   EXPECT_NE(RetainValue::make_real(0.0), RetainValue::make_real(-0.0));
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -54,19 +54,6 @@ bool vec_from_json(const Json& j, Vec3& out) {
   return finite_number(j[0], out.x) && finite_number(j[1], out.y) && finite_number(j[2], out.z);
 }
 
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> t{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) {
-      c = (c & 1u) != 0 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    }
-    t[i] = c;
-  }
-  return t;
-}
-constexpr auto kCrcTable = make_crc_table();
-
 // Little-endian writers for the canonical block record.
 template <class T>
 void put_le(std::uint8_t*& p, T v) {
@@ -172,11 +159,7 @@ bool from_json(const Json& j, MotionBlock& out, std::string& error) {
 }
 
 void Crc32::update(std::span<const std::uint8_t> bytes) noexcept {
-  std::uint32_t c = state_;
-  for (const std::uint8_t byte : bytes) {
-    c = kCrcTable[(c ^ byte) & 0xFFu] ^ (c >> 8);
-  }
-  state_ = c;
+  crc_.process_bytes(bytes.data(), bytes.size());
 }
 
 void Crc32::update(const MotionBlock& b) noexcept {

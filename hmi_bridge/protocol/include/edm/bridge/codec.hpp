@@ -5,6 +5,7 @@
 // Thread-safety: pure functions (thread-safe); Crc32 is a value type (thread-compatible).
 // Not RT-safe: everything here may allocate.
 
+#include <boost/crc.hpp>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -40,14 +41,15 @@ bool from_json(const Json& j, machining::MotionBlock& out, std::string& error);
 // lost, repeated or reordered chunk and any number the JSON round trip changed.
 inline constexpr std::size_t kBlockRecordBytes = 98;
 
+// Incremental: update() in any number of pieces gives the CRC of their concatenation.
 class Crc32 {
  public:
   void update(std::span<const std::uint8_t> bytes) noexcept;
   void update(const machining::MotionBlock& b) noexcept;
-  [[nodiscard]] std::uint32_t value() const noexcept { return ~state_; }
+  [[nodiscard]] std::uint32_t value() const noexcept { return crc_.checksum(); }
 
  private:
-  std::uint32_t state_{0xFFFFFFFFu};
+  boost::crc_32_type crc_;  // CRC-32/ISO-HDLC: reflected 0x04C11DB7, init and xorout 0xFFFFFFFF
 };
 
 std::uint32_t program_checksum(std::span<const machining::MotionBlock> blocks) noexcept;
