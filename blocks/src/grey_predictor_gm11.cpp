@@ -95,16 +95,14 @@ std::vector<rt::ParamError> GreyPredictorGM11::configure(const rt::BlockSetup& /
   if (!errs.empty()) {
     return errs;
   }
-  ring_.assign(static_cast<std::size_t>(params_.window), 0.0);
-  work_.assign(ring_.size(), 0.0);
+  window_.allocate(static_cast<std::size_t>(params_.window));
+  work_.assign(window_.capacity(), 0.0);
   activate();
   return errs;
 }
 
 void GreyPredictorGM11::activate() noexcept {
-  std::fill(ring_.begin(), ring_.end(), 0.0);
-  next_ = 0;
-  count_ = 0;
+  window_.clear();
   out_.set(0.0);
   c_.set(0.0);
   b_.set(0.0);
@@ -113,27 +111,21 @@ void GreyPredictorGM11::activate() noexcept {
 
 rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
-  const std::size_t n = ring_.size();
+  const std::size_t n = window_.capacity();
   if (!std::isfinite(x) || n == 0) {
     return rt::BlockStatus::kFault;
   }
-  ring_[next_] = x;
-  next_ = next_ + 1 == n ? 0 : next_ + 1;
-  if (count_ < n) {
-    ++count_;
-  }
+  window_.push(x);
   const auto clamped = [this](double y) noexcept {
     return std::min(std::max(y, params_.out_min), params_.out_max);
   };
-  if (count_ < n) {
+  if (!window_.full()) {
     out_.set(clamped(x));
     valid_.set(false);
     return rt::BlockStatus::kOk;
   }
-  // next_ is now the oldest slot.
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j = next_ + i;
-    work_[i] = ring_[j < n ? j : j - n];
+    work_[i] = window_[i];  // oldest first
   }
   const Fit f = predict(work_.data(), n, params_.horizon, params_.paper_exp);
   c_.set(f.c);

@@ -38,15 +38,13 @@ std::vector<rt::ParamError> MovingAverage::configure(const rt::BlockSetup& /*set
   if (!errs.empty()) {
     return errs;
   }
-  buf_.assign(static_cast<std::size_t>(params_.window), 0.0);
+  window_.allocate(static_cast<std::size_t>(params_.window));
   activate();
   return errs;
 }
 
 void MovingAverage::activate() noexcept {
-  std::fill(buf_.begin(), buf_.end(), 0.0);
-  next_ = 0;
-  count_ = 0;
+  window_.clear();
   sum_ = {};
   pass_sum_ = {};
   out_.set(0.0);
@@ -55,26 +53,20 @@ void MovingAverage::activate() noexcept {
 
 rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
-  const std::size_t window = buf_.size();
-  if (!std::isfinite(x) || window == 0) {  // window 0: not configured
+  if (!std::isfinite(x) || window_.capacity() == 0) {  // capacity 0: not configured
     return rt::BlockStatus::kFault;
   }
-  const double old = count_ == window ? buf_[next_] : 0.0;
-  buf_[next_] = x;
+  const double old = window_.push(x);  // 0 until the window is full
   sum_.add(x);
   sum_.add(-old);
   pass_sum_.add(x);
-  if (++next_ == window) {
+  if (window_.at_first_slot()) {
     // The buffer now holds exactly the samples of this pass: restart from their sum.
-    next_ = 0;
     sum_ = pass_sum_;
     pass_sum_ = {};
   }
-  if (count_ < window) {
-    ++count_;
-  }
-  const double mean = sum_.value() / static_cast<double>(count_);
-  full_.set(count_ == window);
+  const double mean = sum_.value() / static_cast<double>(window_.size());
+  full_.set(window_.full());
   if (!std::isfinite(mean)) {
     return rt::BlockStatus::kFault;
   }

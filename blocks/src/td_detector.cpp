@@ -41,14 +41,13 @@ std::vector<rt::ParamError> TdDetector::configure(const rt::BlockSetup& /*setup*
   if (!errs.empty()) {
     return errs;
   }
-  ring_.assign(static_cast<std::size_t>(params_.window), Counts{});
+  window_.allocate(static_cast<std::size_t>(params_.window));
   activate();
   return errs;
 }
 
 void TdDetector::activate() noexcept {
-  std::fill(ring_.begin(), ring_.end(), Counts{});
-  next_ = 0;
+  window_.clear();
   sum_ = {};
   td_us_.set(params_.empty_td_us);
   td_raw_us_.set(params_.empty_td_us);
@@ -60,8 +59,8 @@ void TdDetector::activate() noexcept {
 rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
   Counts c{td_sum_ns_.get(), td_count_.get(), n_open_.get(), n_short_.get(), n_total_.get()};
   const auto in_range = [](std::int64_t x) noexcept { return x >= 0 && x <= kMaxCount; };
-  if (ring_.empty() || !in_range(c.td_sum_ns) || !in_range(c.td_count) || !in_range(c.n_open) ||
-      !in_range(c.n_short) || !in_range(c.n_total)) {
+  if (window_.capacity() == 0 || !in_range(c.td_sum_ns) || !in_range(c.td_count) ||
+      !in_range(c.n_open) || !in_range(c.n_short) || !in_range(c.n_total)) {
     return rt::BlockStatus::kFault;  // ring empty: not configured
   }
   if (c.n_total == 0) {
@@ -73,16 +72,12 @@ rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
     return rt::BlockStatus::kFault;  // a delay sum without pulses
   }
 
-  Counts& slot = ring_[next_];
-  sum_.td_sum_ns += c.td_sum_ns - slot.td_sum_ns;
-  sum_.td_count += c.td_count - slot.td_count;
-  sum_.n_open += c.n_open - slot.n_open;
-  sum_.n_short += c.n_short - slot.n_short;
-  sum_.n_total += c.n_total - slot.n_total;
-  slot = c;
-  if (++next_ == ring_.size()) {
-    next_ = 0;
-  }
+  const Counts old = window_.push(c);  // all 0 until the window is full
+  sum_.td_sum_ns += c.td_sum_ns - old.td_sum_ns;
+  sum_.td_count += c.td_count - old.td_count;
+  sum_.n_open += c.n_open - old.n_open;
+  sum_.n_short += c.n_short - old.n_short;
+  sum_.n_total += c.n_total - old.n_total;
 
   const bool hold = params_.hold_when_empty;
   if (c.td_count > 0) {

@@ -35,6 +35,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -85,10 +86,8 @@ class GreyPredictorGM11 final : public rt::BlockWithParams<GreyPredictorGM11Para
   rt::Input<double> in_;
   rt::Output<double> out_, c_, b_;
   rt::Output<bool> valid_;
-  std::vector<double> ring_;
-  std::vector<double> work_;  // the window in chronological order
-  std::size_t next_{0};
-  std::size_t count_{0};
+  WindowRing<double> window_;  // allocated in configure(); its capacity is n
+  std::vector<double> work_;   // the window in chronological order
 };
 
 }  // namespace edm::blocks

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -60,11 +61,9 @@ class MovingAverage final : public rt::BlockWithParams<MovingAverageParams> {
   rt::Input<double> in_;
   rt::Output<double> out_;
   rt::Output<bool> full_;
-  std::vector<double> buf_;  // sized in configure(); its size is the window in use
-  std::size_t next_{0};      // slot the next sample overwrites
-  std::size_t count_{0};     // samples in the window, ≤ buf_.size()
-  CompensatedSum sum_;       // running sum of the window
-  CompensatedSum pass_sum_;  // sum of the samples written since next_ was last 0
+  WindowRing<double> window_;  // allocated in configure(); its capacity is the window in use
+  CompensatedSum sum_;         // running sum of the window
+  CompensatedSum pass_sum_;    // sum of the samples pushed since the ring was last at slot 0
 };
 
 }  // namespace edm::blocks

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -73,9 +74,8 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
   rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_, n_total_;
   rt::Output<double> td_us_, td_raw_us_, open_ratio_, short_ratio_;
   rt::Output<bool> valid_;
-  std::vector<Counts> ring_;  // sized in configure(); its size is the window in use
-  std::size_t next_{0};       // slot the next cycle overwrites
-  Counts sum_;                // sums over the ring
+  WindowRing<Counts> window_;  // allocated in configure(); its capacity is the window in use
+  Counts sum_;                 // sums over the ring
 };
 
 }  // namespace edm::blocks
