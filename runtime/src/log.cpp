@@ -16,76 +16,14 @@
 #include <thread>
 #include <type_traits>
 
+#include "edm/runtime/mpmc_queue.hpp"
+
 namespace edm::rt {
 
 static_assert(std::is_trivially_copyable_v<RtLogRecord>, "RT log records are copied as bytes");
 
-// A bounded MPMC ring with a sequence number per cell (D. Vyukov's design). Not
-// boost::lockfree::queue: its array freelist reads a node's link non-atomically while another
-// thread may rewrite it (boostorg/lockfree#78), which ThreadSanitizer (./edm tsan) reports.
-// Here every record is published by a release store of its cell's sequence, so TSan is clean.
-// Producers never wait: a cell that is not free yet means "full" and the record is dropped.
-struct RtLogQueue::Impl {
-  static constexpr std::size_t kMask = kCapacity - 1;
-  static_assert((kCapacity & kMask) == 0, "kCapacity must be a power of two");
-
-  struct Cell {
-    std::atomic<std::size_t> seq;  // == pos: free for push #pos; == pos + 1: holds push #pos
-    RtLogRecord rec;
-  };
-
-  Impl() {
-    for (std::size_t i = 0; i < kCapacity; ++i) {
-      cells[i].seq.store(i, std::memory_order_relaxed);
-    }
-  }
-
-  static std::ptrdiff_t diff(std::size_t a, std::size_t b) noexcept {
-    return static_cast<std::ptrdiff_t>(a - b);  // wrap-around safe distance
-  }
-
-  bool push(const RtLogRecord& rec) noexcept {
-    std::size_t pos = enqueue_pos.load(std::memory_order_relaxed);
-    for (;;) {
-      Cell& cell = cells[pos & kMask];
-      const std::ptrdiff_t d = diff(cell.seq.load(std::memory_order_acquire), pos);
-      if (d == 0) {
-        if (enqueue_pos.compare_exchange_weak(pos, pos + 1, std::memory_order_relaxed)) {
-          cell.rec = rec;
-          cell.seq.store(pos + 1, std::memory_order_release);
-          return true;
-        }
-      } else if (d < 0) {
-        return false;  // full (or the consumer is still copying this cell out)
-      } else {
-        pos = enqueue_pos.load(std::memory_order_relaxed);  // another producer took pos
-      }
-    }
-  }
-
-  bool pop(RtLogRecord& out) noexcept {
-    std::size_t pos = dequeue_pos.load(std::memory_order_relaxed);
-    for (;;) {
-      Cell& cell = cells[pos & kMask];
-      const std::ptrdiff_t d = diff(cell.seq.load(std::memory_order_acquire), pos + 1);
-      if (d == 0) {
-        if (dequeue_pos.compare_exchange_weak(pos, pos + 1, std::memory_order_relaxed)) {
-          out = cell.rec;
-          cell.seq.store(pos + kCapacity, std::memory_order_release);
-          return true;
-        }
-      } else if (d < 0) {
-        return false;  // empty (or the next producer has not finished writing)
-      } else {
-        pos = dequeue_pos.load(std::memory_order_relaxed);
-      }
-    }
-  }
-
-  std::array<Cell, kCapacity> cells;
-  alignas(64) std::atomic<std::size_t> enqueue_pos{0};  // own cache lines: producers vs consumer
-  alignas(64) std::atomic<std::size_t> dequeue_pos{0};
-};
+// The ring lives on the heap (about 72 KiB): MpmcQueue (mpmc_queue.hpp) says why not Boost's.
+struct RtLogQueue::Impl : MpmcQueue<RtLogRecord, RtLogQueue::kCapacity> {};
 
 RtLogQueue::RtLogQueue() : impl_(std::make_unique<Impl>()) {}
 RtLogQueue::~RtLogQueue() = default;

@@ -20,10 +20,10 @@
 
 #include <array>
 #include <atomic>
-#include <boost/lockfree/queue.hpp>
 #include <cstdint>
 #include <string_view>
 
+#include "edm/runtime/mpmc_queue.hpp"
 #include "edm/runtime/time.hpp"
 
 namespace edm::rt {
@@ -174,7 +174,7 @@ class Machine {
   std::atomic<MachineState> state_{MachineState::kOff};
   std::atomic<std::uint64_t> safe_epoch_{0};
   std::atomic<AlarmCode> last_cause_{AlarmCode::kNone};
-  boost::lockfree::queue<Alarm, boost::lockfree::capacity<kAlarmCapacity>> alarms_;
+  MpmcQueue<Alarm, kAlarmCapacity> alarms_;
   std::atomic<std::uint64_t> dropped_alarms_{0};
   std::array<Latch, kLatchCapacity> latches_{};
   std::atomic<std::uint64_t> repeated_alarms_{0};
