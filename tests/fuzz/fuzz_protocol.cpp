@@ -3,13 +3,26 @@
 // parser, the error reply the server would send, and the payload decoders (motion blocks of
 // program.chunk, the status message). A bad line is normal: it must give one well-formed error
 // reply line and never crash or throw. What a decoder accepts must encode and decode unchanged.
+// Then the whole input goes, after a hello, through a real session of a real bridge server (the
+// framing, limits, dispatcher and every op against a runtime) over an in-memory transport: the
+// session must answer a final ping or close, never hang.
 
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <memory>
 #include <string>
 #include <string_view>
 
+#include "edm/blocks/register.hpp"
 #include "edm/bridge/codec.hpp"
 #include "edm/bridge/protocol.hpp"
+#include "edm/bridge/server.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/loopback_driver.hpp"
+#include "edm/runtime/runtime.hpp"
 #include "fuzz/fuzz_entry.hpp"
+#include "support/memory_transport.hpp"
 
 namespace edm::fuzz {
 namespace {
@@ -81,6 +94,77 @@ void one_line(std::string_view line) {
   decode_payloads(*req);
 }
 
+// A runtime (loopback I/O, one block, tasks not running) with its bridge server, built once.
+struct SessionHarness {
+  rt::BlockRegistry blocks;
+  rt::DriverRegistry drivers;
+  std::unique_ptr<rt::Runtime> runtime;
+  std::unique_ptr<bridge::Server> server;
+  std::uint32_t next_address{0};
+
+  SessionHarness() {
+#ifdef EDM_LIBFUZZER
+    spdlog::set_level(spdlog::level::err);  // millions of sessions: their info lines are noise
+#endif
+    blocks::register_builtin_blocks(blocks);
+    rt::register_runtime_drivers(drivers);
+    const rt::Config cfg = rt::parse_config_text(R"(version: 1
+machine:
+  name: fuzz
+  io: {driver: loopback, task: fast, params: {channels: 2}}
+  axes:
+    - {name: X, min_mm: -100, max_mm: 100}
+    - {name: Z, min_mm: -60, max_mm: 20}
+conditions:
+  - {E: 1, name: rough}
+tasks:
+  - {name: fast, interval: 1ms, priority: 0, programs: [chain]}
+programs:
+  - name: chain
+    blocks:
+      - {name: g, type: Gain, params: {k: 1.0, offset: 0.0}}
+    wires:
+      g.in: io.ai0
+      io.ao0: g.out
+)",
+                                                 "fuzz.yaml");
+    runtime = rt::Runtime::build(cfg, blocks, drivers);
+    bridge::ServerOptions o;
+    o.port = 0;  // listens on an ephemeral loopback port nobody dials
+    server = std::make_unique<bridge::Server>(*runtime, o);
+    server->start();
+  }
+  // Each input comes from its own loopback address, so the failed-hello throttle of one input
+  // never slows the next.
+  std::string address() {
+    const std::uint32_t n = ++next_address & 0xFFFFFFu;
+    return "127." + std::to_string(n >> 16) + "." + std::to_string((n >> 8) & 0xFF) + "." +
+           std::to_string(n & 0xFF);
+  }
+};
+
+void through_a_session(std::string_view input) {
+  static SessionHarness h;
+  test::MemoryPeer peer(h.server->io_context());
+  h.server->adopt(peer.transport(h.address()));
+  peer.send("{\"id\":0,\"op\":\"hello\",\"protocol\":1}\n");
+  peer.send(std::string(input));
+  peer.send("\n{\"id\":\"fuzz-end\",\"op\":\"ping\"}\n");
+  const bool answered = peer.wait_for("\"fuzz-end\"", std::chrono::seconds(20));
+  EDM_FUZZ_CHECK(answered || peer.wait_closed(std::chrono::milliseconds(0)));
+  peer.close_input();
+  EDM_FUZZ_CHECK(peer.wait_closed(std::chrono::seconds(20)));
+  // Every line the server wrote is one JSON object.
+  const std::string written = peer.output();
+  std::string_view out = written;
+  while (!out.empty()) {
+    const std::size_t nl = out.find('\n');
+    EDM_FUZZ_CHECK(nl != std::string_view::npos);
+    check_out_line(std::string(out.substr(0, nl + 1)));
+    out.remove_prefix(nl + 1);
+  }
+}
+
 }  // namespace
 
 int protocol_one_input(const std::uint8_t* data, std::size_t size) {
@@ -93,6 +177,7 @@ int protocol_one_input(const std::uint8_t* data, std::size_t size) {
     }
     rest.remove_prefix(nl == std::string_view::npos ? rest.size() : nl + 1);
   }
+  through_a_session(std::string_view(reinterpret_cast<const char*>(data), size));
   return 0;
 }
 
