@@ -481,6 +481,34 @@ TEST_F(Hardening, state_changing_requests_are_audited_with_session_role_and_peer
   has(6, "op=estop -> forbidden");
 }
 
+// ---- 4. a repeating alarm: one event, then counted, and the count is visible ----------------
+
+TEST_F(Hardening, a_persisting_alarm_is_one_event_and_its_repeats_are_counted_in_tasks_stats) {
+  start();
+  EventSink sink;
+  Client c;
+  c.set_event_handler(sink.handler());
+  ASSERT_EQ(c.connect(client_opts()), Role::kOperator);
+  ASSERT_TRUE(c.subscribe({"alarm"}));
+  rt::Alarm a;
+  a.code = rt::AlarmCode::kWatchdogWarning;
+  a.severity = rt::AlarmSeverity::kWarning;
+  a.source = "test.raiser";
+  a.text = "persisting";
+  for (int i = 0; i < 500; ++i) {
+    rt_->machine().raise(a);
+  }
+  ASSERT_EQ(sink.wait_for("alarm", 1).size(), 1u);
+  const Reply r = c.request("tasks.stats");
+  ASSERT_TRUE(r) << r.message;
+  const Json& alarms = r.body["alarms"];
+  ASSERT_EQ(alarms["active"].size(), 1u) << alarms;
+  EXPECT_EQ(alarms["active"][0]["source"], "test.raiser");
+  EXPECT_EQ(alarms["active"][0]["count"], 500);
+  EXPECT_EQ(alarms["repeated"], 499);
+  EXPECT_EQ(sink.wait_for("alarm", 2, 300ms).size(), 1u) << "the repeats sent no events";
+}
+
 // ---- the in-memory transport: the dispatcher without a socket (fuzzing uses it) ------------
 
 TEST_F(Hardening, a_session_over_the_memory_transport_runs_the_real_dispatcher) {

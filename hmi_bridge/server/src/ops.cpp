@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <set>
@@ -407,6 +408,18 @@ Body op_tasks_stats(Session& s) {
   auto& srv = s.server();
   Json doc = Json::parse(rt::stats_to_json(srv.rt.stats_reports()));
   const ServerStats st = srv.stats_snapshot();
+  // Latched alarms and how often each repeated while latched (raised once, then counted).
+  std::array<rt::ActiveAlarm, 64> latched{};
+  const std::size_t n = srv.rt.machine().active_alarms(latched.data(), latched.size());
+  Json active = Json::array();
+  for (std::size_t i = 0; i < n; ++i) {
+    active.push_back({{"code", static_cast<int>(latched[i].code)},
+                      {"name", std::string(rt::to_string(latched[i].code))},
+                      {"source", std::string(latched[i].source)},
+                      {"first_t_s", rt::to_seconds(latched[i].first)},
+                      {"count", latched[i].count}});
+  }
+  doc["alarms"] = {{"active", std::move(active)}, {"repeated", srv.rt.machine().repeated_alarms()}};
   doc["bridge"] = {{"sessions_open", st.sessions_open},
                    {"sessions_pending", st.sessions_pending},
                    {"pending_evicted", st.pending_evicted},
