@@ -5,7 +5,10 @@
 # (tests/reference/traces.sha256); the CSVs are ~0.8 MB each.
 #
 #   tests/reference/record.sh                 record: run every config twice (determinism), write
-#                                             traces.sha256 (and vars/*.vars, see below)
+#                                             traces.sha256 (and vars/*.vars, see below), and
+#                                             jobs.fnv64 through edm_programs_tests (the job
+#                                             references: drill-sim/drill-fuzzy-sim running
+#                                             examples/parts/drill-then-finish.nc)
 #   tests/reference/record.sh --check         compare with traces.sha256 (ctest reference.traces)
 #   options: --edmplc PATH (default build/bin/edmplc), --keep DIR (keep the CSVs there, to diff
 #            them against a recording made at an older commit)
@@ -101,6 +104,17 @@ if [ "$mode" = record ]; then
   done
   cp "$tmp/sums" "$sums"
   echo "wrote $sums ($(wc -l < "$sums") configs, --run-for $run_for --seed $seed)"
+  # The job references (tests/programs/job_reference_test.cpp: EdmJob running a part program,
+  # which edmplc alone never does) are recorded by their own test.
+  programs_tests="$(dirname "$edmplc")/edm_programs_tests"
+  if [ -x "$programs_tests" ]; then
+    EDM_RECORD_REFERENCES=1 "$programs_tests" --gtest_filter='Shipped/JobReference.*' \
+      > "$tmp/out.txt" 2>&1 || { cat "$tmp/out.txt" >&2; exit 1; }
+    echo "wrote $ref_dir/jobs.fnv64 (edm_programs_tests)"
+  else
+    echo "reference: no $programs_tests: tests/reference/jobs.fnv64 not re-recorded" >&2
+    exit 1
+  fi
   exit 0
 fi
 
