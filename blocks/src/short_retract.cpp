@@ -59,15 +59,14 @@ std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup)
     return errs;
   }
   dt_s_ = rt::to_seconds(setup.period);
-  ring_.assign(static_cast<std::size_t>(params_.history_capacity), PathPoint{});
+  history_.allocate(static_cast<std::size_t>(params_.history_capacity));
   compute_ramp();
   activate();
   return errs;
 }
 
 void ShortRetract::activate() noexcept {
-  start_ = 0;
-  count_ = 0;
+  history_.clear();
   state_ = State::kIdle;
   pos_s_ = 0.0;
   target_s_ = 0.0;
@@ -103,19 +102,17 @@ void ShortRetract::compute_ramp() noexcept {
 }
 
 void ShortRetract::record(double x, double y, double z, bool force) noexcept {
-  const std::size_t cap = ring_.size();
-  if (count_ == 0) {
-    ring_[start_] = {x, y, z, 0.0};
-    count_ = 1;
+  if (history_.size() == 0) {
+    history_.push({x, y, z, 0.0});
     return;
   }
   // A back-off over the last segment unwinds the path instead of doubling it.
-  while (count_ >= 2) {
+  while (history_.size() >= 2) {
     const PathPoint& h = head();
-    const PathPoint& p = at(count_ - 2);
+    const PathPoint& p = at(history_.size() - 2);
     const double dot = (x - h.x) * (h.x - p.x) + (y - h.y) * (h.y - p.y) + (z - h.z) * (h.z - p.z);
     if (dot < 0.0 && distance(p.x, p.y, p.z, x, y, z) < h.s - p.s) {
-      --count_;
+      history_.pop_newest();
     } else {
       break;
     }
@@ -125,18 +122,12 @@ void ShortRetract::record(double x, double y, double z, bool force) noexcept {
   if (d <= 0.0 || (!force && d < params_.min_spacing_mm)) {
     return;
   }
-  const double s = h.s + d;
-  if (count_ == cap) {  // drop the oldest point
-    start_ = (start_ + 1) % cap;
-    --count_;
-  }
-  ring_[(start_ + count_) % cap] = {x, y, z, s};
-  ++count_;
+  history_.push({x, y, z, h.s + d});  // when full, the oldest point leaves
 }
 
 void ShortRetract::set_point_at(double s) noexcept {
   const PathPoint& a = at(seg_);
-  if (count_ < 2 || s <= a.s) {
+  if (history_.size() < 2 || s <= a.s) {
     sp_[0] = a.x;
     sp_[1] = a.y;
     sp_[2] = a.z;
@@ -158,7 +149,7 @@ void ShortRetract::set_point_at(double s) noexcept {
 void ShortRetract::start_retract(bool from_head) noexcept {
   if (from_head) {
     pos_s_ = head().s;
-    seg_ = count_ >= 2 ? count_ - 2 : 0;
+    seg_ = history_.size() >= 2 ? history_.size() - 2 : 0;
     s_at_short_ = pos_s_;
   }
   target_s_ = std::max(pos_s_ - params_.retract_distance_mm, at(0).s);
@@ -168,7 +159,7 @@ void ShortRetract::start_retract(bool from_head) noexcept {
 
 rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
   const ShortRetractParams& p = params_;
-  if (ring_.empty()) {  // not configured
+  if (history_.capacity() == 0) {  // not configured
     return rt::BlockStatus::kFault;
   }
   if (reset_.get()) {
@@ -183,8 +174,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
   double v_scale = 1.0;
   if (!enable_.get()) {
     state_ = State::kIdle;
-    count_ = 0;
-    start_ = 0;
+    history_.forget();  // O(1): record() never reads a slot it has not written
     short_count_ = 0;
     final_ = false;
     const double x = x_mm_.get();
@@ -252,7 +242,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
       case State::kResume: {
         const double s_head = head().s;
         pos_s_ = std::min(pos_s_ + p.resume_speed_mm_s * dt_s_, s_head);
-        while (seg_ + 2 < count_ && at(seg_ + 1).s < pos_s_) {
+        while (seg_ + 2 < history_.size() && at(seg_ + 1).s < pos_s_) {
           ++seg_;
         }
         v_scale = 0.0;

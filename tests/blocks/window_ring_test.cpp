@@ -64,5 +64,35 @@ TEST(WindowRing, capacity_one_is_the_last_sample) {
   EXPECT_TRUE(r.full());
 }
 
+TEST(WindowRing, pop_newest_unwinds_and_push_continues_after_it) {
+  WindowRing<int> r;
+  r.allocate(3);
+  for (int x = 1; x <= 4; ++x) {
+    r.push(x);  // window 2, 3, 4
+  }
+  r.pop_newest();
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r[0], 2);
+  EXPECT_EQ(r[1], 3);
+  r.push(9);
+  EXPECT_EQ(r[0], 2);
+  EXPECT_EQ(r[2], 9);
+  r.push(10);  // full: 2 leaves
+  EXPECT_EQ(r[0], 3);
+  EXPECT_EQ(r[2], 10);
+}
+
+TEST(WindowRing, forget_empties_in_place) {
+  WindowRing<int> r;
+  r.allocate(2);
+  r.push(1);
+  r.push(2);
+  r.forget();
+  EXPECT_EQ(r.size(), 0u);
+  r.push(5);
+  ASSERT_EQ(r.size(), 1u);
+  EXPECT_EQ(r[0], 5);
+}
+
 }  // namespace
 }  // namespace edm::blocks

@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -87,7 +88,7 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   /// The current state. For tests and diagnostics; not synchronised.
   [[nodiscard]] State state() const noexcept { return state_; }
   /// Points in the history. For tests and diagnostics; not synchronised.
-  [[nodiscard]] std::size_t history_size() const noexcept { return count_; }
+  [[nodiscard]] std::size_t history_size() const noexcept { return history_.size(); }
 
  protected:
   /// RT-safe. Recomputes the ramp length after a runtime write.
@@ -99,10 +100,8 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
     double s{0.0};  // arc-length coordinate [mm]
   };
 
-  [[nodiscard]] const PathPoint& at(std::size_t i) const noexcept {
-    return ring_[(start_ + i) % ring_.size()];
-  }
-  [[nodiscard]] const PathPoint& head() const noexcept { return at(count_ - 1); }
+  [[nodiscard]] const PathPoint& at(std::size_t i) const noexcept { return history_[i]; }
+  [[nodiscard]] const PathPoint& head() const noexcept { return at(history_.size() - 1); }
   void record(double x, double y, double z, bool force) noexcept;
   void start_retract(bool from_head) noexcept;
   void set_point_at(double s) noexcept;
@@ -123,9 +122,7 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   rt::Output<bool> alarm_out_;
   rt::Output<bool> hold_out_;
 
-  std::vector<PathPoint> ring_;  // sized in configure()
-  std::size_t start_{0};         // ring index of the oldest point
-  std::size_t count_{0};         // points in the history
+  WindowRing<PathPoint> history_;  // allocated in configure(); at(0) is the oldest point
   double dt_s_{0.0};
   State state_{State::kIdle};
   double pos_s_{0.0};           // arc coordinate of the setpoint while active

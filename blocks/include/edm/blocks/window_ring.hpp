@@ -1,8 +1,8 @@
 #pragma once
 // WindowRing<T>: the ring of the last N samples that the window blocks keep (MovingAverage,
-// TdDetector, GreyPredictorGM11). N comes from a load-time parameter, so the slots are allocated
-// once in configure() and never again; a push overwrites the oldest sample and hands it back, so
-// a block can keep a running sum without rescanning the window.
+// TdDetector, GreyPredictorGM11, ShortRetract's path history). N comes from a load-time parameter,
+// so the slots are allocated once in configure() and never again; a push overwrites the oldest
+// sample and hands it back, so a block can keep a running sum without rescanning the window.
 //
 // RT-safety: allocate() is not RT (allocates). Everything else is RT-safe: noexcept, O(1) (clear()
 // is O(N)), no allocation. Thread-safety: none (a block's own state, used by its task only).
@@ -28,6 +28,19 @@ class WindowRing {
     std::fill(slots_.begin(), slots_.end(), T{});
     next_ = 0;
     size_ = 0;
+  }
+
+  /// Empties the ring in O(1) without touching the slots: push() then hands back stale samples,
+  /// so only for a block that does not use push()'s return value. @note RT-safe.
+  void forget() noexcept {
+    next_ = 0;
+    size_ = 0;
+  }
+
+  /// Removes the newest sample. @pre size() > 0. @note RT-safe.
+  void pop_newest() noexcept {
+    next_ = next_ == 0 ? slots_.size() - 1 : next_ - 1;
+    --size_;
   }
 
   /// Appends x and returns what its slot held: the sample that left the window once the ring is
