@@ -154,7 +154,7 @@ TEST_F(EdmhmiProcessTest, MissingAndMalformedPartProgramsExitTwo) {
   start_plc();
   const Outcome missing = edmhmi({"run", dir_.file("nope.nc")});
   EXPECT_EQ(missing.code, 2);
-  EXPECT_NE(missing.err.find(dir_.file("nope.nc") + ": cannot open"), std::string::npos)
+  EXPECT_NE(missing.err.find(dir_.file("nope.nc") + ":1:1: cannot open"), std::string::npos)
       << missing.err;
   const std::string part = dir_.file("bad.nc");
   std::ofstream(part) << "G00 Z5\nE9\nM30\n";
