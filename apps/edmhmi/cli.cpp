@@ -9,14 +9,8 @@ namespace edmhmi {
 
 bool connect(edm::bridge::Client& client, const edm::hmi::ConnectionSettings& s,
              bool auto_reconnect) {
-  edm::bridge::ClientOptions o;
-  o.host = s.host;
-  o.port = s.port;
-  o.token = s.token;
+  edm::bridge::ClientOptions o = edm::hmi::client_options(s);
   o.auto_reconnect = auto_reconnect;
-  o.tls.enabled = !s.tls_ca_file.empty() || !s.tls_fingerprint.empty();
-  o.tls.ca_file = s.tls_ca_file;
-  o.tls.fingerprint = s.tls_fingerprint;
   try {
     client.connect(o);
     return true;

@@ -44,6 +44,17 @@ std::string read_token_file(const std::string& path) {
   return line;
 }
 
+bridge::ClientOptions client_options(const ConnectionSettings& s) {
+  bridge::ClientOptions o;
+  o.host = s.host;
+  o.port = s.port;
+  o.token = s.token;
+  o.tls.enabled = !s.tls_ca_file.empty() || !s.tls_fingerprint.empty();
+  o.tls.ca_file = s.tls_ca_file;
+  o.tls.fingerprint = s.tls_fingerprint;
+  return o;
+}
+
 ConnectionSettings resolve_connection(const ConnectionFlags& flags, EnvLookup env) {
   ConnectionSettings s;
   if (!flags.host.empty()) {

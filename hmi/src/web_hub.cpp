@@ -195,13 +195,8 @@ void WebHub::worker_loop(Worker& w) {
 
 bridge::Role WebHub::authenticate(const std::string& token) {
   bridge::Client probe;
-  bridge::ClientOptions o;
-  o.host = settings_.host;
-  o.port = settings_.port;
+  bridge::ClientOptions o = client_options(settings_);
   o.token = token;
-  o.tls.enabled = !settings_.tls_ca_file.empty() || !settings_.tls_fingerprint.empty();
-  o.tls.ca_file = settings_.tls_ca_file;
-  o.tls.fingerprint = settings_.tls_fingerprint;
   o.timeout = std::chrono::seconds(15);  // edmplc delays a hello after wrong ones (up to 10 s)
   const bridge::Role theirs = probe.connect(o);  // throws on a refused token
   probe.close();

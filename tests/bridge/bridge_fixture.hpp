@@ -3,7 +3,11 @@
 // ephemeral loopback port, and helpers to wait for events without sleeping.
 
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -11,39 +15,93 @@
 #include <condition_variable>
 #include <fstream>
 #include <mutex>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 #include "edm/bridge/client.hpp"
 #include "edm/bridge/server.hpp"
+#include "support/bridge_test_config.hpp"
 #include "support/runtime_fixture.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::bridge::test {
 
-inline const char* kBridgeTestConfig = R"(version: 1
-machine:
-  name: bridge-test
-  io: {driver: loopback, task: fast, params: {channels: 2}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Y, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
-  - name: fast
-    interval: 1ms
-    priority: 0
-    programs: [chain]
-programs:
-  - name: chain
-    blocks:
-      - {name: g, type: Gain, params: {k: 1.0, offset: 0.0}}
-    wires:
-      g.in: io.ai0
-      io.ao0: g.out
-)";
+using edm::test::kBridgeTestConfig;
+
+/// A raw TCP client: a socket that connects and then does only what the test says (never reads
+/// unless asked), for clients that misbehave on purpose.
+class RawSocket {
+ public:
+  explicit RawSocket(std::uint16_t port, int rcvbuf = 0) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (rcvbuf > 0) {
+      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+    }
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  }
+  ~RawSocket() { ::close(fd_); }
+  RawSocket(const RawSocket&) = delete;
+  RawSocket& operator=(const RawSocket&) = delete;
+  [[nodiscard]] bool ok() const { return ok_; }
+  /// Writes what the socket takes without blocking; returns the bytes written.
+  std::size_t send_some(std::string_view s) {
+    const ssize_t n = ::send(fd_, s.data(), s.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+    return n > 0 ? static_cast<std::size_t>(n) : 0;
+  }
+  void send(std::string_view s) {
+    std::size_t done = 0;
+    while (done < s.size()) {
+      const ssize_t n = ::send(fd_, s.data() + done, s.size() - done, MSG_NOSIGNAL);
+      if (n <= 0) {
+        return;
+      }
+      done += static_cast<std::size_t>(n);
+    }
+  }
+  /// Reads until `pred(all read so far)` or close/timeout; returns what was read.
+  template <class Pred>
+  std::string read_until(Pred pred, std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (!pred(buf_) && std::chrono::steady_clock::now() < end) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 20) > 0) {
+        char b[65536];
+        const ssize_t n = ::read(fd_, b, sizeof b);
+        if (n <= 0) {
+          closed_ = true;
+          break;
+        }
+        buf_.append(b, static_cast<std::size_t>(n));
+      }
+    }
+    return buf_;
+  }
+  std::string read_line(std::chrono::milliseconds timeout = std::chrono::seconds(5)) {
+    read_until([](const std::string& b) { return b.find('\n') != std::string::npos; }, timeout);
+    const auto nl = buf_.find('\n');
+    if (nl == std::string::npos) {
+      return "";
+    }
+    std::string line = buf_.substr(0, nl);
+    buf_.erase(0, nl + 1);
+    return line;
+  }
+  bool closed_within(std::chrono::milliseconds timeout) {
+    read_until([this](const std::string&) { return closed_; }, timeout);
+    return closed_;
+  }
+
+ private:
+  int fd_{-1};
+  bool ok_{false};
+  bool closed_{false};
+  std::string buf_;
+};
 
 /// Collects events from a Client's handler; waits with a deadline on a condition variable.
 class EventSink {

@@ -21,79 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using edm::test::MemoryPeer;
 
-/// A socket that connects and then does only what the test says (never reads unless asked).
-class Socket {
- public:
-  explicit Socket(std::uint16_t port, int rcvbuf = 0) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    if (rcvbuf > 0) {
-      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
-    }
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  }
-  ~Socket() { ::close(fd_); }
-  Socket(const Socket&) = delete;
-  Socket& operator=(const Socket&) = delete;
-  [[nodiscard]] bool ok() const { return ok_; }
-  /// Writes what the socket takes without blocking; returns the bytes written.
-  std::size_t send_some(std::string_view s) {
-    const ssize_t n = ::send(fd_, s.data(), s.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
-    return n > 0 ? static_cast<std::size_t>(n) : 0;
-  }
-  void send(std::string_view s) {
-    std::size_t done = 0;
-    while (done < s.size()) {
-      const ssize_t n = ::send(fd_, s.data() + done, s.size() - done, MSG_NOSIGNAL);
-      if (n <= 0) {
-        return;
-      }
-      done += static_cast<std::size_t>(n);
-    }
-  }
-  /// Reads until `pred(all read so far)` or close/timeout; returns what was read.
-  template <class Pred>
-  std::string read_until(Pred pred, std::chrono::milliseconds timeout) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (!pred(buf_) && std::chrono::steady_clock::now() < end) {
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, 20) > 0) {
-        char b[65536];
-        const ssize_t n = ::read(fd_, b, sizeof b);
-        if (n <= 0) {
-          closed_ = true;
-          break;
-        }
-        buf_.append(b, static_cast<std::size_t>(n));
-      }
-    }
-    return buf_;
-  }
-  std::string read_line(std::chrono::milliseconds timeout = 5s) {
-    read_until([](const std::string& b) { return b.find('\n') != std::string::npos; }, timeout);
-    const auto nl = buf_.find('\n');
-    if (nl == std::string::npos) {
-      return "";
-    }
-    std::string line = buf_.substr(0, nl);
-    buf_.erase(0, nl + 1);
-    return line;
-  }
-  bool closed_within(std::chrono::milliseconds timeout) {
-    read_until([this](const std::string&) { return closed_; }, timeout);
-    return closed_;
-  }
-
- private:
-  int fd_{-1};
-  bool ok_{false};
-  bool closed_{false};
-  std::string buf_;
-};
-
 Json parse(const std::string& line) { return Json::parse(line, nullptr, false); }
 
 template <class Pred>
@@ -152,7 +79,7 @@ TEST(StrictJson, nesting_is_bounded_and_duplicate_keys_are_refused) {
 
 TEST_F(Hardening, a_viewer_sending_deep_nesting_anywhere_gets_bad_json_and_the_server_lives) {
   start(with_tokens());
-  Socket s(server_->port());
+  RawSocket s(server_->port());
   ASSERT_TRUE(s.ok());
   s.send(std::string("{\"id\":1,\"op\":\"hello\",\"protocol\":1,\"token\":\"") + kViewer + "\"}\n");
   ASSERT_EQ(parse(s.read_line())["role"], "viewer");
@@ -190,7 +117,7 @@ TEST_F(Hardening, a_viewer_sending_deep_nesting_anywhere_gets_bad_json_and_the_s
 
 TEST_F(Hardening, a_repeated_op_key_is_bad_json_and_does_nothing) {
   start();
-  Socket s(server_->port());
+  RawSocket s(server_->port());
   s.send("{\"id\":1,\"op\":\"hello\",\"protocol\":1}\n");
   ASSERT_EQ(parse(s.read_line())["role"], "operator");
   for (const char* line :
@@ -214,9 +141,9 @@ TEST_F(Hardening, stalled_trace_status_and_alarm_subscribers_are_dropped_without
   start(o);
   // Several stalled subscribers of every kind, so a broadcast loop closes one while others
   // follow it in the registry.
-  std::vector<std::unique_ptr<Socket>> stalled;
+  std::vector<std::unique_ptr<RawSocket>> stalled;
   for (int i = 0; i < 6; ++i) {
-    auto s = std::make_unique<Socket>(server_->port(), /*rcvbuf=*/1024);
+    auto s = std::make_unique<RawSocket>(server_->port(), /*rcvbuf=*/1024);
     ASSERT_TRUE(s->ok());
     s->send("{\"id\":1,\"op\":\"hello\",\"protocol\":1}\n");
     ASSERT_FALSE(s->read_line().empty());
@@ -241,7 +168,7 @@ TEST_F(Hardening, pipelined_requests_whose_replies_are_not_read_are_bounded_in_b
   o.queue_bytes = 64 * 1024;
   o.send_buffer_bytes = 4096;
   start(o);
-  Socket s(server_->port(), /*rcvbuf=*/2048);
+  RawSocket s(server_->port(), /*rcvbuf=*/2048);
   s.send("{\"id\":0,\"op\":\"hello\",\"protocol\":1}\n");
   ASSERT_FALSE(s.read_line().empty());
   // var.list replies are large: thousands pipelined would be megabytes queued per session.
@@ -328,9 +255,9 @@ TEST_F(Hardening, silent_sockets_never_lock_the_operator_out) {
   o.max_pending = 8;
   o.hello_timeout = 500ms;
   start(o);
-  std::vector<std::unique_ptr<Socket>> silent;
+  std::vector<std::unique_ptr<RawSocket>> silent;
   for (int i = 0; i < 40; ++i) {  // far more than every cap
-    silent.push_back(std::make_unique<Socket>(server_->port()));
+    silent.push_back(std::make_unique<RawSocket>(server_->port()));
   }
   // A viewer fills what viewers may have; the operator still gets in, at once.
   Client viewer;
@@ -355,8 +282,8 @@ TEST_F(Hardening, a_blank_line_keeps_a_session_alive_but_not_past_the_hello_dead
   o.read_timeout = 400ms;
   o.hello_timeout = 400ms;
   start(o);
-  Socket pre(server_->port());
-  Socket s(server_->port());
+  RawSocket pre(server_->port());
+  RawSocket s(server_->port());
   s.send("{\"id\":1,\"op\":\"hello\",\"protocol\":1}\n");
   ASSERT_FALSE(s.read_line().empty());
   // 2 s of keep-alives, one every 100 ms: five read timeouts' worth.
@@ -401,9 +328,9 @@ TEST_F(Hardening, wrong_hellos_are_throttled_logged_and_a_right_token_still_gets
   start(with_tokens());
   // 30 guesses on 30 parallel connections, as fast as the client can send them.
   const auto sent_at = std::chrono::steady_clock::now();  // before the first failure
-  std::vector<std::unique_ptr<Socket>> guessers;
+  std::vector<std::unique_ptr<RawSocket>> guessers;
   for (int i = 0; i < 30; ++i) {
-    guessers.push_back(std::make_unique<Socket>(server_->port()));
+    guessers.push_back(std::make_unique<RawSocket>(server_->port()));
     guessers.back()->send("{\"id\":1,\"op\":\"hello\",\"protocol\":1,\"token\":\"guess-" +
                           std::to_string(i) + "-xxxxxxxxxxxx\"}\n");
   }

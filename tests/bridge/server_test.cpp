@@ -35,68 +35,7 @@ std::vector<MotionBlock> line_program(std::size_t n) {
   return p;
 }
 
-/// A raw TCP client: a socket and nothing else (for clients that misbehave on purpose).
-class RawClient {
- public:
-  RawClient(std::uint16_t port, int rcvbuf = 0) {
-    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
-    if (rcvbuf > 0) {
-      ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
-    }
-    sockaddr_in a{};
-    a.sin_family = AF_INET;
-    a.sin_port = htons(port);
-    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ok_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  }
-  ~RawClient() { ::close(fd_); }
-  [[nodiscard]] bool ok() const { return ok_; }
-  void send(const std::string& s) {
-    ASSERT_EQ(::write(fd_, s.data(), s.size()), static_cast<ssize_t>(s.size()));
-  }
-  /// The next line from the server ("" on close or timeout).
-  std::string read_line(std::chrono::milliseconds timeout) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    while (buf_.find('\n') == std::string::npos && std::chrono::steady_clock::now() < end) {
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, 50) > 0) {
-        char b[4096];
-        const ssize_t n = ::read(fd_, b, sizeof b);
-        if (n <= 0) {
-          break;
-        }
-        buf_.append(b, static_cast<std::size_t>(n));
-      }
-    }
-    const auto nl = buf_.find('\n');
-    if (nl == std::string::npos) {
-      return "";
-    }
-    std::string line = buf_.substr(0, nl);
-    buf_.erase(0, nl + 1);
-    return line;
-  }
-  /// True when the server closed the connection within `timeout` (reads and discards data).
-  bool closed_within(std::chrono::milliseconds timeout) {
-    const auto end = std::chrono::steady_clock::now() + timeout;
-    char buf[4096];
-    while (std::chrono::steady_clock::now() < end) {
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, 50) > 0) {
-        const ssize_t n = ::read(fd_, buf, sizeof buf);
-        if (n <= 0) {
-          return true;
-        }
-      }
-    }
-    return false;
-  }
-
- private:
-  int fd_{-1};
-  bool ok_{false};
-  std::string buf_;
-};
+using RawClient = RawSocket;
 
 class Bridge : public BridgeFixture {};
 

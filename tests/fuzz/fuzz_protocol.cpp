@@ -22,6 +22,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "fuzz/fuzz_entry.hpp"
+#include "support/bridge_test_config.hpp"
 #include "support/memory_transport.hpp"
 
 namespace edm::fuzz {
@@ -108,26 +109,7 @@ struct SessionHarness {
 #endif
     blocks::register_builtin_blocks(blocks);
     rt::register_runtime_drivers(drivers);
-    const rt::Config cfg = rt::parse_config_text(R"(version: 1
-machine:
-  name: fuzz
-  io: {driver: loopback, task: fast, params: {channels: 2}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
-  - {name: fast, interval: 1ms, priority: 0, programs: [chain]}
-programs:
-  - name: chain
-    blocks:
-      - {name: g, type: Gain, params: {k: 1.0, offset: 0.0}}
-    wires:
-      g.in: io.ai0
-      io.ao0: g.out
-)",
-                                                 "fuzz.yaml");
+    const rt::Config cfg = rt::parse_config_text(test::kBridgeTestConfig, "fuzz.yaml");
     runtime = rt::Runtime::build(cfg, blocks, drivers);
     bridge::ServerOptions o;
     o.port = 0;  // listens on an ephemeral loopback port nobody dials

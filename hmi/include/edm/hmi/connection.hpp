@@ -16,13 +16,15 @@
 #include <string>
 #include <string_view>
 
+#include "edm/bridge/client.hpp"
+
 namespace edm::hmi {
 
 struct ConnectionSettings {
   std::string host{"127.0.0.1"};
   std::uint16_t port{7730};
-  std::string token;         // empty: none
-  std::string token_source;  // "--token-file F", "$EDM_TOKEN_FILE F", "$EDM_TOKEN" or ""
+  std::string token;            // empty: none
+  std::string token_source;     // "--token-file F", "$EDM_TOKEN_FILE F", "$EDM_TOKEN" or ""
   std::string tls_ca_file;      // TLS on when this or tls_fingerprint is set
   std::string tls_fingerprint;  // SHA-256, hex, colons optional
 };
@@ -45,6 +47,9 @@ using EnvLookup = const char* (*)(const char* name);
 
 /// Resolves the settings in the order above. Throws SettingsError.
 ConnectionSettings resolve_connection(const ConnectionFlags& flags, EnvLookup env);
+
+/// The client library's options for these settings (host, port, token, TLS).
+bridge::ClientOptions client_options(const ConnectionSettings& s);
 
 /// Reads a token file: the first line, trimmed; refuses a missing, unreadable or empty file.
 std::string read_token_file(const std::string& path);
