@@ -203,8 +203,8 @@ int main(int argc, char** argv) {
       } catch (const edm::bridge::BridgeError& e) {
         edm::rt::shutdown_logging();
         std::cerr << (bs.loc.file.empty() ? opt.config : bs.loc.file) << ":"
-                  << std::max(bs.loc.line, 1) << ":" << std::max(bs.loc.col, 1) << ": "
-                  << e.what() << "\n";
+                  << std::max(bs.loc.line, 1) << ":" << std::max(bs.loc.col, 1) << ": " << e.what()
+                  << "\n";
         return kExitBadInput;
       }
     }

@@ -302,11 +302,10 @@ void Parser::parse_trace(const Value& v, TraceSpec& out) {
 
 void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
   out.loc = v.loc;
-  auto m =
-      r_.map(v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions",
-                 "max_line_bytes", "read_timeout", "queue_limit", "stall_timeout", "status_vars",
-                 "queue_bytes", "max_pending", "hello_timeout", "tls", "insecure_plaintext",
-                 "audit_file"});
+  auto m = r_.map(
+      v, {"bind", "port", "token_file", "viewer_token_file", "max_sessions", "max_line_bytes",
+          "read_timeout", "queue_limit", "stall_timeout", "status_vars", "queue_bytes",
+          "max_pending", "hello_timeout", "tls", "insecure_plaintext", "audit_file"});
   if (!m) {
     return;
   }

@@ -123,10 +123,10 @@ struct BridgeSpec {
   std::size_t queue_bytes{std::size_t{4} << 20};    // queued bytes per session (replies + events)
   int max_pending{16};                              // connections that have not said hello yet
   Duration hello_timeout{std::chrono::seconds(5)};  // no valid hello this soon: close
-  std::string tls_cert;            // PEM certificate chain; with tls_key: the bridge speaks TLS
-  std::string tls_key;             // PEM private key
-  bool insecure_plaintext{false};  // a network bind without TLS (loud opt-out)
-  std::string audit_file;          // state-changing ops are appended here too (and always logged)
+  std::string tls_cert;              // PEM certificate chain; with tls_key: the bridge speaks TLS
+  std::string tls_key;               // PEM private key
+  bool insecure_plaintext{false};    // a network bind without TLS (loud opt-out)
+  std::string audit_file;            // state-changing ops are appended here too (and always logged)
   std::vector<NameRef> status_vars;  // key pins of the status snapshot (default: docs/protocol.md)
   SourceLoc loc;
   SourceLoc tls_loc;  // where `tls:` is, for errors about its files
