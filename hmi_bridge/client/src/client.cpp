@@ -9,13 +9,14 @@
 #include <boost/asio/ssl.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/write.hpp>
-#include <cctype>
 #include <condition_variable>
 #include <deque>
 #include <future>
 #include <map>
 #include <mutex>
 #include <thread>
+
+#include "client_tls.hpp"
 
 namespace edm::bridge {
 
@@ -57,40 +58,7 @@ Reply to_reply(Json j) {
   return r;
 }
 
-/// SHA-256 of the peer's certificate (DER), as lower-case hex without separators.
-std::string peer_fingerprint(SSL* ssl) {
-  X509* cert = SSL_get1_peer_certificate(ssl);
-  if (cert == nullptr) {
-    return "";
-  }
-  unsigned char md[EVP_MAX_MD_SIZE];
-  unsigned int n = 0;
-  const int ok = X509_digest(cert, EVP_sha256(), md, &n);
-  X509_free(cert);
-  if (ok != 1) {
-    return "";
-  }
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string out;
-  for (unsigned int i = 0; i < n; ++i) {
-    out += kHex[md[i] >> 4];
-    out += kHex[md[i] & 0xF];
-  }
-  return out;
-}
-
 }  // namespace
-
-std::string normalise_fingerprint(std::string_view text) {
-  std::string out;
-  for (const char ch : text) {
-    if (ch == ':' || ch == ' ') {
-      continue;
-    }
-    out += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  }
-  return out;
-}
 
 /// One TCP connection, with TLS over it when the options ask; touched only on the I/O thread
 /// once started.
@@ -391,37 +359,11 @@ struct Client::Impl : std::enable_shared_from_this<Impl> {
   /// or a pinned SHA-256 fingerprint of its certificate. Throws ClientError.
   void tls_handshake(const std::shared_ptr<Conn>& c, const ClientOptions& o) {
     const std::string where = "bridge: TLS to " + o.host + ":" + std::to_string(o.port) + ": ";
-    c->tls_ctx = std::make_shared<asio::ssl::context>(asio::ssl::context::tls_client);
-    c->tls_ctx->set_options(asio::ssl::context::default_workarounds | asio::ssl::context::no_sslv2 |
-                            asio::ssl::context::no_sslv3 | asio::ssl::context::no_tlsv1 |
-                            asio::ssl::context::no_tlsv1_1);
-    boost::system::error_code ec;
-    if (!o.tls.ca_file.empty()) {
-      c->tls_ctx->load_verify_file(o.tls.ca_file, ec);
-      if (ec) {
-        throw ClientError(where + "CA file " + o.tls.ca_file + ": " + ec.message());
-      }
-      c->tls_ctx->set_verify_mode(asio::ssl::verify_peer);
-    } else if (o.tls.fingerprint.empty()) {
-      throw ClientError(where + "no way to verify the server: give a CA file or a fingerprint");
-    } else {
-      c->tls_ctx->set_verify_mode(asio::ssl::verify_none);  // the pin is checked below
-    }
+    c->tls_ctx = make_client_tls_context(o.tls, where);
     c->tls.emplace(c->socket, *c->tls_ctx);
     SSL* ssl = c->tls->native_handle();
     if (!o.tls.ca_file.empty()) {
-      // The certificate must name the host we dialled (an IP SAN for an address).
-      boost::system::error_code aec;
-      asio::ip::make_address(o.host, aec);
-      X509_VERIFY_PARAM* param = SSL_get0_param(ssl);
-      const int ok = aec ? X509_VERIFY_PARAM_set1_host(param, o.host.c_str(), 0)
-                         : X509_VERIFY_PARAM_set1_ip_asc(param, o.host.c_str());
-      if (ok != 1) {
-        throw ClientError(where + "cannot set the name to verify");
-      }
-      if (aec) {
-        SSL_set_tlsext_host_name(ssl, o.host.c_str());
-      }
+      expect_host_name(ssl, o.host, where);
     }
     std::promise<boost::system::error_code> done;
     auto f = done.get_future();
