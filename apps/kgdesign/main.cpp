@@ -1,5 +1,6 @@
 // edm-kgdesign — the ISE-optimal gain of the P gap controller Vz = Kg·(Tdr − Td) (SEEDS 004
-// eq. 1–3) for a linearised gap + Z-axis model; see edm/blocks/kg_design.hpp and docs/blocks.md.
+// eq. 1–3) for a linearised gap + Z-axis model, its Td slope from the simulator's law; see
+// kg_design.hpp, td_law.hpp and docs/blocks.md.
 // Exit codes: 0 ok, 2 bad arguments or invalid model.
 
 #include <cmath>
@@ -12,14 +13,15 @@
 #include <string_view>
 
 #include "cli_number.hpp"
-#include "edm/blocks/kg_design.hpp"
+#include "kg_design.hpp"
+#include "td_law.hpp"
 
 namespace {
 
-using edm::blocks::AxisOrder;
-using edm::blocks::GapLoopModel;
-using edm::blocks::KgDesignStatus;
-using edm::blocks::TdMedianLaw;
+using edm::kgdesign::AxisOrder;
+using edm::kgdesign::GapLoopModel;
+using edm::kgdesign::KgDesignStatus;
+using edm::kgdesign::TdMedianLaw;
 
 constexpr int kExitOk = 0;
 constexpr int kExitBadInput = 2;
@@ -116,11 +118,11 @@ int main(int argc, char** argv) {
 
   if (debris) law.debris = *debris;
   if (const auto errs = law.validate(); !errs.empty()) return bad("Td law: " + errs.front());
-  const double gap = gap_um.value_or(law.g_r_um);
+  const double gap = gap_um.value_or(law.params.td_gap_ref_um);
   if (gap_um && !(gap > 0.0)) return bad("--gap-um must be > 0");
 
   GapLoopModel m;
-  m.kd_us_per_um = kd.value_or(edm::blocks::td_gap_slope_us_per_um(law, gap));
+  m.kd_us_per_um = kd.value_or(edm::kgdesign::td_gap_slope_us_per_um(law, gap));
   if (tau_v_ms) {
     m.axis.order = AxisOrder::kFirstOrder;
     m.axis.tau_v_s = *tau_v_ms * 1e-3;
@@ -134,7 +136,7 @@ int main(int argc, char** argv) {
   if (const auto errs = m.validate(); !errs.empty()) return bad("model: " + errs.front());
   if (kg_eval && !(*kg_eval > 0.0)) return bad("--kg must be > 0");
 
-  const auto r = edm::blocks::optimal_kg(m);
+  const auto r = edm::kgdesign::optimal_kg(m);
   if (r.status == KgDesignStatus::kInvalidModel) return bad("model: " + r.errors.front());
 
   std::printf("edm-kgdesign: ISE-optimal Kg of the P gap controller Vz = Kg*(Tdr - Td)\n");
@@ -143,10 +145,10 @@ int main(int argc, char** argv) {
     std::printf("  kd              %.6g us/um (given)\n", m.kd_us_per_um);
   } else {
     std::printf("  Td law (%s)   tau_med = %g + %g*exp((g - %g)/%g)*exp(-%g*%g) us\n",
-                law_name.c_str(), law.tau_min_us, law.tau_r_us, law.g_r_um, law.l_g_um, law.k_cd,
-                law.debris);
+                law_name.c_str(), law.params.td_tau_min_us, law.params.td_tau_ref_us,
+                law.params.td_gap_ref_um, law.params.td_len_um, law.params.td_debris_k, law.debris);
     std::printf("  working gap     %g um, Td median %.4g us (the Tdr that holds it)\n", gap,
-                edm::blocks::td_median_us(law, gap));
+                edm::kgdesign::td_median_us(law, gap));
     std::printf("  kd              %.6g us/um (slope of the law at the gap)\n", m.kd_us_per_um);
   }
   if (m.axis.order == AxisOrder::kFirstOrder) {
@@ -169,7 +171,7 @@ int main(int argc, char** argv) {
   std::printf("design\n");
   if (std::isfinite(r.critical_kg)) {
     std::printf("  Kg critical     %.6g (mm/s)/us (stability limit, K = %.6g 1/s)\n", r.critical_kg,
-                edm::blocks::loop_gain_per_s(m, r.critical_kg));
+                edm::kgdesign::loop_gain_per_s(m, r.critical_kg));
   } else {
     std::printf("  Kg critical     none (stable for every Kg > 0)\n");
   }
@@ -186,7 +188,7 @@ int main(int argc, char** argv) {
     print_poles(r.poles);
   }
   if (kg_eval) {
-    const double j = edm::blocks::ise_for_kg(m, *kg_eval);
+    const double j = edm::kgdesign::ise_for_kg(m, *kg_eval);
     std::printf("at --kg %g (mm/s)/us\n", *kg_eval);
     if (std::isfinite(j)) {
       std::printf("  J               %.6g us^2*s (%.3g x the optimum)\n", j,
@@ -194,8 +196,8 @@ int main(int argc, char** argv) {
     } else {
       std::printf("  J               inf (closed loop unstable)\n");
     }
-    const auto t = edm::blocks::error_transfer(m, *kg_eval);
-    print_poles(edm::blocks::polynomial_roots(t.a));
+    const auto t = edm::kgdesign::error_transfer(m, *kg_eval);
+    print_poles(edm::kgdesign::polynomial_roots(t.a));
   }
   return kExitOk;
 }

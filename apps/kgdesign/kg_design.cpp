@@ -1,4 +1,4 @@
-#include "edm/blocks/kg_design.hpp"
+#include "kg_design.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
-namespace edm::blocks {
+namespace edm::kgdesign {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -59,29 +59,6 @@ double critical_loop_gain(const std::vector<double>& d) {
 }
 
 }  // namespace
-
-std::vector<std::string> TdMedianLaw::validate() const {
-  std::vector<std::string> errs;
-  if (!std::isfinite(tau_min_us) || tau_min_us < 0.0) errs.emplace_back("tau_min_us must be >= 0");
-  if (!finite_positive(tau_r_us)) errs.emplace_back("tau_r_us must be > 0");
-  if (!std::isfinite(g_r_um)) errs.emplace_back("g_r_um must be finite");
-  if (!finite_positive(l_g_um)) errs.emplace_back("l_g_um must be > 0");
-  if (!std::isfinite(k_cd) || k_cd < 0.0) errs.emplace_back("k_cd must be >= 0");
-  if (!std::isfinite(debris) || debris < 0.0 || debris > 1.0) {
-    errs.emplace_back("debris must be in [0, 1]");
-  }
-  return errs;
-}
-
-double td_median_us(const TdMedianLaw& law, double gap_um) {
-  return law.tau_min_us + law.tau_r_us * std::exp((gap_um - law.g_r_um) / law.l_g_um) *
-                              std::exp(-law.k_cd * law.debris);
-}
-
-double td_gap_slope_us_per_um(const TdMedianLaw& law, double gap_um) {
-  return law.tau_r_us / law.l_g_um * std::exp((gap_um - law.g_r_um) / law.l_g_um) *
-         std::exp(-law.k_cd * law.debris);
-}
 
 std::vector<std::string> GapLoopModel::validate() const {
   std::vector<std::string> errs;
@@ -324,4 +301,4 @@ KgDesignResult optimal_kg(const GapLoopModel& m) {
   return r;
 }
 
-}  // namespace edm::blocks
+}  // namespace edm::kgdesign

@@ -4,7 +4,8 @@
 // the closed-form tables of integral-square values (Jury & Dewey 1965) for orders 1…4.
 //
 // Linearised loop (units: gap µm, Td µs, time s, Vz mm/s, Kg (mm/s)/µs):
-//   Td:    ΔTd = kd·Δg,  kd = dτ_med/dg at the working gap [µs/µm] (td_gap_slope_us_per_um)
+//   Td:    ΔTd = kd·Δg,  kd = dτ_med/dg at the working gap [µs/µm], the slope of the
+//          simulator's own law (td_law.hpp, td_gap_slope_us_per_um)
 //   gap:   Δg' = 1000·vz − erosion  [µm/s]; vz the Z velocity in mm/s, Z positive upward, so a
 //          positive vz (back off) opens the gap. The erosion rate is a disturbance, dropped here.
 //   axis:  velocity command → velocity, G_axis(0) = 1, either first order 1/(τ_v·s + 1)
@@ -19,7 +20,8 @@
 // grows, so ISE has no finite minimiser; optimal_kg() says so (kNoFiniteMinimum) rather than
 // returning an arbitrary large gain.
 //
-// Non-RT design helpers (allocate, may throw std::invalid_argument on malformed polynomials).
+// An offline tool, not a block (DESIGN §3): the library of edm-kgdesign and its test. Non-RT
+// design helpers (allocate, may throw std::invalid_argument on malformed polynomials).
 // Thread-safe: pure functions, no shared state.
 
 #include <complex>
@@ -27,30 +29,7 @@
 #include <string>
 #include <vector>
 
-namespace edm::blocks {
-
-/// Median ignition delay vs gap (PLANT-MODEL §6.2 step 4):
-///   τ_med(g) = τ_min + τ_r·e^((g − g_r)/ℓ_g)·e^(−k_cd·c)
-struct TdMedianLaw {
-  double tau_min_us{0.5};  // floor of the median [µs]
-  double tau_r_us{5.0};    // median excess at the reference gap [µs]
-  double g_r_um{20.0};     // reference gap [µm]
-  double l_g_um{7.0};      // gap per e-fold [µm], > 0
-  double k_cd{2.0};        // debris sensitivity [–]
-  double debris{0.0};      // debris concentration c ∈ [0, 1] at the working point [–]
-
-  /// PLANT-MODEL §6.5 DRILL defaults (g_r 20 µm, τ_r 5 µs, ℓ_g 7 µm, τ_min 0.5 µs, k_cd 2).
-  [[nodiscard]] static TdMedianLaw drill() { return {}; }
-  /// PLANT-MODEL §6.5 SINK defaults (g_r 50 µm, τ_r 10 µs, ℓ_g 15 µm, τ_min 1 µs, k_cd 2).
-  [[nodiscard]] static TdMedianLaw sink() { return {1.0, 10.0, 50.0, 15.0, 2.0, 0.0}; }
-  /// Empty means valid.
-  [[nodiscard]] std::vector<std::string> validate() const;
-};
-
-/// τ_med at gap_um [µs].
-[[nodiscard]] double td_median_us(const TdMedianLaw& law, double gap_um);
-/// kd = dτ_med/dg = (τ_r/ℓ_g)·e^((g − g_r)/ℓ_g)·e^(−k_cd·c) [µs/µm], the slope at gap_um.
-[[nodiscard]] double td_gap_slope_us_per_um(const TdMedianLaw& law, double gap_um);
+namespace edm::kgdesign {
 
 enum class AxisOrder { kFirstOrder, kSecondOrder };
 
@@ -123,4 +102,4 @@ struct KgDesignResult {
 /// then golden-section search on ln Kg to a relative width of 1e-10.
 [[nodiscard]] KgDesignResult optimal_kg(const GapLoopModel& m);
 
-}  // namespace edm::blocks
+}  // namespace edm::kgdesign

@@ -1,4 +1,6 @@
-#include "edm/blocks/kg_design.hpp"
+// The Kg design of apps/kgdesign (seed 004 eq. 2-3): ISE tables, stability, the optimum, and the
+// Td slope taken from the simulator's law.
+#include "kg_design.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +16,11 @@
 #include <string>
 #include <vector>
 
-namespace edm::blocks {
+#include "edm/sim/gap_model.hpp"
+#include "edm/sim/params.hpp"
+#include "td_law.hpp"
+
+namespace edm::kgdesign {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -340,22 +346,56 @@ TEST(KgDesignOptimumOrderTwo, invalid_model_is_reported) {
   EXPECT_EQ(r.errors.size(), 2u);
 }
 
-// (d) kd against central differences of the median law.
-TEST(KgDesignSlope, kd_matches_finite_differences_of_the_td_law) {
+// (d) The Td law is the simulator's, and kd is its slope: against the closed forms of the exp law
+// (drill, sink) and of the wire preset's quadratic law, written out here as an independent check.
+TEST(KgDesignSlope, td_law_is_the_simulators_gap_model) {
+  for (TdMedianLaw law : {TdMedianLaw::drill(), TdMedianLaw::sink()}) {
+    law.debris = 0.3;
+    const sim::GapModel model(law.params);
+    for (double g = 2.0; g <= 60.0; g += 3.5) {
+      EXPECT_EQ(td_median_us(law, g), model.td_median_us(g, 0.3)) << "g " << g;
+    }
+  }
+  EXPECT_EQ(TdMedianLaw::drill().params.td_gap_ref_um,
+            sim::SimParams::preset("drill")->td_gap_ref_um);
+  EXPECT_EQ(TdMedianLaw::sink().params.td_len_um, sim::SimParams::preset("sink")->td_len_um);
+}
+
+TEST(KgDesignSlope, kd_matches_the_closed_form_slope_of_the_exp_law) {
   for (TdMedianLaw law : {TdMedianLaw::drill(), TdMedianLaw::sink()}) {
     for (const double debris : {0.0, 0.3}) {
       law.debris = debris;
       EXPECT_TRUE(law.validate().empty());
+      const sim::SimParams& p = law.params;
       for (double g = 2.0; g <= 60.0; g += 3.5) {
-        const double h = 1e-3;
-        const double fd = (td_median_us(law, g + h) - td_median_us(law, g - h)) / (2.0 * h);
-        EXPECT_NEAR(td_gap_slope_us_per_um(law, g), fd, 1e-6 * std::abs(fd)) << "g " << g;
+        const double exact = p.td_tau_ref_us / p.td_len_um *
+                             std::exp((g - p.td_gap_ref_um) / p.td_len_um) *
+                             std::exp(-p.td_debris_k * debris);
+        EXPECT_NEAR(td_gap_slope_us_per_um(law, g), exact, 1e-11 * exact) << "g " << g;
       }
     }
   }
   // At the reference gap of the DRILL law: τ_med = τ_min + τ_r, kd = τ_r/ℓ_g.
   EXPECT_DOUBLE_EQ(td_median_us(TdMedianLaw::drill(), 20.0), 5.5);
-  EXPECT_DOUBLE_EQ(td_gap_slope_us_per_um(TdMedianLaw::drill(), 20.0), 5.0 / 7.0);
+  EXPECT_NEAR(td_gap_slope_us_per_um(TdMedianLaw::drill(), 20.0), 5.0 / 7.0, 1e-12);
+}
+
+TEST(KgDesignSlope, kd_follows_the_wire_presets_quadratic_law) {
+  TdMedianLaw law{*sim::SimParams::preset("wire"), 0.0};
+  ASSERT_TRUE(law.validate().empty());
+  const sim::SimParams& p = law.params;
+  for (const double g : {6.0, 10.0, 15.0, 20.0}) {  // above the vertex, below the cut-off
+    EXPECT_NEAR(td_gap_slope_us_per_um(law, g), 2.0 * p.td_quad_a_us * g + p.td_quad_b_us, 1e-10)
+        << "g " << g;
+  }
+}
+
+TEST(KgDesignSlope, debris_outside_zero_to_one_is_reported) {
+  TdMedianLaw law = TdMedianLaw::drill();
+  law.debris = 1.5;
+  const auto errs = law.validate();
+  ASSERT_EQ(errs.size(), 1u);
+  EXPECT_EQ(errs.front(), "debris must be in [0, 1]");
 }
 
 TEST(KgDesignSlope, polynomial_roots_recover_known_poles) {
@@ -371,4 +411,4 @@ TEST(KgDesignSlope, polynomial_roots_recover_known_poles) {
 }
 
 }  // namespace
-}  // namespace edm::blocks
+}  // namespace edm::kgdesign
