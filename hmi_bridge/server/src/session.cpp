@@ -195,6 +195,10 @@ void Session::on_read(boost::system::error_code ec, std::size_t n) {
 // Frames and runs the requests of the last read, but only while the reply queue has room: a
 // client that pipelines requests without reading replies stops being read, mid-read if need
 // be, so its replies never take more than about queue_bytes.
+// Framed by hand, not with asio::async_read_until as the client is: the session reads through
+// the type-erased Transport (TCP, TLS, the fuzzer's in-memory stream), which is no
+// AsyncReadStream; a too-long line is answered too_large and skipped to its '\n' while the
+// session goes on, and read_until's not_found would leave that skipping to code like this anyway.
 void Session::process_input() {
   const std::size_t limit = role_ ? server_.opt.max_line_bytes : kPreAuthLineBytes;
   std::size_t used = 0;
