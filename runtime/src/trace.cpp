@@ -12,11 +12,8 @@
 #include <iterator>
 #include <stdexcept>
 #include <system_error>
-#include <type_traits>
 
 namespace edm::rt {
-
-static_assert(std::is_trivially_copyable_v<TraceSample>, "trace samples are copied as bytes");
 
 namespace {
 
@@ -58,8 +55,7 @@ struct TraceRecorder::Channel {
   const std::uint32_t id;
   const std::string task_name;  // already CSV-quoted if needed
   const std::size_t first_column;
-  std::uint32_t n{0};
-  std::array<PinRef, kMaxTraceVarsPerTask> pins{};
+  PinSampler sampler;
   std::vector<std::string> column_names;  // already CSV-quoted if needed
 
   boost::lockfree::spsc_queue<TraceSample> ring;
@@ -104,12 +100,14 @@ std::uint32_t TraceRecorder::add_channel(std::string task_name,
   }
   const auto id = static_cast<std::uint32_t>(channels_.size());
   auto ch = std::make_unique<Channel>(id, csv_field(task_name), total_columns_, capacity);
-  ch->n = static_cast<std::uint32_t>(vars.size());
+  std::vector<PinRef> pins;
+  pins.reserve(vars.size());
   ch->column_names.reserve(vars.size());
-  for (std::size_t i = 0; i < vars.size(); ++i) {
-    ch->pins[i] = vars[i].second;
-    ch->column_names.push_back(csv_field(vars[i].first));
+  for (const auto& [name, ref] : vars) {
+    pins.push_back(ref);
+    ch->column_names.push_back(csv_field(name));
   }
+  ch->sampler.assign(pins);
   total_columns_ += vars.size();
   channels_.push_back(std::move(ch));
   return id;
@@ -120,15 +118,7 @@ void TraceRecorder::sample(std::uint32_t channel, TimePoint release, std::uint64
     return;
   }
   Channel& ch = *channels_[channel];
-  TraceSample s;
-  s.release = release;
-  s.cycle = cycle;
-  s.channel = channel;
-  s.n = ch.n;
-  for (std::uint32_t i = 0; i < ch.n; ++i) {
-    s.v[i] = read_pin_as_double(ch.pins[i]);
-  }
-  if (!ch.ring.push(s)) {
+  if (!ch.ring.push(ch.sampler.sample(release, cycle, channel))) {
     ch.dropped.fetch_add(1, std::memory_order_relaxed);
   }
 }
@@ -177,7 +167,7 @@ std::size_t TraceRecorder::drain_locked(std::ostream& out) {
     append_seconds(row_, s.release);
     fmt::format_to(std::back_inserter(row_), ",{},{}", next->task_name, s.cycle);
     const std::size_t first = next->first_column;
-    const std::size_t n = std::min<std::size_t>(s.n, next->n);
+    const std::size_t n = std::min<std::size_t>(s.n, next->sampler.size());
     for (std::size_t col = 0; col < total_columns_; ++col) {
       row_ += ',';
       if (col >= first && col < first + n) {

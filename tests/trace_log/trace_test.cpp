@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "edm/runtime/pin.hpp"
+#include "edm/runtime/pin_sampler.hpp"
 
 namespace edm::rt {
 namespace {
@@ -67,6 +68,46 @@ std::string read_file(const std::string& path) {
 std::string temp_path(const std::string& name) {
   return ::testing::TempDir() + "edm_trace_" + name + "_" +
          std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + ".csv";
+}
+
+// The one sampler of the trace recorder and the bridge's trace tap.
+TEST(PinSampler, reads_every_pin_as_a_double_and_stamps_the_cycle) {
+  Output<double> td{-2.5};
+  Output<std::int64_t> count{9007199254740992};
+  Output<bool> on{true};
+  PinSampler sampler;
+  const std::vector<PinRef> pins{PinRef::of(td), PinRef::of(count), PinRef::of(on)};
+  sampler.assign(pins);
+  EXPECT_EQ(sampler.size(), 3u);
+  static_assert(noexcept(sampler.sample(TimePoint{}, 0, 0)), "sampling runs in the cycle");
+
+  const TraceSample s = sampler.sample(TimePoint{1234567890123}, 77, 2);
+  EXPECT_EQ(s.release, TimePoint{1234567890123});
+  EXPECT_EQ(s.cycle, 77u);
+  EXPECT_EQ(s.channel, 2u);
+  ASSERT_EQ(s.n, 3u);
+  EXPECT_EQ(s.v[0], -2.5);
+  EXPECT_EQ(s.v[1], 9007199254740992.0);
+  EXPECT_EQ(s.v[2], 1.0);
+
+  on.set(false);
+  EXPECT_EQ(sampler.sample(TimePoint{}, 78).v[2], 0.0);  // read now, not at assign()
+}
+
+TEST(PinSampler, refuses_too_many_or_null_pins_and_keeps_the_previous_ones) {
+  Output<double> x{4.0};
+  PinSampler sampler;
+  sampler.assign(std::vector<PinRef>{PinRef::of(x)});
+  EXPECT_THROW(sampler.assign(std::vector<PinRef>(kMaxTraceVarsPerTask + 1, PinRef::of(x))),
+               std::invalid_argument);
+  EXPECT_THROW(sampler.assign(std::vector<PinRef>{PinRef::of(x), PinRef{}}), std::invalid_argument);
+  ASSERT_EQ(sampler.size(), 1u);
+  EXPECT_EQ(sampler.sample(TimePoint{}, 0).v[0], 4.0);
+
+  sampler.assign(std::vector<PinRef>(kMaxTraceVarsPerTask, PinRef::of(x)));  // the limit is fine
+  EXPECT_EQ(sampler.size(), kMaxTraceVarsPerTask);
+  sampler.assign({});
+  EXPECT_EQ(sampler.sample(TimePoint{}, 0).n, 0u);
 }
 
 TEST(TraceRecorder, records_exact_values_and_times_of_real_int_and_bool_pins) {

@@ -10,14 +10,7 @@ TraceTap::TraceTap(std::string task_name) : task_name_(std::move(task_name)) {}
 void TraceTap::on_cycle_end(const rt::CycleContext& ctx) noexcept {
   busy_.store(true, std::memory_order_seq_cst);
   if (armed_.load(std::memory_order_seq_cst)) {
-    rt::TraceSample s;
-    s.release = ctx.release;
-    s.cycle = ctx.cycle;
-    s.n = n_;
-    for (std::uint32_t i = 0; i < n_; ++i) {
-      s.v[i] = rt::read_pin_as_double(pins_[i]);
-    }
-    if (!ring_.push(s)) {
+    if (!ring_.push(sampler_.sample(ctx.release, ctx.cycle))) {
       dropped_.fetch_add(1, std::memory_order_relaxed);
     }
   }
@@ -25,21 +18,18 @@ void TraceTap::on_cycle_end(const rt::CycleContext& ctx) noexcept {
 }
 
 void TraceTap::configure(const std::vector<rt::PinRef>& pins) {
-  if (pins.size() > rt::kMaxTraceVarsPerTask) {
-    throw std::invalid_argument("trace: too many variables for one task");
-  }
   armed_.store(false, std::memory_order_seq_cst);
   while (busy_.load(std::memory_order_seq_cst)) {
     std::this_thread::yield();  // non-RT side waits for the RT side to leave on_cycle_end()
   }
-  for (std::size_t i = 0; i < pins.size(); ++i) {
-    pins_[i] = pins[i];
+  try {
+    sampler_.assign(pins);
+  } catch (const std::invalid_argument&) {
+    armed_.store(sampler_.size() > 0, std::memory_order_seq_cst);  // refused: as it was
+    throw;
   }
-  n_ = static_cast<std::uint32_t>(pins.size());
   ring_.consume_all([](const rt::TraceSample&) {});
-  if (n_ > 0) {
-    armed_.store(true, std::memory_order_seq_cst);
-  }
+  armed_.store(sampler_.size() > 0, std::memory_order_seq_cst);
 }
 
 std::size_t TraceTap::drain(std::vector<rt::TraceSample>& out, std::size_t max) {

@@ -23,7 +23,6 @@
 //    never takes.
 //  - dropped(): RT-safe, any thread.
 
-#include <array>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -38,20 +37,10 @@
 #include <vector>
 
 #include "edm/runtime/pin.hpp"
+#include "edm/runtime/pin_sampler.hpp"
 #include "edm/runtime/time.hpp"
 
 namespace edm::rt {
-
-inline constexpr std::size_t kMaxTraceVarsPerTask = 32;
-
-/// One cycle's values of one channel. Trivially copyable: it is copied into the ring as is.
-struct TraceSample {
-  TimePoint release{0};  // scheduled release time of the cycle, ns
-  std::uint64_t cycle{0};
-  std::uint32_t channel{0};
-  std::uint32_t n{0};  // number of valid entries in v
-  std::array<double, kMaxTraceVarsPerTask> v{};
-};
 
 class TraceRecorder {
  public:
@@ -69,7 +58,7 @@ class TraceRecorder {
   std::uint32_t add_channel(std::string task_name, std::vector<std::pair<std::string, PinRef>> vars,
                             std::size_t capacity);
 
-  /// Reads each variable of the channel (read_pin_as_double) and pushes one sample; a full ring
+  /// Samples the channel's variables (PinSampler) and pushes the sample; a full ring
   /// drops it and counts the drop. An unknown channel is ignored.
   /// RT-safe: no allocation, no lock, never blocks. One producer thread per channel.
   void sample(std::uint32_t channel, TimePoint release, std::uint64_t cycle) noexcept;

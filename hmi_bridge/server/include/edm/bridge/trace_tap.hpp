@@ -3,8 +3,9 @@
 // recorder (trace.hpp), so streaming a trace to an HMI never steals samples from --trace-out.
 //
 // One tap per task, attached as a CycleObserver. It owns its own SPSC ring (producer: the task's
-// RT thread; consumer: the bridge server's thread) and its own pin list, set by trace.start /
-// trace.stop. The RT side never waits: a full ring drops the sample and counts it.
+// RT thread; consumer: the bridge server's thread) and its own rt::PinSampler (the recorder's
+// sampler type), whose pins trace.start / trace.stop set. The RT side never waits: a full ring
+// drops the sample and counts it.
 //
 // Reconfiguring while the task runs (Dekker-style handshake, seq_cst): the RT side raises
 // `busy_`, then checks `armed_`; configure() lowers `armed_` and then waits — on the non-RT
@@ -22,7 +23,7 @@
 
 #include "edm/runtime/cycle_observer.hpp"
 #include "edm/runtime/pin.hpp"
-#include "edm/runtime/trace.hpp"
+#include "edm/runtime/pin_sampler.hpp"
 
 namespace edm::bridge {
 
@@ -36,7 +37,8 @@ class TraceTap final : public rt::CycleObserver {
   void on_cycle_end(const rt::CycleContext& ctx) noexcept override;
 
   /// Non-RT. Replaces the sampled pins (empty: off) and empties the ring. At most
-  /// rt::kMaxTraceVarsPerTask pins (std::invalid_argument otherwise).
+  /// rt::kMaxTraceVarsPerTask pins, none null (std::invalid_argument otherwise, and the tap
+  /// keeps its pins and its queued samples).
   void configure(const std::vector<rt::PinRef>& pins);
   /// Non-RT. Moves up to `max` queued samples to out (appended). Returns how many.
   std::size_t drain(std::vector<rt::TraceSample>& out, std::size_t max);
@@ -44,12 +46,11 @@ class TraceTap final : public rt::CycleObserver {
     return dropped_.load(std::memory_order_relaxed);
   }
   [[nodiscard]] const std::string& task_name() const noexcept { return task_name_; }
-  [[nodiscard]] std::uint32_t pin_count() const noexcept { return n_; }
+  [[nodiscard]] std::uint32_t pin_count() const noexcept { return sampler_.size(); }
 
  private:
   std::string task_name_;
-  std::array<rt::PinRef, rt::kMaxTraceVarsPerTask> pins_{};
-  std::uint32_t n_{0};
+  rt::PinSampler sampler_;
   std::atomic<bool> armed_{false};
   std::atomic<bool> busy_{false};
   std::atomic<std::uint64_t> dropped_{0};
