@@ -3,60 +3,32 @@
 #include <fmt/format.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
-#include <iterator>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <system_error>
 
 namespace edm::rt {
 namespace {
 
-void append_escaped(std::string& out, const std::string& text) {
-  out += '"';
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\b':
-        out += "\\b";
-        break;
-      case '\f':
-        out += "\\f";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          fmt::format_to(std::back_inserter(out), "\\u{:04x}", static_cast<unsigned char>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
+using OrderedJson = nlohmann::ordered_json;  // fields in the documented order
+
+// The value printed with 3 decimals, as a number: JSON prints it shortest (250.0, 14.123), so
+// the document carries exactly the 3-decimal values.
+double round3(double x) {
+  const std::string text = fmt::format("{:.3f}", x);
+  double value = 0.0;
+  std::from_chars(text.data(), text.data() + text.size(), value);  // nan and inf too
+  return value;
 }
 
-void append_summary(std::string& out, const char* key, const DurationSummary& s) {
-  fmt::format_to(std::back_inserter(out),
-                 "      \"{}\": {{\n"
-                 "        \"min\": {:.3f},\n"
-                 "        \"avg\": {:.3f},\n"
-                 "        \"p50\": {:.3f},\n"
-                 "        \"p99\": {:.3f},\n"
-                 "        \"max\": {:.3f}\n"
-                 "      }}",
-                 key, s.min_us, s.avg_us, s.p50_us, s.p99_us, s.max_us);
+OrderedJson summary(const DurationSummary& s) {
+  return {{"min", round3(s.min_us)},
+          {"avg", round3(s.avg_us)},
+          {"p50", round3(s.p50_us)},
+          {"p99", round3(s.p99_us)},
+          {"max", round3(s.max_us)}};
 }
 
 [[noreturn]] void throw_io_error(const std::string& path, const char* what, int error) {
@@ -67,27 +39,20 @@ void append_summary(std::string& out, const char* key, const DurationSummary& s)
 }  // namespace
 
 std::string stats_to_json(const std::vector<TaskStatsReport>& tasks) {
-  std::string out = "{\n  \"tasks\": [";
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    const TaskStatsReport& t = tasks[i];
-    out += i == 0 ? "\n    {\n      \"name\": " : ",\n    {\n      \"name\": ";
-    append_escaped(out, t.name);
-    fmt::format_to(std::back_inserter(out),
-                   ",\n"
-                   "      \"interval_us\": {:.3f},\n"
-                   "      \"priority\": {},\n"
-                   "      \"cycles\": {},\n"
-                   "      \"overruns\": {},\n"
-                   "      \"omitted_cycles\": {},\n",
-                   to_micros(t.interval), t.priority, t.stats.cycles, t.stats.overruns,
-                   t.stats.omitted_cycles);
-    append_summary(out, "exec_us", t.stats.exec);
-    out += ",\n";
-    append_summary(out, "latency_us", t.stats.latency);
-    out += "\n    }";
+  OrderedJson list = OrderedJson::array();
+  for (const TaskStatsReport& t : tasks) {
+    list.push_back({{"name", t.name},
+                    {"interval_us", round3(to_micros(t.interval))},
+                    {"priority", t.priority},
+                    {"cycles", t.stats.cycles},
+                    {"overruns", t.stats.overruns},
+                    {"omitted_cycles", t.stats.omitted_cycles},
+                    {"exec_us", summary(t.stats.exec)},
+                    {"latency_us", summary(t.stats.latency)}});
   }
-  out += tasks.empty() ? "]\n}\n" : "\n  ]\n}\n";
-  return out;
+  const OrderedJson doc = {{"tasks", std::move(list)}};
+  // Invalid UTF-8 in a name becomes U+FFFD instead of an exception: the document stays JSON.
+  return doc.dump(2, ' ', /*ensure_ascii=*/false, OrderedJson::error_handler_t::replace) + "\n";
 }
 
 void write_stats_json_file(const std::string& path, const std::vector<TaskStatsReport>& tasks) {

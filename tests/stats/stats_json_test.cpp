@@ -208,28 +208,29 @@ TaskStatsReport sample_task() {
 }
 
 TEST(StatsJson, golden_single_task) {
+  // nlohmann_json prints each value rounded to 3 decimals in its shortest form (250.0, 31.25).
   const std::string expected = R"({
   "tasks": [
     {
       "name": "gap",
-      "interval_us": 250.000,
+      "interval_us": 250.0,
       "priority": 2,
       "cycles": 4000,
       "overruns": 3,
       "omitted_cycles": 5,
       "exec_us": {
-        "min": 12.000,
-        "avg": 14.500,
+        "min": 12.0,
+        "avg": 14.5,
         "p50": 14.123,
         "p99": 20.001,
-        "max": 31.250
+        "max": 31.25
       },
       "latency_us": {
-        "min": 1.000,
-        "avg": 2.500,
-        "p50": 2.250,
-        "p99": 10.000,
-        "max": 12.000
+        "min": 1.0,
+        "avg": 2.5,
+        "p50": 2.25,
+        "p99": 10.0,
+        "max": 12.0
       }
     }
   ]
@@ -258,7 +259,7 @@ TEST(StatsJson, several_tasks_in_order_and_valid) {
   ASSERT_NE(gap, std::string::npos);
   ASSERT_NE(slow_at, std::string::npos);
   EXPECT_LT(gap, slow_at);
-  EXPECT_NE(json.find("\"interval_us\": 40000.000"), std::string::npos);
+  EXPECT_NE(json.find("\"interval_us\": 40000.0,"), std::string::npos);
   for (const char* key :
        {"\"interval_us\"", "\"priority\"", "\"cycles\"", "\"overruns\"", "\"omitted_cycles\"",
         "\"exec_us\"", "\"latency_us\"", "\"min\"", "\"avg\"", "\"p50\"", "\"p99\"", "\"max\""}) {
@@ -281,6 +282,11 @@ TEST(StatsJson, names_are_escaped) {
       << json;
   EXPECT_TRUE(JsonChecker(json).valid()) << json;
   EXPECT_TRUE(brackets_balance(json));
+
+  // Invalid UTF-8 cannot make the document invalid: it becomes U+FFFD.
+  t.name = "a\xff";
+  const std::string replaced = stats_to_json({t});
+  EXPECT_NE(replaced.find("\"name\": \"a\xef\xbf\xbd\""), std::string::npos) << replaced;
 
   // Brackets and braces inside a name must not look like structure.
   t.name = "}]{[\"";
