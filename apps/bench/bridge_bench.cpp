@@ -4,10 +4,8 @@
 //  2. Command round trip (ping) on loopback, p50/p99/max, while those clients are subscribed.
 //  3. Upload + commit of a 100,000-block program (blocks/s).
 // Exit: 0 measured, 1 a step failed, 2 bad arguments.
-#include <fcntl.h>
 #include <fmt/core.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include "edm/apps/cli.hpp"
+#include "edm/apps/subprocess.hpp"
 #include "edm/bridge/client.hpp"
 
 namespace {
@@ -39,27 +39,12 @@ struct Options {
   std::size_t blocks{100'000};
 };
 
-pid_t spawn(const std::vector<std::string>& args, const std::string& log) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, STDERR_FILENO);
-    dup2(fd, STDOUT_FILENO);
-    std::vector<char*> argv;
-    for (const auto& a : args) {
-      argv.push_back(const_cast<char*>(a.c_str()));
-    }
-    argv.push_back(nullptr);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return pid;
-}
-
-int wait_exit(pid_t pid) {
-  int st = 0;
-  waitpid(pid, &st, 0);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+/// edmplc with stdout and stderr into `log` (no pipe to fill up while the bench measures).
+edm::apps::Process spawn(const std::vector<std::string>& args, const std::string& log) {
+  edm::apps::SpawnOptions so;
+  so.out = edm::apps::Stream::kFile;
+  so.out_file = log;
+  return edm::apps::Process(args, so);
 }
 
 /// Connects, retrying until edmplc listens (it starts in well under the deadline).
@@ -109,31 +94,26 @@ double pct(std::vector<double> v, double p) {
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string a = argv[i];
-    const std::string v = argv[i + 1];
-    if (a == "--edmplc") {
-      o.edmplc = v;
-    } else if (a == "--root") {
-      o.root = v;
-    } else if (a == "--duration") {
-      o.duration_s = std::stoi(v);
-    } else if (a == "--clients") {
-      o.clients = std::stoi(v);
-    } else if (a == "--port") {
-      o.port = std::stoi(v);
-    } else if (a == "--blocks") {
-      o.blocks = std::stoul(v);
-    } else {
-      fmt::print(stderr,
-                 "usage: edm-bench-bridge --edmplc PATH [--root DIR] [--duration S] "
-                 "[--clients N] [--port P] [--blocks N]\n");
-      return 2;
-    }
-  }
-  if (o.edmplc.empty()) {
-    fmt::print(stderr, "edm-bench-bridge: --edmplc PATH is required\n");
-    return 2;
+  CLI::App app("edm-bench-bridge: what the HMI bridge costs (docs/benchmarks.md)",
+               "edm-bench-bridge");
+  app.add_option("--edmplc", o.edmplc, "the edmplc binary")->required();
+  app.add_option("--root", o.root, "the source tree")->capture_default_str();
+  app.add_option("--duration", o.duration_s, "seconds per RT latency run")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--clients", o.clients, "status subscribers")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--port", o.port, "edmplc's bridge port")
+      ->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  app.add_option("--blocks", o.blocks, "blocks of the uploaded program")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  if (const auto code = edm::apps::parse(app, argc, argv,
+                                         "edm-bench-bridge --edmplc PATH [--root DIR] "
+                                         "[--duration S] [--clients N] [--port P] [--blocks N]")) {
+    return *code;
   }
   const std::string cfg = o.root + "/config/bench/bridge-jitter.yaml";
   const std::string tmp = "/tmp/edm-bench-bridge-" + std::to_string(getpid());
@@ -143,17 +123,18 @@ int main(int argc, char** argv) {
   co.timeout = 10s;
 
   // 1a. Idle: bridge up, nobody connected.
-  pid_t pid = spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out",
-                     tmp + "-idle.json", "--bridge-port", std::to_string(o.port)},
-                    tmp + "-idle.log");
-  if (wait_exit(pid) != 0) {
+  edm::apps::Process plc =
+      spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out", tmp + "-idle.json",
+             "--bridge-port", std::to_string(o.port)},
+            tmp + "-idle.log");
+  if (plc.wait() != 0) {
     fmt::print(stderr, "edmplc (idle) failed; see {}-idle.log\n", tmp);
     return 1;
   }
   const Latency idle = read_latency(tmp + "-idle.json");
 
   // 1b. Loaded: N subscribers at 100 Hz for the whole run, plus the ping and upload steps.
-  pid = spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out", tmp + "-load.json",
+  plc = spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out", tmp + "-load.json",
                "--bridge-port", std::to_string(o.port)},
               tmp + "-load.log");
   std::vector<std::unique_ptr<Client>> subs;
@@ -174,8 +155,7 @@ int main(int argc, char** argv) {
     });
     if (!connect_retry(*subs.back(), co) || !subs.back()->subscribe({"status"}, 100)) {
       fmt::print(stderr, "client {} could not connect/subscribe\n", i);
-      kill(pid, SIGTERM);
-      wait_exit(pid);
+      plc.stop(SIGTERM);
       return 1;
     }
   }
@@ -212,7 +192,7 @@ int main(int argc, char** argv) {
   if (!up) {
     fmt::print(stderr, "upload failed: {}\n", up.message);
   }
-  const int rc = wait_exit(pid);  // runs to --run-for with the subscribers connected
+  const int rc = plc.wait();  // runs to --run-for with the subscribers connected
   const double sub_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_sub).count();
   std::uint64_t events = 0;

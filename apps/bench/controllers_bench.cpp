@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "controllers/bench.hpp"
+#include "edm/apps/cli.hpp"
 
 namespace {
 
@@ -48,13 +49,6 @@ bool identical(const Outcome& a, const Outcome& b) {
   return a.jitter_per_cycle_um == b.jitter_per_cycle_um && a.rab_per_s == b.rab_per_s;
 }
 
-int usage() {
-  std::fprintf(stderr,
-               "usage: edm-bench-controllers [--quick] [--seeds N] [--first-seed S] [--jobs N] "
-               "[--only ID,...] [--root DIR] [--out DIR]\n");
-  return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -65,32 +59,27 @@ int main(int argc, char** argv) {
   std::string root = EDM_SOURCE_DIR;
   std::string out_dir;
   std::string only;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto next = [&]() -> std::string { return i + 1 < argc ? argv[++i] : ""; };
-    if (a == "--quick") {
-      quick = true;
-    } else if (a == "--seeds") {
-      n_seeds = std::atoi(next().c_str());
-    } else if (a == "--first-seed") {
-      first_seed = std::atoll(next().c_str());
-    } else if (a == "--jobs") {
-      jobs = static_cast<unsigned>(std::max(1, std::atoi(next().c_str())));
-    } else if (a == "--root") {
-      root = next();
-    } else if (a == "--out") {
-      out_dir = next();
-    } else if (a == "--only") {
-      only = "," + next() + ",";
-    } else {
-      return usage();
-    }
+  CLI::App app("edm-bench-controllers: the controller benchmark (docs/benchmarks.md)",
+               "edm-bench-controllers");
+  app.add_flag("--quick", quick, "5 seeds and short scenarios");
+  app.add_option("--seeds", n_seeds, "seeds per scenario (default 20, 5 with --quick)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--first-seed", first_seed, "the first seed (the benchmark's are 1 ... N)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--jobs", jobs, "parallel runs")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--root", root, "the source tree")->capture_default_str();
+  app.add_option("--out", out_dir, "output directory (default ROOT/out/bench/controllers)");
+  app.add_option_function<std::string>(
+      "--only", [&](const std::string& v) { only = "," + v + ","; }, "scenario ids, ID,...");
+  if (const auto code = edm::apps::parse(
+          app, argc, argv,
+          "edm-bench-controllers [--quick] [--seeds N] [--first-seed S] [--jobs N] [--only ID,...] "
+          "[--root DIR] [--out DIR]")) {
+    return *code;
   }
   if (n_seeds < 0) {
     n_seeds = quick ? 5 : 20;
-  }
-  if (n_seeds < 1 || first_seed < 1) {
-    return usage();
   }
   if (out_dir.empty()) {
     out_dir = root + "/out/bench/controllers";

@@ -24,7 +24,8 @@
 #include <vector>
 
 #include "jitter_parse.hpp"
-#include "subprocess.hpp"
+#include "edm/apps/cli.hpp"
+#include "bench_util.hpp"
 
 namespace fs = std::filesystem;
 using edm::bench::child_failure;
@@ -61,10 +62,9 @@ struct Options {
 };
 
 constexpr const char* kUsage =
-    "usage: edm-bench-jitter --edmplc PATH --root DIR [--duration 10s] [--rounds 2]\n"
-    "                        [--only 1k|10k] [--cpu N]\n"
-    "       edm-bench-jitter --parse cyclictest|edmplc FILE   (print the stats parsed from a\n"
-    "                        recorded cyclictest -h output or edmplc --stats-out file)\n";
+    "edm-bench-jitter --edmplc PATH --root DIR [--duration 10s] [--rounds 2] [--only 1k|10k]\n"
+    "                        [--cpu N]\n"
+    "       edm-bench-jitter --parse cyclictest|edmplc FILE";
 
 struct RunRecord {
   const char* variant;
@@ -169,54 +169,30 @@ std::string ratio_text(double num, double den, double target, const char* what) 
 }
 
 int parse_args(int argc, char** argv, Options& opt) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string_view flag = args[i];
-    if (flag == "--help" || flag == "-h") {
-      fmt::print("{}", kUsage);
-      return 0;
-    }
-    if (i + 1 >= args.size()) {
-      fmt::print(stderr, "edm-bench-jitter: {} needs a value\n{}", flag, kUsage);
-      return kExitUsage;
-    }
-    const std::string value(args[++i]);
-    bool ok = true;
-    if (flag == "--edmplc") {
-      opt.edmplc = value;
-    } else if (flag == "--root") {
-      opt.root = value;
-    } else if (flag == "--duration") {
-      const auto s = edm::bench::parse_seconds(value);
-      ok = s.has_value();
-      opt.duration_s = s.value_or(0);
-    } else if (flag == "--rounds") {
-      const auto n = edm::bench::parse_uint(value);
-      ok = n && *n >= 1 && *n <= 100;
-      opt.rounds = static_cast<int>(n.value_or(0));
-    } else if (flag == "--only") {
-      ok = value == "1k" || value == "10k";
-      opt.only = value;
-    } else if (flag == "--cpu") {
-      const auto n = edm::bench::parse_uint(value);
-      const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-      ok = n && static_cast<long>(*n) < ncpu;
-      opt.cpu = static_cast<int>(n.value_or(0));
-    } else {
-      fmt::print(stderr, "edm-bench-jitter: unknown option '{}'\n{}", flag, kUsage);
-      return kExitUsage;
-    }
-    if (!ok) {
-      fmt::print(stderr,
-                 "edm-bench-jitter: bad value '{}' for {} (duration: whole seconds as 10s or "
-                 "2m; rounds: 1..100; only: 1k or 10k; cpu: an online CPU number)\n",
-                 value, flag);
-      return kExitUsage;
-    }
-  }
-  if (opt.edmplc.empty() || opt.root.empty()) {
-    fmt::print(stderr, "edm-bench-jitter: --edmplc and --root are required\n{}", kUsage);
-    return kExitUsage;
+  CLI::App app("edm-bench-jitter: release jitter of edmplc against cyclictest "
+               "(docs/benchmarks.md)",
+               "edm-bench-jitter");
+  app.footer(
+      "edm-bench-jitter --parse cyclictest|edmplc FILE: print the stats parsed from a recorded "
+      "cyclictest -h output or edmplc --stats-out file");
+  app.add_option("--edmplc", opt.edmplc, "the edmplc binary")->required();
+  app.add_option("--root", opt.root, "the source tree")->required();
+  app.add_option_function<std::string>(
+      "--duration",
+      [&](const std::string& v) {
+        const auto s = edm::bench::parse_seconds(v);
+        if (!s) edm::apps::reject("--duration takes whole seconds as 10s or 2m, not '" + v + "'");
+        opt.duration_s = *s;
+      },
+      "per run (default 10s)");
+  app.add_option("--rounds", opt.rounds, "rounds of every variant")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  app.add_option("--only", opt.only, "one variant")->check(CLI::IsMember({"1k", "10k"}));
+  app.add_option("--cpu", opt.cpu, "pin both tools to this CPU")
+      ->check(CLI::Range(0L, sysconf(_SC_NPROCESSORS_ONLN) - 1));
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) {
+    return *code;
   }
   return -1;  // go on
 }
@@ -236,7 +212,7 @@ int parse_only(std::string_view kind, const std::string& path) {
   } else if (kind == "edmplc") {
     stats = edm::bench::parse_edmplc_stats(text, error);
   } else {
-    fmt::print(stderr, "{}", kUsage);
+    fmt::print(stderr, "edm-bench-jitter: --parse takes cyclictest or edmplc\nusage: {}\n", kUsage);
     return kExitUsage;
   }
   if (!stats) {

@@ -25,8 +25,9 @@
 
 #include "soak_hostile.hpp"
 #include "soak_job.hpp"
+#include "edm/apps/cli.hpp"
 #include "soak_plc.hpp"
-#include "subprocess.hpp"
+#include "bench_util.hpp"
 
 namespace {
 
@@ -428,49 +429,41 @@ void write_samples(const fs::path& path, const Phase& ph) {
   }
 }
 
-int usage() {
-  fmt::print(stderr,
-             "usage: edm-bench-soak [--root DIR] [--minutes N] [--baseline-minutes M] [--seed S] "
-             "[--max-stall-s S] [--skip KIND,...]\n"
-             "  KIND: read_only subscribe unsubscribe trace_start trace_stop stall drain "
-             "garbage_bytes bad_json\n"
-             "        deep_nesting long_line pipelined half_line close rst blank_line no_hello "
-             "wrong_token\n");
-  return 2;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   Options o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) {
-      return usage();
-    }
-    const std::string v = argv[++i];
-    try {
-      if (a == "--root") {
-        o.root = v;
-      } else if (a == "--minutes") {
-        o.minutes = std::stod(v);
-      } else if (a == "--baseline-minutes") {
-        o.baseline_minutes = std::stod(v);
-      } else if (a == "--seed") {
-        o.seed = std::stoull(v);
-      } else if (a == "--skip") {
+  CLI::App app("edm-bench-soak: the demo job in a loop with 16 hostile raw-socket clients "
+               "(docs/benchmarks.md, Soak)",
+               "edm-bench-soak");
+  app.footer(
+      "KIND: read_only subscribe unsubscribe trace_start trace_stop stall drain garbage_bytes "
+      "bad_json deep_nesting long_line pipelined half_line close rst blank_line no_hello "
+      "wrong_token");
+  app.add_option("--root", o.root, "the source tree")->capture_default_str();
+  app.add_option("--minutes", o.minutes, "soak length")->check(edm::apps::kPositive)
+      ->capture_default_str();
+  app.add_option("--baseline-minutes", o.baseline_minutes,
+                 "idle baseline length (default: the soak's, at most 5)")
+      ->check(edm::apps::kFinite);
+  app.add_option("--seed", o.seed, "the hostile clients' seed")->capture_default_str();
+  app.add_option_function<std::string>(
+      "--skip",
+      [&](const std::string& v) {
         std::istringstream kinds(v);
         for (std::string k; std::getline(kinds, k, ',');) {
           o.skip.insert(k);
         }
-      } else if (a == "--max-stall-s") {
-        o.max_stall_s = std::stoi(v);
-      } else {
-        return usage();
-      }
-    } catch (const std::exception&) {
-      return usage();
-    }
+      },
+      "hostile kinds not run, KIND,...");
+  app.add_option("--max-stall-s", o.max_stall_s, "a job stalled longer fails the soak")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  if (const auto code = edm::apps::parse(
+          app, argc, argv,
+          "edm-bench-soak [--root DIR] [--minutes N] [--baseline-minutes M] [--seed S] "
+          "[--max-stall-s S] [--skip KIND,...]")) {
+    return *code;
   }
   if (o.baseline_minutes < 0) {
     o.baseline_minutes = std::min(o.minutes, 5.0);

@@ -1,6 +1,6 @@
 #pragma once
-// edmplc as a long-running child of edm-bench-soak: started in the background (run_child() of
-// subprocess.hpp waits for its child, so it serves the short edmhmi runs instead), its resident
+// edmplc as a long-running child of edm-bench-soak: started in the background (an
+// edm::apps::Process; run_child() of bench_util.hpp serves the short edmhmi runs), its resident
 // memory and open descriptors sampled from /proc, stopped with SIGINT as a user stops it.
 // Non-RT. Thread-safety: start/poll/stop from one thread; sample_proc() from any.
 
@@ -11,6 +11,8 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "edm/apps/subprocess.hpp"
 
 namespace edm::bench::soak {
 
@@ -26,28 +28,23 @@ std::optional<ProcSample> sample_proc(pid_t pid);
 
 class PlcProcess {
  public:
-  PlcProcess() = default;
-  PlcProcess(const PlcProcess&) = delete;
-  PlcProcess& operator=(const PlcProcess&) = delete;
-  ~PlcProcess();
-
-  /// fork + exec args[0] (absolute path) with stdout and stderr into `log`. Empty on success.
+  /// exec args[0] (absolute path) with stdout and stderr into `log`. Empty on success.
   std::string start(const std::vector<std::string>& args, const std::filesystem::path& log);
-  [[nodiscard]] pid_t pid() const { return pid_; }
+  [[nodiscard]] pid_t pid() const { return process_.pid(); }
   /// Reaps it if it has exited; true while it runs.
-  bool running();
+  bool running() { return process_.started() && !process_.poll(); }
   /// SIGINT, then waits up to `limit` (then SIGKILL). True if it exited 0 by itself.
   bool stop(std::chrono::seconds limit);
   /// "exit code N" / "killed by signal N (name)" once reaped; empty while running.
-  [[nodiscard]] std::string exit_text() const;
-  [[nodiscard]] bool exited_cleanly() const { return reaped_ && exit_code_ == 0; }
+  [[nodiscard]] std::string exit_text() const {
+    return process_.ended() ? process_.describe() : std::string();
+  }
+  [[nodiscard]] bool exited_cleanly() const {
+    return process_.ended() && process_.exit_code() == 0 && process_.term_signal() == 0;
+  }
 
  private:
-  void record(int status);
-  pid_t pid_{-1};
-  bool reaped_{false};
-  int exit_code_{-1};
-  int signal_{0};
+  edm::apps::Process process_;  // destroyed: SIGKILL and reaped if still running
 };
 
 }  // namespace edm::bench::soak

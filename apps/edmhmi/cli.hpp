@@ -7,23 +7,49 @@
 #include <string_view>
 #include <vector>
 
+#include "edm/apps/cli.hpp"
 #include "edm/bridge/client.hpp"
 #include "edm/hmi/connection.hpp"
 
 namespace edmhmi {
 
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;
-inline constexpr int kExitBadInput = 2;
+using edm::apps::kExitBadInput;
+using edm::apps::kExitFailure;
+using edm::apps::kExitOk;
 inline constexpr int kExitInterrupted = 130;
 
-using Args = std::vector<std::string_view>;
+/// The arguments of each command, filled by CLI11 in main.cpp.
+struct CheckArgs {
+  std::string machine{EDM_DEFAULT_MACHINE};
+  std::string part;
+};
+struct RunArgs {
+  bool detach{false};
+  bool quiet{false};
+  std::string part;
+};
+struct WatchArgs {
+  double rate_hz{5.0};
+  double count{0.0};  // 0: until Ctrl-C
+  std::vector<std::string> names;
+};
+struct TraceArgs {
+  std::string out_path;
+  double duration_s{0.0};  // 0: until Ctrl-C
+  std::vector<std::string> names;
+};
+struct ServeArgs {
+  std::string listen{"127.0.0.1:8080"};
+  std::string web_root{EDM_DEFAULT_WEB_ROOT};
+  bool insecure{false};
+};
 
 /// Set by SIGINT / SIGTERM; loops poll it.
 std::atomic<bool>& interrupted();
 void install_signal_handlers();
 
-/// "edmhmi: message" + usage on stderr; returns kExitBadInput.
+/// "edmhmi: message" + the usage line on stderr (a bad argument CLI11 could not see); returns
+/// kExitBadInput.
 int usage(const std::string& message);
 
 /// Connects and says hello; prints why on failure and returns false.
@@ -36,14 +62,13 @@ int report_error(std::string_view op, const edm::bridge::Reply& reply);
 /// Reads a whole text file (at most 64 MiB); prints why on failure and returns false.
 bool read_text_file(const std::string& path, std::string& out);
 
-int cmd_check(const Args& args);
-int cmd_run(const Args& args, const edm::hmi::ConnectionSettings& settings);
-int cmd_status(const Args& args, const edm::hmi::ConnectionSettings& settings);
-int cmd_stats(const Args& args, const edm::hmi::ConnectionSettings& settings);
-int cmd_machine(std::string_view command, const Args& args,
-                const edm::hmi::ConnectionSettings& settings);
-int cmd_watch(const Args& args, const edm::hmi::ConnectionSettings& settings);
-int cmd_trace(const Args& args, const edm::hmi::ConnectionSettings& settings);
-int cmd_serve(const Args& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_check(const CheckArgs& args);
+int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_status(const edm::hmi::ConnectionSettings& settings);
+int cmd_stats(const edm::hmi::ConnectionSettings& settings);
+int cmd_machine(std::string_view command, const edm::hmi::ConnectionSettings& settings);
+int cmd_watch(const WatchArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_trace(const TraceArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings);
 
 }  // namespace edmhmi

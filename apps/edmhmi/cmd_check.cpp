@@ -8,23 +8,9 @@
 
 namespace edmhmi {
 
-int cmd_check(const Args& args) {
-  std::string machine = EDM_DEFAULT_MACHINE;
-  std::string part;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--machine") {
-      if (i + 1 >= args.size()) return usage("--machine needs a config file");
-      machine = std::string(args[++i]);
-    } else if (args[i].starts_with("--")) {
-      return usage("check: unknown option '" + std::string(args[i]) + "'");
-    } else if (part.empty()) {
-      part = std::string(args[i]);
-    } else {
-      return usage("check takes one part program");
-    }
-  }
-  if (part.empty()) return usage("check needs a part program (PART.nc)");
-
+int cmd_check(const CheckArgs& args) {
+  const std::string& machine = args.machine;
+  const std::string& part = args.part;
   edm::machining::MachineTables tables;
   try {
     tables = edm::machining::read_machine_tables(machine);

@@ -6,9 +6,7 @@
 
 namespace edmhmi {
 
-int cmd_machine(std::string_view command, const Args& args,
-                const edm::hmi::ConnectionSettings& settings) {
-  if (!args.empty()) return usage(std::string(command) + " takes no arguments");
+int cmd_machine(std::string_view command, const edm::hmi::ConnectionSettings& settings) {
   const std::string op = command == "hold"     ? "cycle.hold"
                          : command == "resume" ? "cycle.resume"
                          : command == "stop"   ? "cycle.stop"

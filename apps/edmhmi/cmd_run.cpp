@@ -55,23 +55,9 @@ class ProgressPrinter {
 
 }  // namespace
 
-int cmd_run(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  bool detach = false, quiet = false;
-  std::string part;
-  for (std::string_view a : args) {
-    if (a == "--detach") {
-      detach = true;
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (a.starts_with("--")) {
-      return usage("run: unknown option '" + std::string(a) + "'");
-    } else if (part.empty()) {
-      part = std::string(a);
-    } else {
-      return usage("run takes one part program");
-    }
-  }
-  if (part.empty()) return usage("run needs a part program (PART.nc)");
+int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
+  const bool detach = args.detach, quiet = args.quiet;
+  const std::string& part = args.part;
   std::string text;
   if (!read_text_file(part, text)) return kExitBadInput;
 

@@ -46,21 +46,10 @@ bool parse_listen(std::string_view text, boost::asio::ip::tcp::endpoint& out, st
 
 }  // namespace
 
-int cmd_serve(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  std::string listen = "127.0.0.1:8080";
-  std::string web_root = EDM_DEFAULT_WEB_ROOT;
-  bool insecure = false;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--listen" || args[i] == "--web-root") {
-      if (i + 1 >= args.size()) return usage(std::string(args[i]) + " needs a value");
-      (args[i] == "--listen" ? listen : web_root) = std::string(args[i + 1]);
-      ++i;
-    } else if (args[i] == "--insecure-listen") {
-      insecure = true;
-    } else {
-      return usage("serve: unknown argument '" + std::string(args[i]) + "'");
-    }
-  }
+int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings) {
+  const std::string& listen = args.listen;
+  const std::string& web_root = args.web_root;
+  const bool insecure = args.insecure;
   boost::asio::ip::tcp::endpoint endpoint;
   std::string why;
   if (!parse_listen(listen, endpoint, why)) return usage(why);

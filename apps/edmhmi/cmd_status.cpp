@@ -7,8 +7,7 @@
 
 namespace edmhmi {
 
-int cmd_status(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  if (!args.empty()) return usage("status takes no arguments");
+int cmd_status(const edm::hmi::ConnectionSettings& settings) {
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
   const edm::bridge::Reply r = client.request("status");
@@ -50,8 +49,7 @@ int cmd_status(const Args& args, const edm::hmi::ConnectionSettings& settings) {
   return kExitOk;
 }
 
-int cmd_stats(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  if (!args.empty()) return usage("stats takes no arguments");
+int cmd_stats(const edm::hmi::ConnectionSettings& settings) {
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
   const edm::bridge::Reply r = client.request("tasks.stats");

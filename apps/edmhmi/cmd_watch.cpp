@@ -16,16 +16,6 @@ namespace {
 
 using edm::bridge::Json;
 
-bool parse_positive(std::string_view text, double& out) {
-  try {
-    std::size_t used = 0;
-    out = std::stod(std::string(text), &used);
-    return used == text.size() && std::isfinite(out) && out > 0.0;
-  } catch (const std::exception&) {
-    return false;
-  }
-}
-
 std::string value_text(const Json& v) {
   if (v.is_number_float()) {
     char buf[32];
@@ -37,24 +27,9 @@ std::string value_text(const Json& v) {
 
 }  // namespace
 
-int cmd_watch(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  double rate_hz = 5.0, count = 0.0;
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--rate" || args[i] == "--count") {
-      double* target = args[i] == "--rate" ? &rate_hz : &count;
-      if (i + 1 >= args.size() || !parse_positive(args[i + 1], *target)) {
-        return usage(std::string(args[i]) + " needs a positive number");
-      }
-      ++i;
-    } else if (args[i].starts_with("--")) {
-      return usage("watch: unknown option '" + std::string(args[i]) + "'");
-    } else {
-      names.emplace_back(args[i]);
-    }
-  }
-  if (names.empty()) return usage("watch needs at least one variable");
-  if (rate_hz > 100.0) return usage("watch: --rate is at most 100 Hz");
+int cmd_watch(const WatchArgs& args, const edm::hmi::ConnectionSettings& settings) {
+  const double rate_hz = args.rate_hz, count = args.count;
+  const std::vector<std::string>& names = args.names;
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
   const auto period = std::chrono::duration<double>(1.0 / rate_hz);
@@ -74,27 +49,10 @@ int cmd_watch(const Args& args, const edm::hmi::ConnectionSettings& settings) {
   return kExitOk;
 }
 
-int cmd_trace(const Args& args, const edm::hmi::ConnectionSettings& settings) {
-  std::string out_path;
-  double duration_s = 0.0;
-  std::vector<std::string> names;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--out") {
-      if (i + 1 >= args.size()) return usage("--out needs a file");
-      out_path = std::string(args[++i]);
-    } else if (args[i] == "--duration") {
-      if (i + 1 >= args.size() || !parse_positive(args[i + 1], duration_s)) {
-        return usage("--duration needs a positive number of seconds");
-      }
-      ++i;
-    } else if (args[i].starts_with("--")) {
-      return usage("trace: unknown option '" + std::string(args[i]) + "'");
-    } else {
-      names.emplace_back(args[i]);
-    }
-  }
-  if (names.empty()) return usage("trace needs at least one variable");
-  if (out_path.empty()) return usage("trace needs --out FILE.csv");
+int cmd_trace(const TraceArgs& args, const edm::hmi::ConnectionSettings& settings) {
+  const std::string& out_path = args.out_path;
+  const double duration_s = args.duration_s;
+  const std::vector<std::string>& names = args.names;
   std::ofstream csv(out_path);
   if (!csv) {
     std::fprintf(stderr, "%s: cannot write\n", out_path.c_str());

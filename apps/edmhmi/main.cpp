@@ -15,53 +15,80 @@ namespace edmhmi {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: edmhmi [--host H] [--port P] [--token-file F] [--tls-ca F | --tls-fingerprint FP]\n"
-    "              COMMAND ...\n"
-    "  connection: --host (else $EDM_HOST, 127.0.0.1), --port (else $EDM_PORT, 7730),\n"
-    "              --token-file (else $EDM_TOKEN_FILE, else the token in $EDM_TOKEN),\n"
-    "              TLS verified by --tls-ca (else $EDM_TLS_CA) or the server certificate's\n"
-    "              SHA-256 --tls-fingerprint (else $EDM_TLS_FINGERPRINT)\n"
-    "commands:\n"
-    "  check [--machine CONFIG] PART.nc   interpret offline against CONFIG (default\n"
-    "                                     config/machines/drill-sim.yaml); nothing is sent\n"
-    "  run [--detach] [--quiet] PART.nc   upload, start, show progress, print the job report;\n"
-    "                                     exit 1 when the job does not finish or an alarm came\n"
-    "  status                             machine state, job, key variables, last job's figures\n"
-    "  watch [--rate HZ] [--count N] VAR...     print variables until Ctrl-C (or N samples)\n"
-    "  trace VAR... --out FILE.csv [--duration S]  record every cycle of VAR... to CSV\n"
-    "  stats                              task statistics and bridge counters\n"
-    "  hold | resume | stop | estop | reset   machine commands\n"
-    "  serve [--listen HOST:PORT] [--web-root DIR]  the operator's page in a browser (default\n"
-    "                                     127.0.0.1:8080; docs/web.md)\n";
+    "edmhmi [--host H] [--port P] [--token-file F] [--tls-ca F | --tls-fingerprint FP] "
+    "COMMAND ... (edmhmi --help: the commands)";
 
 std::atomic<bool> g_interrupted{false};
 
 extern "C" void on_signal(int /*sig*/) { g_interrupted.store(true); }
 
 int run(int argc, char** argv) {
-  const Args args(argv + 1, argv + argc);
+  CLI::App app("edmhmi: the HMI of edmplc (docs/hmi.md). Exit 0 ok, 1 runtime failure or alarm, "
+               "2 bad input.",
+               "edmhmi");
+  app.require_subcommand(1);
   edm::hmi::ConnectionFlags flags;
-  std::size_t i = 0;
-  while (i < args.size() && args[i].starts_with("--")) {
-    if (args[i] == "--help" || args[i] == "-h") {
-      std::fputs(kUsage, stdout);
-      return kExitOk;
-    }
-    std::string* target = args[i] == "--host"              ? &flags.host
-                          : args[i] == "--port"            ? &flags.port
-                          : args[i] == "--token-file"      ? &flags.token_file
-                          : args[i] == "--tls-ca"          ? &flags.tls_ca_file
-                          : args[i] == "--tls-fingerprint" ? &flags.tls_fingerprint
-                                                           : nullptr;
-    if (target == nullptr) return usage("unknown option '" + std::string(args[i]) + "'");
-    if (i + 1 >= args.size()) return usage(std::string(args[i]) + " needs a value");
-    *target = std::string(args[i + 1]);
-    i += 2;
+  app.add_option("--host", flags.host, "edmplc's host (else $EDM_HOST, else 127.0.0.1)");
+  app.add_option("--port", flags.port, "its bridge port (else $EDM_PORT, else 7730)");
+  app.add_option("--token-file", flags.token_file,
+                 "the token's file (else $EDM_TOKEN_FILE, else the token in $EDM_TOKEN)");
+  app.add_option("--tls-ca", flags.tls_ca_file,
+                 "TLS, the server verified by this CA file (else $EDM_TLS_CA)");
+  app.add_option("--tls-fingerprint", flags.tls_fingerprint,
+                 "TLS, the server certificate's SHA-256 pinned (else $EDM_TLS_FINGERPRINT)");
+
+  CheckArgs check;
+  CLI::App* c = app.add_subcommand("check", "interpret PART.nc offline against a machine's "
+                                            "conditions and soft limits; nothing is sent");
+  c->add_option("--machine", check.machine, "the machine config")->capture_default_str();
+  c->add_option("PART.nc", check.part, "the part program")->required();
+
+  RunArgs run;
+  CLI::App* r = app.add_subcommand(
+      "run",
+      "upload PART.nc, start it, show progress, print the job report; exit 1 when the job does "
+      "not finish or an alarm came");
+  r->add_flag("--detach", run.detach, "return once the job has started");
+  r->add_flag("--quiet", run.quiet, "no progress, only the report");
+  r->add_option("PART.nc", run.part, "the part program")->required();
+
+  app.add_subcommand("status", "machine state, job, key variables, last job's figures");
+  app.add_subcommand("stats", "task statistics and bridge counters");
+
+  WatchArgs watch;
+  CLI::App* w = app.add_subcommand("watch", "print variables until Ctrl-C (or N samples)");
+  w->add_option("--rate", watch.rate_hz, "samples per second, at most 100")
+      ->check(edm::apps::kPositive)
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            return std::stod(v) <= 100.0 ? std::string() : "at most 100 Hz, not " + v;
+          },
+          ""))
+      ->capture_default_str();
+  w->add_option("--count", watch.count, "stop after N samples")->check(edm::apps::kPositive);
+  w->add_option("VAR", watch.names, "variables")->required();
+
+  TraceArgs trace;
+  CLI::App* t = app.add_subcommand("trace", "record every cycle of VAR... to CSV");
+  t->add_option("--out", trace.out_path, "the CSV file")->required();
+  t->add_option("--duration", trace.duration_s, "seconds (default: until Ctrl-C)")
+      ->check(edm::apps::kPositive);
+  t->add_option("VAR", trace.names, "variables")->required();
+
+  for (const char* m : {"hold", "resume", "stop", "estop", "reset"}) {
+    app.add_subcommand(m, "machine command");
   }
-  if (i >= args.size()) return usage("missing command");
-  const std::string_view command = args[i];
-  const Args rest(args.begin() + static_cast<std::ptrdiff_t>(i) + 1, args.end());
-  if (command == "check") return cmd_check(rest);
+
+  ServeArgs serve;
+  CLI::App* s = app.add_subcommand("serve", "the operator's page in a browser (docs/web.md)");
+  s->add_option("--listen", serve.listen, "HOST:PORT")->capture_default_str();
+  s->add_option("--web-root", serve.web_root, "the built page")->capture_default_str();
+  s->add_flag("--insecure-listen", serve.insecure,
+              "allow a non-loopback address (plain HTTP: tokens in clear)");
+
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
+  const std::string command = app.get_subcommands().front()->get_name();
+  if (command == "check") return cmd_check(check);
 
   edm::hmi::ConnectionSettings settings;
   try {
@@ -72,16 +99,13 @@ int run(int argc, char** argv) {
     return kExitBadInput;
   }
   install_signal_handlers();
-  if (command == "run") return cmd_run(rest, settings);
-  if (command == "status") return cmd_status(rest, settings);
-  if (command == "stats") return cmd_stats(rest, settings);
-  if (command == "watch") return cmd_watch(rest, settings);
-  if (command == "trace") return cmd_trace(rest, settings);
-  if (command == "serve") return cmd_serve(rest, settings);
-  for (std::string_view c : {"hold", "resume", "stop", "estop", "reset"}) {
-    if (command == c) return cmd_machine(command, rest, settings);
-  }
-  return usage("unknown command '" + std::string(command) + "'");
+  if (command == "run") return cmd_run(run, settings);
+  if (command == "status") return cmd_status(settings);
+  if (command == "stats") return cmd_stats(settings);
+  if (command == "watch") return cmd_watch(watch, settings);
+  if (command == "trace") return cmd_trace(trace, settings);
+  if (command == "serve") return cmd_serve(serve, settings);
+  return cmd_machine(command, settings);
 }
 
 }  // namespace
@@ -97,7 +121,7 @@ void install_signal_handlers() {
 }
 
 int usage(const std::string& message) {
-  std::fprintf(stderr, "edmhmi: %s\n%s", message.c_str(), kUsage);
+  std::fprintf(stderr, "edmhmi: %s\nusage: %s\n", message.c_str(), kUsage);
   return kExitBadInput;
 }
 

@@ -14,7 +14,9 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 
+#include "edm/apps/cli.hpp"
 #include "edm/blocks/register.hpp"
 #include "edm/bridge/server.hpp"
 #include "edm/programs/register.hpp"
@@ -27,21 +29,15 @@
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitBadInput = 2;
+using edm::apps::kExitBadInput;
+using edm::apps::kExitFailure;
+using edm::apps::kExitOk;
+using edm::apps::reject;
 
-constexpr std::string_view kUsage =
-    "usage: edmplc --config FILE [--clock real|virtual [--speed F]] [--run-for DURATION]\n"
+constexpr const char* kUsage =
+    "edmplc --config FILE [--clock real|virtual [--speed F]] [--run-for DURATION]\n"
     "              [--stats-out FILE.json] [--trace-out FILE.csv] [--seed N]\n"
-    "              [--bridge-port P] [--check] [--list-vars] [--log-level LEVEL]\n"
-    "  --check       validate the config and exit (0 ok, 2 invalid: file:line:col: message)\n"
-    "  --list-vars   print every variable (name, kind, type, unit, task) and exit\n"
-    "  --run-for     stop after this much (real or virtual) time, e.g. 10s; default: until\n"
-    "                SIGINT/SIGTERM\n"
-    "  --clock       real (default: SCHED_FIFO threads) or virtual (deterministic, fast)\n"
-    "  --speed F     with --clock virtual: pace virtual time to F x wall time (accelerated\n"
-    "                but deterministic; an HMI can follow the job); default: unpaced\n";
+    "              [--bridge-port P] [--check] [--list-vars] [--log-level LEVEL]";
 
 std::atomic<bool> g_stop{false};
 
@@ -61,11 +57,6 @@ struct Options {
   std::string log_level{"info"};
 };
 
-[[noreturn]] void bad_usage(const std::string& message) {
-  std::cerr << "edmplc: " << message << "\n" << kUsage;
-  std::exit(kExitBadInput);
-}
-
 std::optional<std::uint64_t> parse_u64(std::string_view s) {
   if (s.empty() || s.size() > 20) {
     return std::nullopt;
@@ -84,79 +75,78 @@ std::optional<std::uint64_t> parse_u64(std::string_view s) {
   return v;
 }
 
-Options parse_args(int argc, char** argv) {
+/// The options, or the exit code when the program ends here (--help, bad arguments).
+std::variant<Options, int> parse_args(int argc, char** argv) {
   Options o;
-  auto value = [&](int& i, std::string_view flag) -> std::string {
-    if (i + 1 >= argc) {
-      bad_usage(std::string(flag) + " needs a value");
+  CLI::App app("the edmplc runtime: runs a machine config's tasks until SIGINT/SIGTERM or "
+               "--run-for (docs/runtime.md)",
+               "edmplc");
+  app.add_option("--config", o.config, "the machine config (YAML)")->required();
+  app.add_option_function<std::string>(
+      "--clock",
+      [&](const std::string& v) {
+        if (v != "real" && v != "virtual") reject("--clock takes real or virtual, not '" + v + "'");
+        o.clock = v == "real" ? edm::rt::ClockKind::kReal : edm::rt::ClockKind::kVirtual;
+      },
+      "real (default: SCHED_FIFO threads) or virtual (deterministic, fast)");
+  app.add_option_function<std::string>(
+      "--speed",
+      [&](const std::string& v) {
+        char* end = nullptr;
+        o.speed = std::strtod(v.c_str(), &end);
+        if (end == v.c_str() || *end != '\0' || !(o.speed > 0.0) || o.speed > 1e6) {
+          reject("--speed takes a factor > 0 (virtual seconds per wall second), not '" + v + "'");
+        }
+      },
+      "with --clock virtual: pace virtual time to F x wall time (accelerated but deterministic; "
+      "an HMI can follow the job); default: unpaced");
+  app.add_option_function<std::string>(
+      "--run-for",
+      [&](const std::string& v) {
+        auto d = edm::rt::parse_duration(v);
+        if (!d.value || d.value->count() == 0) {
+          reject("--run-for: " + (d.value ? std::string("must be > 0") : d.error));
+        }
+        o.run_for = d.value;
+      },
+      "stop after this much (real or virtual) time, e.g. 10s; default: until SIGINT/SIGTERM");
+  app.add_option("--stats-out", o.stats_out, "write per-task statistics (JSON) at exit");
+  app.add_option("--trace-out", o.trace_out, "record the config's trace: variables (CSV)");
+  app.add_option_function<std::string>(
+      "--seed",
+      [&](const std::string& v) {
+        o.seed = parse_u64(v);
+        if (!o.seed) reject("--seed takes an unsigned 64-bit integer, not '" + v + "'");
+      },
+      "override the simulator seed");
+  app.add_option_function<std::string>(
+      "--bridge-port",
+      [&](const std::string& v) {
+        const auto p = parse_u64(v);
+        if (!p || *p > 65535) reject("--bridge-port takes 0..65535, not '" + v + "'");
+        o.bridge_port = static_cast<int>(*p);
+      },
+      "override the bridge port (0 = no bridge)");
+  app.add_flag("--check", o.check,
+               "validate the config and exit (0 ok, 2 invalid: file:line:col: message)");
+  app.add_flag("--list-vars", o.list_vars,
+               "print every variable (name, kind, type, unit, task) and exit");
+  app.add_option_function<std::string>(
+      "--log-level",
+      [&](const std::string& v) {
+        if (spdlog::level::from_str(v) == spdlog::level::off && v != "off") {
+          reject("--log-level takes trace, debug, info, warn, err, critical or off");
+        }
+        o.log_level = v;
+      },
+      "trace, debug, info (default), warn, err, critical or off");
+  app.callback([&] {
+    if (o.speed > 0.0 && o.clock != edm::rt::ClockKind::kVirtual) {
+      reject("--speed needs --clock virtual (the real clock runs at 1x)");
     }
-    return argv[++i];
-  };
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--config") {
-      o.config = value(i, a);
-    } else if (a == "--clock") {
-      const std::string v = value(i, a);
-      if (v == "real") {
-        o.clock = edm::rt::ClockKind::kReal;
-      } else if (v == "virtual") {
-        o.clock = edm::rt::ClockKind::kVirtual;
-      } else {
-        bad_usage("--clock takes real or virtual, not '" + v + "'");
-      }
-    } else if (a == "--speed") {
-      const std::string v = value(i, a);
-      char* end = nullptr;
-      o.speed = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !(o.speed > 0.0) || o.speed > 1e6) {
-        bad_usage("--speed takes a factor > 0 (virtual seconds per wall second), not '" + v + "'");
-      }
-    } else if (a == "--run-for") {
-      const std::string v = value(i, a);
-      auto d = edm::rt::parse_duration(v);
-      if (!d.value || d.value->count() == 0) {
-        bad_usage("--run-for: " + (d.value ? std::string("must be > 0") : d.error));
-      }
-      o.run_for = d.value;
-    } else if (a == "--stats-out") {
-      o.stats_out = value(i, a);
-    } else if (a == "--trace-out") {
-      o.trace_out = value(i, a);
-    } else if (a == "--seed") {
-      const std::string v = value(i, a);
-      o.seed = parse_u64(v);
-      if (!o.seed) {
-        bad_usage("--seed takes an unsigned 64-bit integer, not '" + v + "'");
-      }
-    } else if (a == "--bridge-port") {
-      const std::string v = value(i, a);
-      auto p = parse_u64(v);
-      if (!p || *p > 65535) {
-        bad_usage("--bridge-port takes 0..65535, not '" + v + "'");
-      }
-      o.bridge_port = static_cast<int>(*p);
-    } else if (a == "--check") {
-      o.check = true;
-    } else if (a == "--list-vars") {
-      o.list_vars = true;
-    } else if (a == "--log-level") {
-      o.log_level = value(i, a);
-      if (spdlog::level::from_str(o.log_level) == spdlog::level::off && o.log_level != "off") {
-        bad_usage("--log-level takes trace, debug, info, warn, err, critical or off");
-      }
-    } else if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      std::exit(kExitOk);
-    } else {
-      bad_usage("unknown argument '" + std::string(a) + "'");
-    }
-  }
-  if (o.config.empty()) {
-    bad_usage("--config FILE is required");
-  }
-  if (o.speed > 0.0 && o.clock != edm::rt::ClockKind::kVirtual) {
-    bad_usage("--speed needs --clock virtual (the real clock runs at 1x)");
+  });
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) {
+    return *code;
   }
   return o;
 }
@@ -170,7 +160,11 @@ void print_diagnostics(const edm::rt::ConfigError& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options opt = parse_args(argc, argv);
+  const auto parsed = parse_args(argc, argv);
+  if (const int* code = std::get_if<int>(&parsed)) {
+    return *code;
+  }
+  const Options& opt = std::get<Options>(parsed);
   edm::rt::init_logging(spdlog::level::from_str(opt.log_level));
 
   edm::rt::BlockRegistry blocks;

@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "edm/apps/cli.hpp"
 #include "edm/blocks/register.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
@@ -37,9 +38,8 @@ using namespace std::chrono_literals;
 namespace gh = edm::greyhorizon;
 namespace rt = edm::rt;
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailed = 1;
-constexpr int kExitBadInput = 2;
+using edm::apps::kExitOk;
+constexpr int kExitFailed = edm::apps::kExitFailure;
 constexpr std::int64_t kSampleMs = 40;  // the paper's sampling period of Rab
 
 // Table 2 of the paper: Wn (fraction of Nyquist) and the chosen horizon p.
@@ -47,35 +47,8 @@ constexpr std::pair<double, int> kPaperTable[] = {{0.010, 46}, {0.012, 37}, {0.0
                                                   {0.020, 17}, {0.030, 6},  {0.050, 1}};
 
 constexpr const char* kUsage =
-    "usage: edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--io PARAMS]\n"
-    "                       [--csv PATH] [--raw PATH]\n"
-    "                       [--max-p P] [--window n] [--warmup W]\n"
-    "  --seed     simulator seed (default 1)\n"
-    "  --samples  Rab samples at 40 ms (default 3000 = 120 s)\n"
-    "  --skip-s   simulated seconds before the record starts (default 30: the kerf debris\n"
-    "             settles)\n"
-    "  --config   wire machine config (default\n"
-    "             <source>/config/bench/controllers/wire-horizon.yaml)\n"
-    "  --io       extra simulator params, e.g. \"wire_thickness_profile: '0:10,40:30'\"\n"
-    "  --csv      also write the RMS error for every Wn and p to PATH\n"
-    "  --raw      also write the recorded Rab (one sample a line) to PATH\n"
-    "  --max-p    largest horizon tried (default 60)\n"
-    "  --window   GM(1,1) window n (default 5, as the block)\n"
-    "  --warmup   samples not scored at the start (default 300)\n";
-
-int bad(const std::string& msg) {
-  std::fprintf(stderr, "edm-greyhorizon: %s\n%s", msg.c_str(), kUsage);
-  return kExitBadInput;
-}
-
-std::optional<std::int64_t> parse_int(std::string_view text) {
-  const std::string s(text);
-  if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const long long v = std::strtoll(s.c_str(), &end, 10);
-  if (end != s.c_str() + s.size()) return std::nullopt;
-  return static_cast<std::int64_t>(v);
-}
+    "edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--io PARAMS]\n"
+    "                       [--csv PATH] [--raw PATH] [--max-p P] [--window n] [--warmup W]";
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -156,46 +129,32 @@ int main(int argc, char** argv) {
   std::string csv;
   std::string raw;
   std::string io_extra;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return kExitOk;
-    }
-    if (i + 1 >= argc) return bad(std::string(a) + ": missing value");
-    const std::string_view v = argv[++i];
-    auto as_int = [&](std::int64_t& out, std::int64_t lo, std::int64_t hi) {
-      const auto n = parse_int(v);
-      if (!n || *n < lo || *n > hi) return false;
-      out = *n;
-      return true;
-    };
-    bool ok = true;
-    if (a == "--seed") {
-      ok = as_int(seed, 0, INT64_MAX);
-    } else if (a == "--samples") {
-      ok = as_int(samples, 1, 10'000'000);
-    } else if (a == "--skip-s") {
-      ok = as_int(skip_s, 0, 100'000);
-    } else if (a == "--max-p") {
-      ok = as_int(max_p, 0, 10'000);
-    } else if (a == "--window") {
-      ok = as_int(window, 4, 1024);
-    } else if (a == "--warmup") {
-      ok = as_int(warmup, 0, 10'000'000);
-    } else if (a == "--config") {
-      config = v;
-    } else if (a == "--csv") {
-      csv = v;
-    } else if (a == "--io") {
-      io_extra = v;
-    } else if (a == "--raw") {
-      raw = v;
-    } else {
-      return bad("unknown option " + std::string(a));
-    }
-    if (!ok) return bad("bad value for " + std::string(a) + ": " + std::string(v));
-  }
+  CLI::App app("edm-greyhorizon: the grey-model horizon p for each Wn (seed 000 Table 2) on "
+               "the Rab recorded from the wire simulator",
+               "edm-greyhorizon");
+  app.add_option("--seed", seed, "simulator seed")->check(CLI::Range(std::int64_t{0}, INT64_MAX))
+      ->capture_default_str();
+  app.add_option("--samples", samples, "Rab samples at 40 ms (default 3000 = 120 s)")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
+  app.add_option("--skip-s", skip_s,
+                 "simulated seconds before the record starts (default 30: the kerf debris "
+                 "settles)")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{100'000}));
+  app.add_option("--config", config, "wire machine config")->capture_default_str();
+  app.add_option("--io", io_extra,
+                 "extra simulator params, e.g. \"wire_thickness_profile: '0:10,40:30'\"");
+  app.add_option("--csv", csv, "also write the RMS error for every Wn and p to PATH");
+  app.add_option("--raw", raw, "also write the recorded Rab (one sample a line) to PATH");
+  app.add_option("--max-p", max_p, "largest horizon tried")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{10'000}))
+      ->capture_default_str();
+  app.add_option("--window", window, "GM(1,1) window n (as the block)")
+      ->check(CLI::Range(std::int64_t{4}, std::int64_t{1024}))
+      ->capture_default_str();
+  app.add_option("--warmup", warmup, "samples not scored at the start")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{10'000'000}))
+      ->capture_default_str();
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
 
   gh::HorizonOptions opt;
   opt.max_horizon = static_cast<std::size_t>(max_p);

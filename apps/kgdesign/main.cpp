@@ -12,7 +12,7 @@
 #include <string>
 #include <string_view>
 
-#include "cli_number.hpp"
+#include "edm/apps/cli.hpp"
 #include "kg_design.hpp"
 #include "td_law.hpp"
 
@@ -23,29 +23,14 @@ using edm::kgdesign::GapLoopModel;
 using edm::kgdesign::KgDesignStatus;
 using edm::kgdesign::TdMedianLaw;
 
-constexpr int kExitOk = 0;
-constexpr int kExitBadInput = 2;
-
 constexpr const char* kUsage =
-    "usage: edm-kgdesign [--law drill|sink] [--gap-um G] [--debris C] [--kd-us-per-um K]\n"
-    "                    [--tau-v-ms T | --wn W --zeta Z] [--tau-m-ms T] [--tdr-us D]\n"
-    "                    [--kg KG]\n"
-    "  --law          Td median law of PLANT-MODEL 6.5 (default drill)\n"
-    "  --gap-um       working gap [um] (default: the law's g_r, 20 for drill)\n"
-    "  --debris       debris concentration c in [0, 1] at the working point (default 0)\n"
-    "  --kd-us-per-um Td slope, overrides the law\n"
-    "  --tau-v-ms     first-order velocity loop, time constant [ms]\n"
-    "  --wn, --zeta   second-order axis, command -> velocity (default 200 rad/s, 0.55)\n"
-    "  --tau-m-ms     first-order lag on the measured Td [ms] (default 0: none)\n"
-    "  --tdr-us       size of the Tdr step used for J [us] (default 1; J scales with D^2)\n"
-    "  --kg           also evaluate this Kg [(mm/s)/us]\n";
+    "edm-kgdesign [--law drill|sink] [--gap-um G] [--debris C] [--kd-us-per-um K]\n"
+    "                    [--tau-v-ms T | --wn W --zeta Z] [--tau-m-ms T] [--tdr-us D] [--kg KG]";
 
 int bad(const std::string& msg) {
-  std::fprintf(stderr, "edm-kgdesign: %s\n%s", msg.c_str(), kUsage);
-  return kExitBadInput;
+  std::fprintf(stderr, "edm-kgdesign: %s\nusage: %s\n", msg.c_str(), kUsage);
+  return edm::apps::kExitBadInput;
 }
-
-using edm::apps::parse_number;
 
 std::string format_poly(std::span<const double> p) {
   std::string out = "[";
@@ -78,42 +63,32 @@ int main(int argc, char** argv) {
   std::string law_name = "drill";
   std::optional<double> gap_um, debris, kd, tau_v_ms, wn, zeta, tau_m_ms, tdr_us, kg_eval;
 
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return kExitOk;
-    }
-    if (i + 1 >= argc) return bad("missing value after " + std::string(arg));
-    const std::string_view val = argv[++i];
-    if (arg == "--law") {
-      if (val == "drill") {
-        law = TdMedianLaw::drill();
-      } else if (val == "sink") {
-        law = TdMedianLaw::sink();
-      } else {
-        return bad("--law must be drill or sink, got '" + std::string(val) + "'");
-      }
-      law_name = std::string(val);
-      continue;
-    }
-    std::optional<double>* slot = nullptr;
-    if (arg == "--gap-um") slot = &gap_um;
-    if (arg == "--debris") slot = &debris;
-    if (arg == "--kd-us-per-um") slot = &kd;
-    if (arg == "--tau-v-ms") slot = &tau_v_ms;
-    if (arg == "--wn") slot = &wn;
-    if (arg == "--zeta") slot = &zeta;
-    if (arg == "--tau-m-ms") slot = &tau_m_ms;
-    if (arg == "--tdr-us") slot = &tdr_us;
-    if (arg == "--kg") slot = &kg_eval;
-    if (slot == nullptr) return bad("unknown option '" + std::string(arg) + "'");
-    if (slot->has_value()) return bad(std::string(arg) + " given twice");
-    *slot = parse_number(val);
-    if (!slot->has_value()) {
-      return bad(std::string(arg) + ": '" + std::string(val) + "' is not a finite number");
-    }
-  }
+  CLI::App app("edm-kgdesign: the ISE-optimal Kg of the P gap controller Vz = Kg*(Tdr - Td) "
+               "(seed 004 eq. 1-3, docs/blocks.md)",
+               "edm-kgdesign");
+  app.add_option_function<std::string>(
+      "--law",
+      [&](const std::string& v) {
+        if (v != "drill" && v != "sink") {
+          edm::apps::reject("--law must be drill or sink, got '" + v + "'");
+        }
+        law = v == "drill" ? TdMedianLaw::drill() : TdMedianLaw::sink();
+        law_name = v;
+      },
+      "Td median law of PLANT-MODEL 6.5 (default drill)");
+  const auto number = [&](const char* flag, std::optional<double>& slot, const char* help) {
+    app.add_option(flag, slot, help)->check(edm::apps::kFinite);
+  };
+  number("--gap-um", gap_um, "working gap [um] (default: the law's g_r, 20 for drill)");
+  number("--debris", debris, "debris concentration c in [0, 1] at the working point (default 0)");
+  number("--kd-us-per-um", kd, "Td slope, overrides the law");
+  number("--tau-v-ms", tau_v_ms, "first-order velocity loop, time constant [ms]");
+  number("--wn", wn, "second-order axis, command -> velocity (default 200 rad/s)");
+  number("--zeta", zeta, "its damping (default 0.55)");
+  number("--tau-m-ms", tau_m_ms, "first-order lag on the measured Td [ms] (default 0: none)");
+  number("--tdr-us", tdr_us, "size of the Tdr step used for J [us] (default 1; J scales with D^2)");
+  number("--kg", kg_eval, "also evaluate this Kg [(mm/s)/us]");
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
   if (tau_v_ms && (wn || zeta)) return bad("--tau-v-ms excludes --wn/--zeta (pick one axis model)");
 
   if (debris) law.debris = *debris;
@@ -199,5 +174,5 @@ int main(int argc, char** argv) {
     const auto t = edm::kgdesign::error_transfer(m, *kg_eval);
     print_poles(edm::kgdesign::polynomial_roots(t.a));
   }
-  return kExitOk;
+  return edm::apps::kExitOk;
 }

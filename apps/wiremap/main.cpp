@@ -13,32 +13,25 @@
 #include <string>
 #include <string_view>
 
-#include "cli_number.hpp"
+#include "edm/apps/cli.hpp"
 #include "edm/sim/plant.hpp"
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitBadInput = 2;
+using edm::apps::kExitBadInput;
+using edm::apps::kExitOk;
 
 constexpr const char* kUsage =
-    "usage: edm-wiremap [--thickness-mm H] [--seed N] [--open-voltage-v U] [--settle-s S]\n"
-    "                   [--measure-s M]\n"
-    "  --thickness-mm  part thickness H [mm] (default 50, seed 000's case 1)\n"
-    "  --seed          simulator seed (default 1)\n"
-    "  --open-voltage-v ignition voltage [V] (default 110, seed 000's machine)\n"
-    "  --settle-s      time before measuring [s] (default 20: the kerf debris settles)\n"
-    "  --measure-s     time measured [s] (default 20)\n";
+    "edm-wiremap [--thickness-mm H] [--seed N] [--open-voltage-v U] [--settle-s S]\n"
+    "                   [--measure-s M]";
 
 constexpr double kArcOffUs[] = {9, 12, 15, 20, 30, 40, 50};
 constexpr double kServoRefV[] = {30, 35, 40, 45, 50, 60, 70};
 
 int bad(const std::string& msg) {
-  std::fprintf(stderr, "edm-wiremap: %s\n%s", msg.c_str(), kUsage);
+  std::fprintf(stderr, "edm-wiremap: %s\nusage: %s\n", msg.c_str(), kUsage);
   return kExitBadInput;
 }
-
-using edm::apps::parse_number;
 
 struct Cell {
   double rab{0.0};           // mean of the 40 ms Rab, sampled every 40 ms
@@ -74,24 +67,23 @@ Cell measure(const edm::sim::SimParams& params, std::uint64_t seed, double arc_o
 
 int main(int argc, char** argv) {
   double thickness = 50.0, open_v = 110.0, settle_s = 20.0, measure_s = 20.0, seed = 1.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string_view arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::fputs(kUsage, stdout);
-      return kExitOk;
-    }
-    double* target = arg == "--thickness-mm"     ? &thickness
-                     : arg == "--open-voltage-v" ? &open_v
-                     : arg == "--settle-s"       ? &settle_s
-                     : arg == "--measure-s"      ? &measure_s
-                     : arg == "--seed"           ? &seed
-                                                 : nullptr;
-    if (target == nullptr) return bad("unknown option '" + std::string(arg) + "'");
-    if (i + 1 >= argc) return bad(std::string(arg) + " needs a value");
-    const auto v = parse_number(argv[++i]);
-    if (!v) return bad(std::string(arg) + ": not a number: '" + argv[i] + "'");
-    *target = *v;
-  }
+  CLI::App app("edm-wiremap: the wire plant's static map, steady Rab and cut speed over arc-off "
+               "time x servo reference voltage (docs/simulator.md)",
+               "edm-wiremap");
+  app.add_option("--thickness-mm", thickness, "part thickness H [mm] (seed 000's case 1)")
+      ->check(edm::apps::kFinite)
+      ->capture_default_str();
+  app.add_option("--seed", seed, "simulator seed")->check(edm::apps::kFinite)->capture_default_str();
+  app.add_option("--open-voltage-v", open_v, "ignition voltage [V] (seed 000's machine)")
+      ->check(edm::apps::kFinite)
+      ->capture_default_str();
+  app.add_option("--settle-s", settle_s, "time before measuring [s] (the kerf debris settles)")
+      ->check(edm::apps::kFinite)
+      ->capture_default_str();
+  app.add_option("--measure-s", measure_s, "time measured [s]")
+      ->check(edm::apps::kFinite)
+      ->capture_default_str();
+  if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
   if (!(thickness > 0.0)) return bad("--thickness-mm must be > 0");
   if (!(open_v > 0.0)) return bad("--open-voltage-v must be > 0");
   if (!(settle_s >= 0.0 && settle_s <= 3600.0)) return bad("--settle-s must be in [0, 3600]");

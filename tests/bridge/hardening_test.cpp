@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "bridge_fixture.hpp"
+#include "edm/apps/subprocess.hpp"
 #include "edm/bridge/hello_throttle.hpp"
 #include "support/memory_transport.hpp"
 
@@ -213,13 +214,15 @@ TEST_F(Hardening, running_out_of_descriptors_backs_off_and_recovers) {
   // The runtime must be past its start-up (which opens descriptors) before the limit drops.
   ASSERT_TRUE(eventually([&] { return rt_->tasks().front()->cycles() > 10; }));
   // Connections come from another process, so only the server's accept() runs out.
-  FILE* clients =
-      ::popen(("python3 -c \"import socket,sys; sys.stdin.readline(); "
-               "s=[socket.create_connection(('127.0.0.1'," +
-               std::to_string(server_->port()) + ")) for _ in range(20)]; sys.stdin.read()\"")
-                  .c_str(),
-              "w");
-  ASSERT_NE(clients, nullptr);
+  edm::apps::SpawnOptions piped;
+  piped.in = edm::apps::Stream::kPipe;
+  piped.out = edm::apps::Stream::kInherit;
+  edm::apps::Process clients(
+      {"python3", "-c",
+       "import socket,sys; sys.stdin.readline(); s=[socket.create_connection(('127.0.0.1'," +
+           std::to_string(server_->port()) + ")) for _ in range(20)]; sys.stdin.read()"},
+      piped);
+  ASSERT_TRUE(clients.started()) << clients.error();
   rlimit old{};
   ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &old), 0);
   // New descriptors take the lowest free number, and the limit caps numbers: capping at the
@@ -230,8 +233,7 @@ TEST_F(Hardening, running_out_of_descriptors_backs_off_and_recovers) {
   rlimit low = old;
   low.rlim_cur = static_cast<rlim_t>(lowest_free);
   ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &low), 0);
-  std::fputs("go\n", clients);
-  std::fflush(clients);
+  clients.write_input("go\n");
   const auto first_error_by = std::chrono::steady_clock::now();
   const bool errors = eventually([&] { return server_->stats().accept_errors >= 6; });
   const auto sixth = std::chrono::steady_clock::now();
@@ -243,8 +245,8 @@ TEST_F(Hardening, running_out_of_descriptors_backs_off_and_recovers) {
   Client c;
   ASSERT_EQ(c.connect(client_opts()), Role::kOperator);
   EXPECT_TRUE(c.request("ping"));
-  std::fputs("done\n", clients);
-  ::pclose(clients);
+  clients.close_input();  // python's sys.stdin.read() returns: it exits
+  EXPECT_EQ(clients.wait(10s), 0);
 }
 
 // ---- 7. unauthenticated connections: a deadline and a cap of their own -------------------

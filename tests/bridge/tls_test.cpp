@@ -7,40 +7,20 @@
 #include <cstdlib>
 
 #include "bridge_fixture.hpp"
+#include "support/self_signed.hpp"
 
 namespace edm::bridge::test {
 namespace {
 
 using namespace std::chrono_literals;
 
-/// Runs a shell command; returns its stdout (empty on failure).
-std::string run(const std::string& cmd) {
-  std::string out;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) {
-    return out;
-  }
-  char buf[512];
-  while (std::fgets(buf, sizeof buf, p) != nullptr) {
-    out += buf;
-  }
-  return ::pclose(p) == 0 ? out : std::string();
-}
-
 class Tls : public BridgeFixture {
  protected:
   void SetUp() override {
     cert_ = dir_.file("cert.pem");
     key_ = dir_.file("key.pem");
-    const std::string made =
-        run("openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 "
-            "-subj /CN=edmplc-test -addext subjectAltName=IP:127.0.0.1 -keyout " +
-            key_ + " -out " + cert_ + " 2>/dev/null && chmod 600 " + key_ + " && echo made");
-    ASSERT_EQ(made, "made\n") << "openssl could not make a certificate";
-    const std::string fp = run("openssl x509 -in " + cert_ + " -noout -fingerprint -sha256");
-    fingerprint_ = fp.substr(fp.find('=') + 1);
-    fingerprint_.erase(fingerprint_.find_last_not_of("\n") + 1);
-    ASSERT_FALSE(fingerprint_.empty());
+    fingerprint_ = edm::test::make_self_signed(key_, cert_, "edmplc-test");
+    ASSERT_FALSE(fingerprint_.empty()) << "openssl could not make a certificate";
   }
   ServerOptions tls_options() {
     ServerOptions o;
@@ -98,10 +78,7 @@ TEST_F(Tls, an_unverifiable_server_is_refused_by_the_client) {
   // A CA that did not sign the server's certificate.
   const std::string other_key = dir_.file("other-key.pem");
   const std::string other = dir_.file("other.pem");
-  ASSERT_FALSE(run("openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes "
-                   "-days 2 -subj /CN=other -keyout " +
-                   other_key + " -out " + other + " 2>/dev/null && echo ok")
-                   .empty());
+  ASSERT_FALSE(edm::test::make_self_signed(other_key, other, "other").empty());
   ClientOptions c = tls_client();
   c.tls.ca_file = other;
   Client client;

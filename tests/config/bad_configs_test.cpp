@@ -3,7 +3,6 @@
 // The parser (in process) and `edmplc --check` (as a subprocess) must both report exactly that.
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "edm/apps/subprocess.hpp"
 #include "edm/runtime/config.hpp"
 
 namespace edm::rt {
@@ -102,53 +102,21 @@ TEST_P(BadConfigParse, first_diagnostic_matches_expectation) {
 
 INSTANTIATE_TEST_SUITE_P(Files, BadConfigParse, ::testing::ValuesIn(cases()), case_name);
 
-struct CommandResult {
-  int exit_code{-1};
-  std::string output;
-};
-
-// Runs a shell command, capturing stdout and stderr together.
-CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
-  if (p == nullptr) {
-    return r;
-  }
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) {
-    r.output.append(buf.data(), n);
-  }
-  const int status = ::pclose(p);
-  if (status != -1 && WIFEXITED(status)) {
-    r.exit_code = WEXITSTATUS(status);
-  }
-  return r;
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char ch : s) {
-    out += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-  }
-  return out + "'";
-}
-
 class BadConfigCheck : public ::testing::TestWithParam<BadCase> {};
 
 TEST_P(BadConfigCheck, edmplc_check_reports_it_and_exits_2) {
   const BadCase& c = GetParam();
   ASSERT_GT(c.line, 0) << c.path;
-  // timeout: a hang is a failure (exit 124), not a stuck test run.
-  const CommandResult r = run_command("timeout 20 " + shell_quote(EDM_EDMPLC_PATH) +
-                                      " --check --config " + shell_quote(c.path));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
+  // A hang is a failure ("no exit after 20 s"), not a stuck test run.
+  const edm::apps::RunResult r = edm::apps::run(
+      {EDM_EDMPLC_PATH, "--check", "--config", c.path}, {}, std::chrono::seconds(20));
+  EXPECT_EQ(r.exit_code, 2) << r.error << r.out;  // r.out: stdout and stderr together
   const std::string where =
       c.path + ":" + std::to_string(c.line) + ":" + std::to_string(c.col) + ":";
-  EXPECT_NE(r.output.find(where), std::string::npos) << "expected '" << where << "' in:\n"
-                                                     << r.output;
-  EXPECT_NE(r.output.find(c.message), std::string::npos) << "expected '" << c.message << "' in:\n"
-                                                         << r.output;
+  EXPECT_NE(r.out.find(where), std::string::npos) << "expected '" << where << "' in:\n"
+                                                     << r.out;
+  EXPECT_NE(r.out.find(c.message), std::string::npos) << "expected '" << c.message << "' in:\n"
+                                                         << r.out;
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, BadConfigCheck, ::testing::ValuesIn(cases()), case_name);

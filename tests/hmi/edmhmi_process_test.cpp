@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "process_fixture.hpp"
+#include "support/self_signed.hpp"
 
 namespace edm::hmi::test {
 namespace {
@@ -256,14 +257,8 @@ TEST_F(EdmhmiTokenTest, WrongOrMissingTokenIsUnauthorized) {
 class EdmhmiTlsTest : public EdmhmiTokenTest {
  protected:
   void SetUp() override {
-    const std::string made = run_shell(
-        "openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 "
-        "-subj /CN=edm-test -addext subjectAltName=IP:127.0.0.1 -keyout " +
-        key_ + " -out " + cert_ + " 2>/dev/null && chmod 600 " + key_ + " && openssl x509 -in " +
-        cert_ + " -noout -fingerprint -sha256");
-    ASSERT_NE(made.find('='), std::string::npos) << "openssl could not make a certificate";
-    fingerprint_ = made.substr(made.find('=') + 1);
-    fingerprint_.erase(fingerprint_.find_last_not_of('\n') + 1);
+    fingerprint_ = edm::test::make_self_signed(key_, cert_, "edm-test");
+    ASSERT_FALSE(fingerprint_.empty()) << "openssl could not make a certificate";
     write_token(op_, "op-3c1d77a0b1c2d3e4");
     std::string cfg = read_file(kDrillSim);
     const std::string anchor = "\n  port: 7730\n";
@@ -276,15 +271,6 @@ class EdmhmiTlsTest : public EdmhmiTokenTest {
     tls.enabled = true;
     tls.ca_file = cert_;
     start_plc(config_, "op-3c1d77a0b1c2d3e4", tls);
-  }
-  static std::string run_shell(const std::string& cmd) {
-    std::string out;
-    if (FILE* p = ::popen(cmd.c_str(), "r")) {
-      char buf[256];
-      while (std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
-      if (::pclose(p) != 0) out.clear();
-    }
-    return out;
   }
   std::string cert_ = dir_.file("bridge.crt");
   std::string key_ = dir_.file("bridge.key");

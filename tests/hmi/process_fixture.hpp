@@ -1,16 +1,12 @@
 #pragma once
 // Process tests of edmhmi against a real edmplc (virtual clock paced to a multiple of wall time,
 // the bridge on a free loopback port): child processes whose stdout and stderr go to files (no
-// pipe can fill up and block a child nobody reads), waits that poll observable state with a
-// deadline, and a fixture that kills every child it started in its teardown.
+// pipe can fill up and block a child nobody reads), waits for observable state with a deadline,
+// and a fixture that kills every child it started in its teardown.
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
-#include <signal.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -24,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "edm/apps/subprocess.hpp"
 #include "edm/bridge/client.hpp"
 #include "support/temp_dir.hpp"
 
@@ -63,81 +60,32 @@ inline int free_port() {
 
 using Env = std::vector<std::pair<std::string, std::string>>;
 
-/// A child process; stdout and stderr to files. The edmhmi connection variables of the test's
-/// own environment are removed, then `env` is set. Killed (SIGKILL) and reaped when destroyed.
-class Proc {
+/// A child process (edm::apps::Process); stdout and stderr to files. The edmhmi connection
+/// variables of the test's own environment are removed, then `env` is set. Killed (SIGKILL, its
+/// group) and reaped when destroyed.
+class Proc : public edm::apps::Process {
  public:
   Proc(const std::vector<std::string>& argv, std::string out_path, std::string err_path,
        const Env& env = {})
-      : out_path_(std::move(out_path)), err_path_(std::move(err_path)) {
-    std::vector<char*> args;
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    // The environment is built before fork (the child only calls async-signal-safe functions).
-    std::vector<std::string> env_text;
-    for (char** e = environ; *e != nullptr; ++e) {
-      const std::string v(*e);
-      bool connection = false;
-      for (const char* n : {"EDM_HOST=", "EDM_PORT=", "EDM_TOKEN_FILE=", "EDM_TOKEN="}) {
-        connection = connection || v.starts_with(n);
-      }
-      if (!connection) env_text.push_back(v);
-    }
-    for (const auto& [k, v] : env) env_text.push_back(k + "=" + v);
-    std::vector<char*> envp;
-    for (auto& e : env_text) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int out = ::open(out_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-      const int err = ::open(err_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
-      if (out < 0 || err < 0) _exit(126);
-      ::dup2(out, STDOUT_FILENO);
-      ::dup2(err, STDERR_FILENO);
-      const int null = ::open("/dev/null", O_RDONLY);
-      if (null >= 0) ::dup2(null, STDIN_FILENO);
-      ::execve(args[0], args.data(), envp.data());
-      _exit(127);
-    }
-  }
-  ~Proc() { kill(); }
-  Proc(const Proc&) = delete;
-  Proc& operator=(const Proc&) = delete;
+      : Process(argv, options(out_path, err_path, env)),
+        out_path_(std::move(out_path)),
+        err_path_(std::move(err_path)) {}
 
-  [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] std::string out() const { return read_file(out_path_); }
   [[nodiscard]] std::string err() const { return read_file(err_path_); }
-  void signal(int sig) const {
-    if (pid_ > 0 && !status_) ::kill(pid_, sig);
-  }
-
-  /// The exit status (128 + signal when killed), once it has ended.
-  std::optional<int> poll() {
-    if (status_ || pid_ <= 0) return status_;
-    int st = 0;
-    if (::waitpid(pid_, &st, WNOHANG) == pid_) {
-      status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-    }
-    return status_;
-  }
-  /// Waits for the end with a deadline; nullopt if still running then.
-  std::optional<int> wait(std::chrono::milliseconds timeout) {
-    poll_until([this] { return poll().has_value(); }, timeout, 5ms);
-    return status_;
-  }
-  /// SIGKILL and reap (no-op once ended).
-  void kill() {
-    if (pid_ <= 0 || status_) return;
-    ::kill(pid_, SIGKILL);
-    int st = 0;
-    ::waitpid(pid_, &st, 0);
-    status_ = 128 + SIGKILL;
-  }
 
  private:
+  static edm::apps::SpawnOptions options(const std::string& out, const std::string& err,
+                                         const Env& env) {
+    edm::apps::SpawnOptions o;
+    o.out = o.err = edm::apps::Stream::kFile;
+    o.out_file = out;
+    o.err_file = err;
+    o.unset_env = {"EDM_HOST", "EDM_PORT", "EDM_TOKEN_FILE", "EDM_TOKEN"};
+    o.set_env = env;
+    return o;
+  }
   std::string out_path_, err_path_;
-  pid_t pid_{-1};
-  std::optional<int> status_;
 };
 
 struct Outcome {

@@ -1,10 +1,7 @@
 // Acceptance test of the atomic write: a writer killed with SIGKILL at random moments never leaves
 // a retain file that fails to load or mixes two iterations.
 #include <gtest/gtest.h>
-#include <poll.h>
-#include <signal.h>
 #include <stdlib.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +12,7 @@
 #include <string>
 #include <system_error>
 
+#include "edm/apps/subprocess.hpp"
 #include "edm/runtime/retain.hpp"
 #include "support/temp_dir.hpp"
 
@@ -53,34 +51,23 @@ RetainMap iteration_map(std::int64_t it) {
   return m;
 }
 
-// Child: write iterations forever, reporting each completed (renamed) one through the pipe.
-[[noreturn]] void child_loop(const std::string& path, std::int64_t first, int report_fd) {
-  try {
-    for (std::int64_t it = first;; ++it) {
-      write_retain_file_atomic(path, iteration_map(it));
-      const char done = 1;
-      if (::write(report_fd, &done, 1) != 1) {
-        ::_exit(4);
-      }
+// Child: write iterations forever, reporting each completed (renamed) one on stdout (a pipe).
+[[noreturn]] void child_loop(const std::string& path, std::int64_t first) {
+  for (std::int64_t it = first;; ++it) {
+    write_retain_file_atomic(path, iteration_map(it));
+    const char done = 1;
+    if (::write(STDOUT_FILENO, &done, 1) != 1) {
+      ::_exit(4);
     }
-  } catch (...) {
-    ::_exit(3);
   }
 }
 
 // Reads n completion reports; false if the child died or went silent.
-bool wait_for_reports(int fd, int n) {
-  for (int got = 0; got < n;) {
-    pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, /*timeout_ms=*/10'000) <= 0) {
+bool wait_for_reports(edm::apps::Process& child, std::size_t n) {
+  while (child.output().size() < n) {
+    if (!child.read_some(std::chrono::seconds(10))) {
       return false;
     }
-    char buf[64];
-    const ssize_t r = ::read(fd, buf, static_cast<std::size_t>(std::min(n - got, 64)));
-    if (r <= 0) {
-      return false;
-    }
-    got += static_cast<int>(r);
   }
   return true;
 }
@@ -110,24 +97,18 @@ TEST(RetainKill9, file_always_loads_whole_and_from_one_iteration) {
   for (int trial = 1; trial <= kTrials; ++trial) {
     SCOPED_TRACE("trial " + std::to_string(trial) + ", seed " + std::to_string(kSeed));
     const std::int64_t first = trial * kTrialStride + 1;
-    int fds[2];
-    ASSERT_EQ(::pipe(fds), 0);
-    const pid_t pid = ::fork();
-    ASSERT_GE(pid, 0);
-    if (pid == 0) {
-      ::close(fds[0]);
-      child_loop(path, first, fds[1]);
-    }
-    ::close(fds[1]);
+    edm::apps::SpawnOptions reports_only;
+    reports_only.err = edm::apps::Stream::kInherit;
+    edm::apps::Process writer =
+        edm::apps::Process::fork_call([&] { child_loop(path, first); }, reports_only);
+    ASSERT_TRUE(writer.started()) << writer.error();
+    const pid_t pid = writer.pid();
     const int reports = reports_dist(rng);
-    const bool alive = wait_for_reports(fds[0], reports);
+    const bool alive = wait_for_reports(writer, static_cast<std::size_t>(reports));
     busy_spin(std::chrono::nanoseconds(spin_dist(rng)));
-    ::kill(pid, SIGKILL);
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ::close(fds[0]);
+    writer.kill();
     ASSERT_TRUE(alive) << "writer stopped reporting";
-    ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << "status " << status;
+    ASSERT_EQ(writer.term_signal(), SIGKILL) << writer.describe();
     // The temp name is `path.tmp.<pid>.<random>`: look for the killed writer's prefix.
     const std::string killed_prefix =
         fs::path(path).filename().string() + ".tmp." + std::to_string(pid) + ".";

@@ -1,7 +1,7 @@
 #pragma once
-// Child processes and temp files for the bench drivers: run a tool without a shell, capture its
-// stdout through a pipe and its stderr into a file, with a time limit and Ctrl-C handling.
-// Non-RT. Not thread-safe: one child at a time, from the main thread.
+// What the bench drivers share: a temp directory, a tool run the drivers' way (edm::apps::run with
+// stdout captured and stderr into a file), failure texts with the tool's last lines, the PM QoS
+// hold. Non-RT. Not thread-safe: from the main thread.
 
 #include <chrono>
 #include <cstddef>
@@ -11,6 +11,8 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "edm/apps/subprocess.hpp"
 
 namespace edm::bench {
 
@@ -39,19 +41,13 @@ class TempDir {
   fs::path path_;
 };
 
-struct ChildResult {
-  std::string error;  // non-empty: could not start, timed out or interrupted
-  int exit_code{-1};  // >= 0 when the child exited normally
-  int signal{0};      // the signal that ended it, if any
-  std::string out;    // its stdout
-};
+using ChildResult = edm::apps::RunResult;
+using edm::apps::find_in_path;
+using edm::apps::install_stop_handlers;
 
-/// Makes SIGINT and SIGTERM stop the running child (run_child() then reports "interrupted").
-void install_stop_handlers();
-
-/// Runs args[0] (an absolute path; no shell) with stdin from /dev/null, stdout captured, stderr
-/// into `err_path`, optionally pinned with all its threads to `cpu` (sched_setaffinity before
-/// exec). Kills it (SIGTERM, 2 s later SIGKILL) after `timeout` or on SIGINT/SIGTERM.
+/// Runs args[0] (no shell) with stdin from /dev/null, stdout captured, stderr into `err_path`,
+/// optionally pinned with all its threads to `cpu`. Stopped (SIGTERM, 2 s later SIGKILL) after
+/// `timeout` or on SIGINT/SIGTERM.
 ChildResult run_child(const std::vector<std::string>& args, const fs::path& err_path,
                       std::optional<int> cpu, std::chrono::seconds timeout);
 
@@ -63,9 +59,6 @@ std::string read_file(const fs::path& path);
 
 /// The last `n` lines of `text`, indented with "    | ", for error messages.
 std::string tail_lines(const std::string& text, std::size_t n);
-
-/// The first executable `name` in $PATH.
-std::optional<std::string> find_in_path(const std::string& name);
 
 /// Holds /dev/cpu_dma_latency at 0 us (no deep C-states) until the returned fd is closed; -1 and
 /// a note on stdout when that is not allowed.
