@@ -12,40 +12,29 @@ namespace {
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 }  // namespace
 
-std::vector<rt::ParamError> CircularInterpolatorParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_finite(errs, "x0_mm", x0_mm);
-  rt::require_finite(errs, "y0_mm", y0_mm);
-  rt::require_finite(errs, "end_tol_mm", end_tol_mm);
-  if (std::isfinite(end_tol_mm)) {
-    rt::require_non_negative(errs, "end_tol_mm", end_tol_mm);
-  }
-  return errs;
-}
-
 void CircularInterpolator::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start_);
-  v.input("cw", cw_);
-  v.input("i_mm", i_, "mm");
-  v.input("j_mm", j_, "mm");
-  v.input("full_circle", full_circle_);
-  v.input("turns", turns_);
-  v.input("ex_mm", ex_, "mm");
-  v.input("ey_mm", ey_, "mm");
-  v.input("feed_mm_min", feed_, "mm/min");
-  v.input("override", override_);
-  v.input("hold", hold_);
-  v.input("load", load_);
-  v.input("load_x_mm", load_x_, "mm");
-  v.input("load_y_mm", load_y_, "mm");
-  v.output("rx_mm", rx_, "mm");
-  v.output("ry_mm", ry_, "mm");
-  v.output("vx_mm_s", vx_, "mm/s");
-  v.output("vy_mm_s", vy_, "mm/s");
-  v.output("angle_rad", angle_, "rad");
-  v.output("swept_rad", swept_, "rad");
-  v.output("busy", busy_);
-  v.output("done", done_);
+  v.input("start", start);
+  v.input("cw", cw);
+  v.input("i_mm", i_mm, "mm");
+  v.input("j_mm", j_mm, "mm");
+  v.input("full_circle", full_circle);
+  v.input("turns", turns);
+  v.input("ex_mm", ex_mm, "mm");
+  v.input("ey_mm", ey_mm, "mm");
+  v.input("feed_mm_min", feed_mm_min, "mm/min");
+  v.input("override", feed_override);
+  v.input("hold", hold);
+  v.input("load", load);
+  v.input("load_x_mm", load_x_mm, "mm");
+  v.input("load_y_mm", load_y_mm, "mm");
+  v.output("rx_mm", rx_mm, "mm");
+  v.output("ry_mm", ry_mm, "mm");
+  v.output("vx_mm_s", vx_mm_s, "mm/s");
+  v.output("vy_mm_s", vy_mm_s, "mm/s");
+  v.output("angle_rad", angle_rad, "rad");
+  v.output("swept_rad", swept_rad, "rad");
+  v.output("busy", busy);
+  v.output("done", done);
 }
 
 std::vector<rt::ParamError> CircularInterpolator::configure(const rt::BlockSetup& setup) {
@@ -83,14 +72,14 @@ void CircularInterpolator::enter_safe_state(const rt::SafeStateRequest& /*reques
 }
 
 bool CircularInterpolator::latch_move() noexcept {
-  const double i = i_.get();
-  const double j = j_.get();
-  const double feed_mm_min = feed_.get();
-  const bool full = full_circle_.get();
-  const double ex = ex_.get();
-  const double ey = ey_.get();
-  if (!std::isfinite(i) || !std::isfinite(j) || !std::isfinite(feed_mm_min) ||
-      !(feed_mm_min > 0.0)) {
+  const double i = i_mm.get();
+  const double j = j_mm.get();
+  const double feed_mm_min_now = feed_mm_min.get();
+  const bool full = full_circle.get();
+  const double ex = ex_mm.get();
+  const double ey = ey_mm.get();
+  if (!std::isfinite(i) || !std::isfinite(j) || !std::isfinite(feed_mm_min_now) ||
+      !(feed_mm_min_now > 0.0)) {
     return false;
   }
   const double r = std::hypot(i, j);
@@ -100,16 +89,16 @@ bool CircularInterpolator::latch_move() noexcept {
     return false;
   }
   const double theta0 = std::atan2(-j, -i);
-  const double sigma = cw_.get() ? -1.0 : 1.0;
+  const double sigma = cw.get() ? -1.0 : 1.0;
   double sweep = 0.0;
   double end_x = x_;
   double end_y = y_;
   if (full) {
-    const std::int64_t turns = turns_.get();
-    if (turns < 1 || turns > kMaxTurns) {
+    const std::int64_t turns_now = turns.get();
+    if (turns_now < 1 || turns_now > kMaxTurns) {
       return false;
     }
-    sweep = kTwoPi * static_cast<double>(turns);
+    sweep = kTwoPi * static_cast<double>(turns_now);
   } else {
     if (!std::isfinite(ex) || !std::isfinite(ey)) {
       return false;
@@ -144,20 +133,20 @@ bool CircularInterpolator::latch_move() noexcept {
   sigma_ = sigma;
   sweep_ = sweep;
   phi_ = 0.0;
-  feed_mm_s_ = feed_mm_min / 60.0;
+  feed_mm_s_ = feed_mm_min_now / 60.0;
   busy_state_ = true;
   done_state_ = false;
   return true;
 }
 
 rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start = start_.get();
-  const bool edge = start && !prev_start_;
-  prev_start_ = start;
+  const bool start_now = start.get();
+  const bool edge = start_now && !prev_start_;
+  prev_start_ = start_now;
 
-  if (load_.get()) {
-    const double lx = load_x_.get();
-    const double ly = load_y_.get();
+  if (load.get()) {
+    const double lx = load_x_mm.get();
+    const double ly = load_y_mm.get();
     if (!std::isfinite(lx) || !std::isfinite(ly)) {
       publish(0.0, 0.0);
       return rt::BlockStatus::kFault;
@@ -181,14 +170,14 @@ rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) no
     return rt::BlockStatus::kOk;
   }
 
-  const double ov_in = override_.get();
+  const double ov_in = feed_override.get();
   if (!std::isfinite(ov_in)) {
     publish(0.0, 0.0);
     return rt::BlockStatus::kFault;
   }
   const double ov = std::clamp(ov_in, 0.0, kMaxOverride);
   const rt::BlockStatus status = ov != ov_in ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-  if (hold_.get()) {
+  if (hold.get()) {
     publish(0.0, 0.0);
     return status;
   }
@@ -218,15 +207,15 @@ rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) no
   return status;
 }
 
-void CircularInterpolator::publish(double vx_mm_s, double vy_mm_s) noexcept {
-  rx_.set(x_);
-  ry_.set(y_);
-  vx_.set(vx_mm_s);
-  vy_.set(vy_mm_s);
-  angle_.set(std::remainder(theta_, kTwoPi));
-  swept_.set(phi_);
-  busy_.set(busy_state_);
-  done_.set(done_state_);
+void CircularInterpolator::publish(double vx_mm_s_now, double vy_mm_s_now) noexcept {
+  rx_mm.set(x_);
+  ry_mm.set(y_);
+  vx_mm_s.set(vx_mm_s_now);
+  vy_mm_s.set(vy_mm_s_now);
+  angle_rad.set(std::remainder(theta_, kTwoPi));
+  swept_rad.set(phi_);
+  busy.set(busy_state_);
+  done.set(done_state_);
 }
 
 }  // namespace edm::blocks

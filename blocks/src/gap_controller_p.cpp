@@ -7,20 +7,6 @@ namespace edm::blocks {
 
 std::vector<rt::ParamError> GapControllerPParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_finite(errs, "kg", kg);
-  rt::require_finite(errs, "tdr_default_us", tdr_default_us);
-  rt::require_finite(errs, "v_feed_max_mm_s", v_feed_max_mm_s);
-  rt::require_finite(errs, "v_retract_max_mm_s", v_retract_max_mm_s);
-  rt::require_finite(errs, "retract_speed_mm_s", retract_speed_mm_s);
-  rt::require_finite(errs, "idle_feed_mm_s", idle_feed_mm_s);
-  if (!errs.empty()) {
-    return errs;
-  }
-  rt::require_positive(errs, "kg", kg);
-  rt::require_positive(errs, "tdr_default_us", tdr_default_us);
-  rt::require_positive(errs, "v_feed_max_mm_s", v_feed_max_mm_s);
-  rt::require_positive(errs, "v_retract_max_mm_s", v_retract_max_mm_s);
-  rt::require_positive(errs, "retract_speed_mm_s", retract_speed_mm_s);
   rt::require_range(errs, "idle_feed_mm_s", idle_feed_mm_s, -v_feed_max_mm_s, 0.0);
   if (errs.empty()) {
     rt::require_ordered(errs, "retract_speed_mm_s", retract_speed_mm_s, "v_retract_max_mm_s",
@@ -30,38 +16,38 @@ std::vector<rt::ParamError> GapControllerPParams::validate() const {
 }
 
 void GapControllerP::visit_pins(rt::PinVisitor& v) {
-  v.input("td_us", td_us_, "us");
-  v.input("valid", valid_);
-  v.input("enable", enable_);
-  v.input("hold", hold_);
-  v.input("retract", retract_);
-  v.input("tdr_us", tdr_us_, "us");
-  v.output("vz_mm_s", vz_mm_s_, "mm/s");
-  v.output("saturated", saturated_);
+  v.input("td_us", td_us, "us");
+  v.input("valid", valid);
+  v.input("enable", enable);
+  v.input("hold", hold);
+  v.input("retract", retract);
+  v.input("tdr_us", tdr_us, "us");
+  v.output("vz_mm_s", vz_mm_s, "mm/s");
+  v.output("saturated", saturated);
 }
 
 void GapControllerP::activate() noexcept {
-  vz_mm_s_.set(0.0);
-  saturated_.set(false);
+  vz_mm_s.set(0.0);
+  saturated.set(false);
 }
 
 rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept {
   const auto& p = params_;
-  if (retract_.get()) {
+  if (retract.get()) {
     // Validated retract_speed ≤ v_retract_max; the limit guards a direct set_params().
-    vz_mm_s_.set(std::min(p.retract_speed_mm_s, p.v_retract_max_mm_s));
-    saturated_.set(false);
+    vz_mm_s.set(std::min(p.retract_speed_mm_s, p.v_retract_max_mm_s));
+    saturated.set(false);
     return rt::BlockStatus::kOk;
   }
-  if (!enable_.get() || hold_.get()) {
-    vz_mm_s_.set(0.0);
-    saturated_.set(false);
+  if (!enable.get() || hold.get()) {
+    vz_mm_s.set(0.0);
+    saturated.set(false);
     return rt::BlockStatus::kOk;
   }
   double vz = p.idle_feed_mm_s;
-  if (valid_.get()) {
-    const double td = td_us_.get();
-    const double tdr_in = tdr_us_.get();
+  if (valid.get()) {
+    const double td = td_us.get();
+    const double tdr_in = tdr_us.get();
     if (!std::isfinite(td) || !std::isfinite(tdr_in) || tdr_in < 0.0) {
       return rt::BlockStatus::kFault;
     }
@@ -73,10 +59,10 @@ rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept
   }
   // max/min rather than std::clamp: no undefined behaviour for limits that bypassed validate().
   const double limited = std::min(std::max(vz, -p.v_feed_max_mm_s), p.v_retract_max_mm_s);
-  const bool saturated = limited != vz;
-  vz_mm_s_.set(limited);
-  saturated_.set(saturated);
-  return saturated ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
+  const bool saturated_now = limited != vz;
+  vz_mm_s.set(limited);
+  saturated.set(saturated_now);
+  return saturated_now ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
 }
 
 }  // namespace edm::blocks

@@ -7,34 +7,26 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> LinearInterpolatorParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_finite(errs, "x0_mm", x0_mm);
-  rt::require_finite(errs, "y0_mm", y0_mm);
-  rt::require_finite(errs, "z0_mm", z0_mm);
-  return errs;
-}
-
 void LinearInterpolator::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start_);
-  v.input("lx_mm", lx_, "mm");
-  v.input("ly_mm", ly_, "mm");
-  v.input("lz_mm", lz_, "mm");
-  v.input("feed_mm_min", feed_, "mm/min");
-  v.input("override", override_);
-  v.input("hold", hold_);
-  v.input("load", load_);
-  v.input("load_x_mm", load_x_, "mm");
-  v.input("load_y_mm", load_y_, "mm");
-  v.input("load_z_mm", load_z_, "mm");
-  v.output("rx_mm", rx_, "mm");
-  v.output("ry_mm", ry_, "mm");
-  v.output("rz_mm", rz_, "mm");
-  v.output("vx_mm_s", vx_, "mm/s");
-  v.output("vy_mm_s", vy_, "mm/s");
-  v.output("vz_mm_s", vz_, "mm/s");
-  v.output("busy", busy_);
-  v.output("done", done_);
+  v.input("start", start);
+  v.input("lx_mm", lx_mm, "mm");
+  v.input("ly_mm", ly_mm, "mm");
+  v.input("lz_mm", lz_mm, "mm");
+  v.input("feed_mm_min", feed_mm_min, "mm/min");
+  v.input("override", feed_override);
+  v.input("hold", hold);
+  v.input("load", load);
+  v.input("load_x_mm", load_x_mm, "mm");
+  v.input("load_y_mm", load_y_mm, "mm");
+  v.input("load_z_mm", load_z_mm, "mm");
+  v.output("rx_mm", rx_mm, "mm");
+  v.output("ry_mm", ry_mm, "mm");
+  v.output("rz_mm", rz_mm, "mm");
+  v.output("vx_mm_s", vx_mm_s, "mm/s");
+  v.output("vy_mm_s", vy_mm_s, "mm/s");
+  v.output("vz_mm_s", vz_mm_s, "mm/s");
+  v.output("busy", busy);
+  v.output("done", done);
 }
 
 std::vector<rt::ParamError> LinearInterpolator::configure(const rt::BlockSetup& setup) {
@@ -66,10 +58,10 @@ void LinearInterpolator::enter_safe_state(const rt::SafeStateRequest& /*request*
 }
 
 bool LinearInterpolator::latch_move() noexcept {
-  const Vec3 l{lx_.get(), ly_.get(), lz_.get()};
-  const double feed_mm_min = feed_.get();
+  const Vec3 l{lx_mm.get(), ly_mm.get(), lz_mm.get()};
+  const double feed_mm_min_now = feed_mm_min.get();
   if (!std::isfinite(l[0]) || !std::isfinite(l[1]) || !std::isfinite(l[2]) ||
-      !std::isfinite(feed_mm_min)) {
+      !std::isfinite(feed_mm_min_now)) {
     return false;
   }
   const double len = std::hypot(l[0], l[1], l[2]);
@@ -91,22 +83,22 @@ bool LinearInterpolator::latch_move() noexcept {
     done_state_ = true;
     return true;
   }
-  if (!(feed_mm_min > 0.0)) {
+  if (!(feed_mm_min_now > 0.0)) {
     return false;
   }
-  feed_mm_s_ = feed_mm_min / 60.0;
+  feed_mm_s_ = feed_mm_min_now / 60.0;
   busy_state_ = true;
   done_state_ = false;
   return true;
 }
 
 rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start = start_.get();
-  const bool edge = start && !prev_start_;
-  prev_start_ = start;
+  const bool start_now = start.get();
+  const bool edge = start_now && !prev_start_;
+  prev_start_ = start_now;
 
-  if (load_.get()) {
-    const Vec3 p{load_x_.get(), load_y_.get(), load_z_.get()};
+  if (load.get()) {
+    const Vec3 p{load_x_mm.get(), load_y_mm.get(), load_z_mm.get()};
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
       publish({});
       return rt::BlockStatus::kFault;
@@ -129,14 +121,14 @@ rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noex
     return rt::BlockStatus::kOk;
   }
 
-  const double ov_in = override_.get();
+  const double ov_in = feed_override.get();
   if (!std::isfinite(ov_in)) {
     publish({});
     return rt::BlockStatus::kFault;
   }
   const double ov = std::clamp(ov_in, 0.0, kMaxOverride);
   const rt::BlockStatus status = ov != ov_in ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-  if (hold_.get()) {
+  if (hold.get()) {
     publish({});
     return status;
   }
@@ -165,14 +157,14 @@ rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noex
 }
 
 void LinearInterpolator::publish(const Vec3& v_mm_s) noexcept {
-  rx_.set(pos_[0]);
-  ry_.set(pos_[1]);
-  rz_.set(pos_[2]);
-  vx_.set(v_mm_s[0]);
-  vy_.set(v_mm_s[1]);
-  vz_.set(v_mm_s[2]);
-  busy_.set(busy_state_);
-  done_.set(done_state_);
+  rx_mm.set(pos_[0]);
+  ry_mm.set(pos_[1]);
+  rz_mm.set(pos_[2]);
+  vx_mm_s.set(v_mm_s[0]);
+  vy_mm_s.set(v_mm_s[1]);
+  vz_mm_s.set(v_mm_s[2]);
+  busy.set(busy_state_);
+  done.set(done_state_);
 }
 
 }  // namespace edm::blocks

@@ -5,35 +5,20 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> OrbitExpanderParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_finite(errs, "kr", kr);
-  rt::require_finite(errs, "dr_max_mm", dr_max_mm);
-  if (std::isfinite(kr)) {
-    rt::require_non_negative(errs, "kr", kr);
-  }
-  if (std::isfinite(dr_max_mm)) {
-    rt::require_non_negative(errs, "dr_max_mm", dr_max_mm);
-  }
-  rt::require_range(errs, "samples_per_rev", static_cast<double>(samples_per_rev), 0.0,
-                    static_cast<double>(OrbitExpander::kMaxSamplesPerRev));
-  return errs;
-}
-
 void OrbitExpander::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start_);
-  v.input("r0_mm", r0_, "mm");
-  v.input("final_radius_mm", final_radius_, "mm");
-  v.input("enable", enable_);
-  v.input("td_us", td_, "us");
-  v.input("valid", valid_);
-  v.input("rev_pulse", rev_pulse_);
-  v.output("radius_mm", radius_, "mm");
-  v.output("dr_mm", dr_, "mm");
-  v.output("tdm_us", tdm_, "us");
-  v.output("revolutions", revolutions_);
-  v.output("busy", busy_);
-  v.output("done", done_);
+  v.input("start", start);
+  v.input("r0_mm", r0_mm, "mm");
+  v.input("final_radius_mm", final_radius_mm, "mm");
+  v.input("enable", enable);
+  v.input("td_us", td_us, "us");
+  v.input("valid", valid);
+  v.input("rev_pulse", rev_pulse);
+  v.output("radius_mm", radius_mm, "mm");
+  v.output("dr_mm", dr_mm, "mm");
+  v.output("tdm_us", tdm_us, "us");
+  v.output("revolutions", revolutions);
+  v.output("busy", busy);
+  v.output("done", done);
 }
 
 void OrbitExpander::activate() noexcept {
@@ -53,18 +38,18 @@ void OrbitExpander::activate() noexcept {
 }
 
 rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start = start_.get();
-  const bool start_edge = start && !prev_start_;
-  prev_start_ = start;
+  const bool start_now = start.get();
+  const bool start_edge = start_now && !prev_start_;
+  prev_start_ = start_now;
   // rev_pulse edges are tracked in every cycle so that a pulse held high across a pause or a
   // start does not count twice.
-  const bool rev = rev_pulse_.get();
+  const bool rev = rev_pulse.get();
   const bool rev_edge = rev && !prev_rev_;
   prev_rev_ = rev;
 
   if (start_edge && !busy_state_) {
-    const double r0 = r0_.get();
-    const double fin = final_radius_.get();
+    const double r0 = r0_mm.get();
+    const double fin = final_radius_mm.get();
     if (!std::isfinite(r0) || !std::isfinite(fin) || r0 < 0.0 || fin < r0) {
       publish();
       return rt::BlockStatus::kFault;
@@ -82,14 +67,14 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
     publish();
     return rt::BlockStatus::kOk;  // collecting starts with the next sample
   }
-  if (!busy_state_ || !enable_.get()) {
+  if (!busy_state_ || !enable.get()) {
     publish();
     return rt::BlockStatus::kOk;
   }
 
   rt::BlockStatus status = rt::BlockStatus::kOk;
-  if (valid_.get()) {
-    const double td = td_.get();
+  if (valid.get()) {
+    const double td = td_us.get();
     if (std::isfinite(td)) {
       sum_us_ += td;
       ++n_valid_;
@@ -138,12 +123,12 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
 }
 
 void OrbitExpander::publish() noexcept {
-  radius_.set(radius_mm_);
-  dr_.set(dr_mm_);
-  tdm_.set(tdm_us_);
-  revolutions_.set(revs_);
-  busy_.set(busy_state_);
-  done_.set(done_state_);
+  radius_mm.set(radius_mm_);
+  dr_mm.set(dr_mm_);
+  tdm_us.set(tdm_us_);
+  revolutions.set(revs_);
+  busy.set(busy_state_);
+  done.set(done_state_);
 }
 
 }  // namespace edm::blocks

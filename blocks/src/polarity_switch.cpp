@@ -4,27 +4,21 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> PolaritySwitchParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_positive(errs, "settle", rt::to_seconds(settle));
-  return errs;
-}
-
 void PolaritySwitch::visit_pins(rt::PinVisitor& v) {
-  v.input("request_positive", request_positive_);
-  v.input("generator_on_request", generator_on_request_);
-  v.output("polarity_positive", polarity_positive_);
-  v.output("generator_on", generator_on_);
-  v.output("switching", switching_);
+  v.input("request_positive", request_positive);
+  v.input("generator_on_request", generator_on_request);
+  v.output("polarity_positive", polarity_positive);
+  v.output("generator_on", generator_on);
+  v.output("switching", switching);
 }
 
 void PolaritySwitch::activate() noexcept {
   polarity_ = params_.initial_positive;
   gen_on_ = false;
   started_ = false;
-  polarity_positive_.set(polarity_);
-  generator_on_.set(false);
-  switching_.set(true);
+  polarity_positive.set(polarity_);
+  generator_on.set(false);
+  switching.set(true);
 }
 
 rt::BlockStatus PolaritySwitch::update(const rt::CycleContext& ctx) noexcept {
@@ -38,7 +32,7 @@ rt::BlockStatus PolaritySwitch::update(const rt::CycleContext& ctx) noexcept {
   // At least 1 ns, so that the generator is off for at least one cycle on each side of a switch
   // even with a settle that bypassed validate().
   const rt::Duration settle = std::max(params_.settle, rt::Duration{1});
-  const bool request = request_positive_.get();
+  const bool request = request_positive.get();
 
   if (request != polarity_) {
     if (gen_on_) {
@@ -51,15 +45,15 @@ rt::BlockStatus PolaritySwitch::update(const rt::CycleContext& ctx) noexcept {
     }
   }
   const bool allowed = request == polarity_ && now - last_switch_ >= settle;
-  const bool gen_on = allowed && generator_on_request_.get();
+  const bool gen_on = allowed && generator_on_request.get();
   if (gen_on_ && !gen_on) {
     off_since_ = now;
   }
   gen_on_ = gen_on;
 
-  polarity_positive_.set(polarity_);
-  generator_on_.set(gen_on_);
-  switching_.set(!allowed);
+  polarity_positive.set(polarity_);
+  generator_on.set(gen_on_);
+  switching.set(!allowed);
   return rt::BlockStatus::kOk;
 }
 

@@ -5,39 +5,25 @@
 namespace edm::blocks {
 namespace {
 
-// Index of `window` in TdDetectorParams::visit().
-constexpr std::size_t kWindowIndex = 0;
-
 constexpr double kNsPerUs = 1000.0;
 
 }  // namespace
 
-std::vector<rt::ParamError> TdDetectorParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "window", static_cast<double>(window), 1.0,
-                    static_cast<double>(kMaxWindow));
-  rt::require_finite(errs, "empty_td_us", empty_td_us);
-  if (errs.empty()) {
-    rt::require_non_negative(errs, "empty_td_us", empty_td_us);
-  }
-  return errs;
-}
-
 void TdDetector::visit_pins(rt::PinVisitor& v) {
-  v.input("td_sum_ns", td_sum_ns_, "ns");
-  v.input("td_count", td_count_);
-  v.input("n_open", n_open_);
-  v.input("n_short", n_short_);
-  v.input("n_total", n_total_);
-  v.output("td_us", td_us_, "us");
-  v.output("td_raw_us", td_raw_us_, "us");
-  v.output("open_ratio", open_ratio_, "1");
-  v.output("short_ratio", short_ratio_, "1");
-  v.output("valid", valid_);
+  v.input("td_sum_ns", td_sum_ns, "ns");
+  v.input("td_count", td_count);
+  v.input("n_open", n_open);
+  v.input("n_short", n_short);
+  v.input("n_total", n_total);
+  v.output("td_us", td_us, "us");
+  v.output("td_raw_us", td_raw_us, "us");
+  v.output("open_ratio", open_ratio, "1");
+  v.output("short_ratio", short_ratio, "1");
+  v.output("valid", valid);
 }
 
 std::vector<rt::ParamError> TdDetector::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = params_.validate();
+  auto errs = rt::validate_params(params_);
   if (!errs.empty()) {
     return errs;
   }
@@ -49,15 +35,15 @@ std::vector<rt::ParamError> TdDetector::configure(const rt::BlockSetup& /*setup*
 void TdDetector::activate() noexcept {
   window_.clear();
   sum_ = {};
-  td_us_.set(params_.empty_td_us);
-  td_raw_us_.set(params_.empty_td_us);
-  open_ratio_.set(0.0);
-  short_ratio_.set(0.0);
-  valid_.set(false);
+  td_us.set(params_.empty_td_us);
+  td_raw_us.set(params_.empty_td_us);
+  open_ratio.set(0.0);
+  short_ratio.set(0.0);
+  valid.set(false);
 }
 
 rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
-  Counts c{td_sum_ns_.get(), td_count_.get(), n_open_.get(), n_short_.get(), n_total_.get()};
+  Counts c{td_sum_ns.get(), td_count.get(), n_open.get(), n_short.get(), n_total.get()};
   const auto in_range = [](std::int64_t x) noexcept { return x >= 0 && x <= kMaxCount; };
   if (window_.capacity() == 0 || !in_range(c.td_sum_ns) || !in_range(c.td_count) ||
       !in_range(c.n_open) || !in_range(c.n_short) || !in_range(c.n_total)) {
@@ -81,33 +67,26 @@ rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
 
   const bool hold = params_.hold_when_empty;
   if (c.td_count > 0) {
-    td_raw_us_.set(static_cast<double>(c.td_sum_ns) / static_cast<double>(c.td_count) / kNsPerUs);
+    td_raw_us.set(static_cast<double>(c.td_sum_ns) / static_cast<double>(c.td_count) / kNsPerUs);
   } else if (!hold) {
-    td_raw_us_.set(params_.empty_td_us);
+    td_raw_us.set(params_.empty_td_us);
   }
-  const bool valid = sum_.td_count > 0;
-  if (valid) {
-    td_us_.set(static_cast<double>(sum_.td_sum_ns) / static_cast<double>(sum_.td_count) / kNsPerUs);
+  const bool valid_now = sum_.td_count > 0;
+  if (valid_now) {
+    td_us.set(static_cast<double>(sum_.td_sum_ns) / static_cast<double>(sum_.td_count) / kNsPerUs);
   } else if (!hold) {
-    td_us_.set(params_.empty_td_us);
+    td_us.set(params_.empty_td_us);
   }
   if (sum_.n_total > 0) {
     const auto total = static_cast<double>(sum_.n_total);
-    open_ratio_.set(static_cast<double>(sum_.n_open) / total);
-    short_ratio_.set(static_cast<double>(sum_.n_short) / total);
+    open_ratio.set(static_cast<double>(sum_.n_open) / total);
+    short_ratio.set(static_cast<double>(sum_.n_short) / total);
   } else if (!hold) {
-    open_ratio_.set(0.0);
-    short_ratio_.set(0.0);
+    open_ratio.set(0.0);
+    short_ratio.set(0.0);
   }
-  valid_.set(valid);
+  valid.set(valid_now);
   return rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> TdDetector::stage_param(std::size_t index, const rt::ParamValue& v) {
-  if (index == kWindowIndex) {
-    return {{"window", "cannot change at run time (it sizes the ring); reload the config"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

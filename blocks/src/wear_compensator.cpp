@@ -9,23 +9,19 @@ namespace edm::blocks {
 
 std::vector<rt::ParamError> WearCompensatorParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_positive(errs, "hole_area_mm2", hole_area_mm2);
-  rt::require_finite(errs, "hole_area_mm2", hole_area_mm2);
-  rt::require_positive(errs, "electrode_area_mm2", electrode_area_mm2);
-  rt::require_finite(errs, "electrode_area_mm2", electrode_area_mm2);
-  rt::require_positive(errs, "wear_ratio_max", wear_ratio_max);
-  rt::require_finite(errs, "wear_ratio_max", wear_ratio_max);
+  rt::require_ordered(errs, "wear_ratio_default", wear_ratio_default, "wear_ratio_max",
+                      wear_ratio_max);
   return errs;
 }
 
 void WearCompensator::visit_pins(rt::PinVisitor& v) {
-  v.input("vz_in_mm_s", vz_in_mm_s_, "mm/s");
-  v.input("wear_ratio", wear_ratio_);
-  v.input("enable", enable_);
-  v.input("reset_wear", reset_wear_);
-  v.output("vz_out_mm_s", vz_out_mm_s_, "mm/s");
-  v.output("vd_mm_s", vd_mm_s_, "mm/s");
-  v.output("wear_mm", wear_mm_, "mm");
+  v.input("vz_in_mm_s", vz_in_mm_s, "mm/s");
+  v.input("wear_ratio", wear_ratio);
+  v.input("enable", enable);
+  v.input("reset_wear", reset_wear);
+  v.output("vz_out_mm_s", vz_out_mm_s, "mm/s");
+  v.output("vd_mm_s", vd_mm_s, "mm/s");
+  v.output("wear_mm", wear_mm, "mm");
 }
 
 std::vector<rt::ParamError> WearCompensator::configure(const rt::BlockSetup& setup) {
@@ -33,11 +29,11 @@ std::vector<rt::ParamError> WearCompensator::configure(const rt::BlockSetup& set
   require_task_period(errs, setup.period);
   dt_s_ = rt::to_seconds(setup.period);
   compute_ratio();
-  wear_mm_.set(0.0);
+  wear_mm.set(0.0);
   front_mm_ = 0.0;
   deepest_mm_ = 0.0;
-  vd_mm_s_.set(0.0);
-  vz_out_mm_s_.set(0.0);
+  vd_mm_s.set(0.0);
+  vz_out_mm_s.set(0.0);
   return errs;
 }
 
@@ -49,8 +45,8 @@ void WearCompensator::compute_ratio() noexcept {
 
 rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
-  double wear = wear_mm_.get();
-  if (reset_wear_.get()) {
+  double wear = wear_mm.get();
+  if (reset_wear.get()) {
     wear = 0.0;
     front_mm_ = 0.0;
     deepest_mm_ = 0.0;
@@ -70,11 +66,11 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   }
   have_release_ = true;
   last_release_ = ctx.release;
-  const double vz_in = vz_in_mm_s_.get();
+  const double vz_in = vz_in_mm_s.get();
   if (!std::isfinite(vz_in)) {
-    vz_out_mm_s_.set(0.0);
-    vd_mm_s_.set(0.0);
-    wear_mm_.set(wear);
+    vz_out_mm_s.set(0.0);
+    vd_mm_s.set(0.0);
+    wear_mm.set(wear);
     return rt::BlockStatus::kFault;
   }
   // High-water mark of the front: only depth never reached before is erosion progress.
@@ -90,13 +86,17 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
     deepest_mm_ = -front_mm_;
   }
   double vd = 0.0;
-  if (enable_.get() && new_depth_mm > 0.0) {
-    const double ratio_in = wear_ratio_.get();
+  if (enable.get() && new_depth_mm > 0.0) {
+    const double ratio_in = wear_ratio.get();
     if (!std::isfinite(ratio_in)) {
       status = rt::BlockStatus::kFault;
     } else {
-      const double ratio = std::clamp(ratio_in, 0.0, params_.wear_ratio_max);
-      if (ratio != ratio_in && status == rt::BlockStatus::kOk) {
+      // No estimate (<= 0; an unwired input reads 0): the parameter's θ. With the default 0 this
+      // is the input itself, sign of zero included.
+      const double default_ratio = params_.wear_ratio_default;
+      const double wanted = ratio_in <= 0.0 && default_ratio > 0.0 ? default_ratio : ratio_in;
+      const double ratio = std::clamp(wanted, 0.0, params_.wear_ratio_max);
+      if ((ratio != wanted || ratio_in < 0.0) && status == rt::BlockStatus::kOk) {
         status = rt::BlockStatus::kSaturated;
       }
       vd = ratio * area_ratio_ * new_depth_mm / dt_s_;  // v_bottom = new depth per cycle
@@ -105,14 +105,14 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   const double vz_out = vz_in - vd;
   const double wear_next = wear + vd * dt_s_;
   if (!std::isfinite(vz_out) || !std::isfinite(wear_next)) {  // overflow from absurd inputs
-    vz_out_mm_s_.set(vz_in);
-    vd_mm_s_.set(0.0);
-    wear_mm_.set(wear);
+    vz_out_mm_s.set(vz_in);
+    vd_mm_s.set(0.0);
+    wear_mm.set(wear);
     return rt::BlockStatus::kFault;
   }
-  vz_out_mm_s_.set(vz_out);
-  vd_mm_s_.set(vd);
-  wear_mm_.set(wear_next);
+  vz_out_mm_s.set(vz_out);
+  vd_mm_s.set(vd);
+  wear_mm.set(wear_next);
   return status;
 }
 

@@ -56,6 +56,8 @@ class Parser {
   void parse_program(const Value& v, ProgramSpec& out);
   void parse_block(const Value& v, BlockSpec& out);
   void parse_params(const Value& v, std::vector<ParamSetting>& out);
+  void parse_params_under(const Value& v, const std::string& prefix, int depth,
+                          std::vector<ParamSetting>& out);
   void parse_wires(const Value& v, std::vector<WireSpec>& out);
   void parse_trace(const Value& v, TraceSpec& out);
   void parse_bridge(const Value& v, BridgeSpec& out);

@@ -1,5 +1,6 @@
 // Config parser, one function per section: keys, types and ranges. See config_parser.cpp.
 
+#include <algorithm>
 #include <utility>
 
 #include "config_parser_impl.hpp"
@@ -208,22 +209,45 @@ void Parser::parse_block(const Value& v, BlockSpec& out) {
   }
 }
 
+// Parameters are a map of name: scalar. A C++ PROGRAM's child parameters are set as a nested map
+// (`gap: {kg: 0.1}`) or a dotted key (`gap.kg: 0.1`); both give the setting "gap.kg", and one
+// parameter set both ways is an error.
 void Parser::parse_params(const Value& v, std::vector<ParamSetting>& out) {
+  parse_params_under(v, "", 0, out);
+}
+
+void Parser::parse_params_under(const Value& v, const std::string& prefix, int depth,
+                                std::vector<ParamSetting>& out) {
+  constexpr int kMaxDepth = 4;  // program.block.child.grandchild.param at the most
   auto m = r_.map(v, {});
   if (!m) {
     return;
   }
   for (const Field& f : m->fields) {
-    if (!yaml_util::is_identifier(f.key)) {
+    if (!yaml_util::is_dotted_name(f.key, 1, kMaxDepth - depth)) {
       r_.error(f.key_loc, v.path,
-               "parameter name " + yaml_util::quote(f.key) + " is not an identifier");
+               "parameter name " + yaml_util::quote(f.key) +
+                   " is not an identifier (or child.parameter)");
       continue;
     }
-    if (!r_.scalar(f.value, "a scalar (number, true/false, duration or string)")) {
+    const std::string key = prefix + f.key;
+    if (f.value.node.IsMap() && depth + 1 < kMaxDepth) {
+      parse_params_under(f.value, key + ".", depth + 1, out);
+      continue;
+    }
+    if (!r_.scalar(f.value, "a scalar (number, true/false, duration or string), or a map of a "
+                            "child's parameters")) {
+      continue;
+    }
+    const auto same = [&](const ParamSetting& s) { return s.key == key; };
+    if (const auto it = std::find_if(out.begin(), out.end(), same); it != out.end()) {
+      r_.error(f.key_loc, v.path,
+               "parameter '" + key + "' is set twice (first at line " +
+                   line_of(it->key_loc) + ")");
       continue;
     }
     out.push_back(
-        {f.key, f.value.node.Scalar(), Reader::is_quoted(f.value.node), f.key_loc, f.value.loc});
+        {key, f.value.node.Scalar(), Reader::is_quoted(f.value.node), f.key_loc, f.value.loc});
   }
 }
 

@@ -80,10 +80,60 @@ bool write_param(const ParamRef& ref, const ParamValue& v) noexcept {
 namespace {
 std::string num(double v) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
+  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  } else {
+    std::snprintf(buf, sizeof buf, "%g", v);
+  }
   return buf;
 }
 }  // namespace
+
+bool Range::unbounded() const noexcept { return std::isinf(lo) && std::isinf(hi); }
+
+std::string Range::text() const {
+  const bool has_lo = !std::isinf(lo);
+  const bool has_hi = !std::isinf(hi);
+  if (has_lo && has_hi) {
+    return std::string(lo_open ? "(" : "[") + num(lo) + ", " + num(hi) + (hi_open ? ")" : "]");
+  }
+  if (has_lo) {
+    return (lo_open ? "> " : ">= ") + num(lo);
+  }
+  if (has_hi) {
+    return (hi_open ? "< " : "<= ") + num(hi);
+  }
+  return {};
+}
+
+void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef ref,
+                 const ParamSpec& spec) {
+  double v = 0.0;
+  switch (ref.type) {
+    case ParamType::kBool:
+    case ParamType::kString:
+      return;
+    case ParamType::kInt:
+      v = static_cast<double>(*static_cast<const std::int64_t*>(ref.field));
+      break;
+    case ParamType::kReal:
+      v = *static_cast<const double*>(ref.field);
+      if (spec.finite && !std::isfinite(v)) {
+        errs.push_back({std::string(name), "must be a finite number (got " + num(v) + ")"});
+        return;
+      }
+      break;
+    case ParamType::kDuration:
+      v = read_param(ref).as_double();
+      break;
+  }
+  if (!spec.range.contains(v)) {
+    const std::string t = spec.range.text();
+    const bool interval = !t.empty() && (t[0] == '[' || t[0] == '(');
+    errs.push_back({std::string(name), std::string("must be ") + (interval ? "in " : "") + t +
+                                           " (got " + num(v) + ")"});
+  }
+}
 
 void require_positive(std::vector<ParamError>& errs, std::string_view field, double v) {
   if (!(v > 0.0) || !std::isfinite(v)) {

@@ -26,18 +26,21 @@ BlockStatus Program::run(const CycleContext& ctx) noexcept {
     const BlockStatus s = e.block->update(ctx);
     if (s == BlockStatus::kFault) {
       if (e.last != BlockStatus::kFault) {
+        // A C++ PROGRAM names the child that raised the fault ("cnc.job.drill.gap").
+        const char* inner = e.block->fault_source();
+        e.fault_source = inner != nullptr ? inner : e.full_name.c_str();
         Alarm a;
         a.code = AlarmCode::kBlockFault;
         a.severity = AlarmSeverity::kFault;
         a.time = ctx.release;
-        a.source = e.full_name.c_str();
+        a.source = e.fault_source;
         a.text = "block reported a fault";
         machine_->raise(a);
       }
       worst = BlockStatus::kFault;
     } else {
       if (e.last == BlockStatus::kFault) {
-        machine_->clear_alarm(AlarmCode::kBlockFault, e.full_name.c_str());
+        machine_->clear_alarm(AlarmCode::kBlockFault, e.fault_source);
       }
       if (s == BlockStatus::kSaturated && worst == BlockStatus::kOk) {
         worst = BlockStatus::kSaturated;

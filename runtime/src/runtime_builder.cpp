@@ -50,13 +50,13 @@ class ParamLister final : public ParamVisitor {
   struct Field {
     std::string name;
     ParamType type;
-    std::string unit;
+    ParamSpec spec;  // its strings point into the block type's visit(): static text
   };
   std::vector<Field> fields;
 
  protected:
-  void on_param(std::string_view name, ParamRef ref, ParamInfo info) override {
-    fields.push_back({std::string(name), ref.type, std::string(info.unit)});
+  void on_param(std::string_view name, ParamRef ref, ParamSpec spec) override {
+    fields.push_back({std::string(name), ref.type, spec});
   }
 };
 
@@ -354,7 +354,10 @@ class RuntimeBuilder {
       v.block = &block;
       v.param_index = i;
       v.param_type = pl.fields[i].type;
-      v.unit = pl.fields[i].unit;
+      v.unit = pl.fields[i].spec.unit;
+      v.description = pl.fields[i].spec.description;
+      v.range = pl.fields[i].spec.range.text();
+      v.load_time_only = pl.fields[i].spec.load_time_only;
       v.owner = owner;
       if (!rt_->variables_.add(std::move(v))) {
         diag_.error(SourceLoc{cfg_.path, 0, 0},
@@ -450,6 +453,15 @@ class RuntimeBuilder {
   }
 
   void finish() {
+    // bind() after the wiring: a C++ PROGRAM connects its children seeing its final inputs.
+    if (rt_->driver_) {
+      rt_->driver_->bind();
+    }
+    for (auto& prog : rt_->programs_) {
+      for (const Program::Entry& e : prog->blocks()) {
+        e.block->bind();
+      }
+    }
     if (rt_->driver_) {
       rt_->driver_->commit_params();
       rt_->driver_->activate();

@@ -18,6 +18,18 @@ std::string_view to_string(VarKind k) noexcept {
   return "?";
 }
 
+std::string list_row(const Variable& v) {
+  const auto or_dash = [](const std::string& s) { return s.empty() ? std::string("-") : s; };
+  std::string row = v.name + "\t" + std::string(to_string(v.kind)) + "\t" +
+                    std::string(v.type_name()) + "\t" + or_dash(v.unit) + "\t" +
+                    (v.owner != nullptr ? v.owner->name() : std::string("-"));
+  if (v.kind == VarKind::kParam) {
+    row += "\t" + or_dash(v.range) + "\t" + (v.load_time_only ? "load-time" : "runtime") +
+           "\t" + or_dash(v.description);
+  }
+  return row;
+}
+
 std::string_view Variable::type_name() const noexcept {
   return is_pin() ? to_string(pin.type) : to_string(param_type);
 }

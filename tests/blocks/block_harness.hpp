@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "edm/runtime/block.hpp"
+#include "support/param_access.hpp"
 
 namespace edm::blocks::test {
 
@@ -130,35 +131,14 @@ class BlockHarness {
   [[nodiscard]] std::uint64_t cycle() const noexcept { return cycle_; }
   void set_cycle(std::uint64_t c) noexcept { cycle_ = c; }
 
-  /// Index of parameter `name` for stage_param/apply_param/read_param (as the variable registry
-  /// numbers them: visit order).
+  /// Index of parameter `name` for stage_param/apply_param/read_param (visit order).
   [[nodiscard]] std::size_t param_index(std::string_view name) {
-    struct Find final : rt::ParamVisitor {
-      std::string_view want;
-      std::size_t n{0};
-      std::size_t found{static_cast<std::size_t>(-1)};
-      void on_param(std::string_view pname, rt::ParamRef, rt::ParamInfo) override {
-        if (pname == want) {
-          found = n;
-        }
-        ++n;
-      }
-    } f;
-    f.want = name;
-    block_.visit_params(f);
-    EXPECT_NE(f.found, static_cast<std::size_t>(-1)) << "no parameter '" << name << "'";
-    return f.found;
+    return ::edm::test::param_index(block_, name);
   }
 
-  /// A runtime parameter write the way the runtime does it: stage (non-RT, validated on the
-  /// shadow copy) and, if accepted, apply before the next cycle. Returns stage_param's errors.
+  /// A runtime parameter write the way the runtime does it (support/param_access.hpp).
   std::vector<rt::ParamError> write_param(std::string_view name, const rt::ParamValue& v) {
-    const std::size_t index = param_index(name);
-    auto errs = block_.stage_param(index, v);
-    if (errs.empty()) {
-      block_.apply_param(index, v);
-    }
-    return errs;
+    return ::edm::test::write_param(block_, name, v);
   }
 
  private:

@@ -45,6 +45,7 @@ struct Rig {
     in<double>("z_mm").connect(z_mm);
     in<bool>("start").connect(start);
     in<bool>("enable_wear_comp").connect(comp);
+    drill.bind();
     drill.activate();
     ctx.period = 1ms;
     ctx.dt_s = 0.001;
@@ -178,6 +179,7 @@ TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
   Rig r(params());
   rt::Output<double> servo;
   r.in<double>("vz_servo_mm_s").connect(servo);
+  r.drill.bind();  // as the runtime does after the YAML wiring: the servo is now wired
   r.comp.set(false);
   r.start.set(true);
   r.sparks(20, 12.0);  // the P law would feed at −0.2 mm/s
@@ -208,6 +210,7 @@ TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
   Rig r(params());
   rt::Output<double> servo;
   r.in<double>("vz_servo_mm_s").connect(servo);
+  r.drill.bind();  // as the runtime does after the YAML wiring: the servo is now wired
   r.start.set(true);
   r.sparks(20, 12.0);
   servo.set(-0.25);

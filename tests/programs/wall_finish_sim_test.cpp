@@ -209,7 +209,7 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
 TEST(FinishNoSpark, AnOrbitThatNeverSparksFaultsAfterTheTimeout) {
   std::string text = slurp(kConfig);
   replace_once(text, "initial_depth_mm: 2}", "initial_depth_mm: 2, start_gap_um: 5000}");
-  replace_once(text, "spark_out_revs: 4}", "spark_out_revs: 4, no_spark_timeout: 3s}");
+  replace_once(text, "spark_out_revs: 4,", "spark_out_revs: 4, no_spark_timeout: 3s,");
   auto r = build_sim_machine(rt::parse_config_text(text, "finish-sim-program.yaml"));
   r->machine().command(rt::MachineCommand::kPowerOn);
   rt::VirtualClock clock;

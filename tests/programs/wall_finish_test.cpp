@@ -4,6 +4,7 @@
 // safe state.
 
 #include "edm/programs/wall_finish.hpp"
+#include "support/param_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,6 +32,8 @@ struct Rig {
 
   explicit Rig(const programs::WallFinishParams& p) {
     wf.set_params(p);
+    // orbit.kr keeps WallFinish's default 1e-4 mm/µs: Td = 10 µs → Δr = 1 µm per revolution.
+    EXPECT_TRUE(write_param(wf, "orbit.dr_max_mm", rt::ParamValue::of_real(0.005)).empty());
     EXPECT_TRUE(wf.validate().empty());
     EXPECT_TRUE(wf.configure({"cycle.finish", 1ms}).empty());
     struct Collect final : rt::PinVisitor {
@@ -50,6 +53,7 @@ struct Rig {
     in<double>("start_offset_mm").connect(start_offset);
     in<double>("final_offset_mm").connect(final_offset);
     in<bool>("start").connect(start);
+    wf.bind();
     wf.activate();
     ctx.period = 1ms;
     ctx.dt_s = 0.001;
@@ -90,8 +94,6 @@ programs::WallFinishParams params() {
   programs::WallFinishParams p;
   p.orbit_period_s = 0.2;
   p.radial_speed_mm_s = 0.05;
-  p.kr = 1e-4;  // Td = 10 µs → Δr = 1 µm per revolution
-  p.dr_max_mm = 0.005;
   p.spark_out_revs = 2;
   return p;
 }
@@ -106,8 +108,12 @@ TEST(WallFinish, RejectsBadParameters) {
   programs::WallFinishParams p = params();
   p.orbit_period_s = 0.0;
   p.spark_out_revs = -1;
-  p.settle = rt::Duration::zero();
-  EXPECT_EQ(p.validate().size(), 3u);
+  EXPECT_EQ(rt::validate_params(p).size(), 2u);
+  programs::WallFinish wf;
+  wf.set_params(params());
+  EXPECT_EQ(write_param(wf, "pol.settle", rt::ParamValue::of_duration(rt::Duration::zero())).size(),
+            1u);
+  EXPECT_EQ(write_param(wf, "orbit.dr_max_mm", rt::ParamValue::of_real(-1.0)).size(), 1u);
 }
 
 TEST(WallFinish, FullCyclePolarityThenGrowingOrbitThenBackToCentre) {

@@ -89,3 +89,33 @@ programs:
 
 }  // namespace
 }  // namespace edm::test
+
+namespace edm::test {
+namespace {
+
+TEST(CompositeBlock, ChildParametersAreVariablesSetUnderTheCompositesParams) {
+  const std::string base = R"(version: 1
+machine: {name: t}
+tasks:
+  - {name: fast, interval: 1ms, priority: 0, programs: [p]}
+programs:
+  - name: p
+    blocks:
+      - {name: seq, type: TwoStep, params: )";
+  auto r = build_from_text(base + "{target: 3, drain: {tag: dr}}}\n");
+  const rt::Variable* tag = r->variables().find("p.seq.drain.tag");
+  ASSERT_NE(tag, nullptr);
+  EXPECT_EQ(tag->kind, rt::VarKind::kParam);
+  EXPECT_EQ(r->variables().find("p.seq.target")->kind, rt::VarKind::kParam);
+  EXPECT_NO_THROW(build_from_text(base + "{drain.tag: dr}}\n"));
+  const rt::Diagnostic twice = build_error(base + "{drain.tag: a, drain: {tag: b}}}\n");
+  EXPECT_EQ(twice.loc.line, 8);
+  EXPECT_NE(twice.message.find("parameter 'drain.tag' is set twice"), std::string::npos)
+      << twice.str();
+  const rt::Diagnostic unknown = build_error(base + "{drain: {tagg: b}}}\n");
+  EXPECT_NE(unknown.message.find("unknown parameter 'drain.tagg'"), std::string::npos)
+      << unknown.str();
+}
+
+}  // namespace
+}  // namespace edm::test

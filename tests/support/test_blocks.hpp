@@ -84,26 +84,25 @@ class Cost final : public rt::BlockWithParams<CostParams> {
 class AddOne final : public rt::Block {
  public:
   void visit_pins(rt::PinVisitor& v) override {
-    v.input("in", in_);
-    v.output("out", out_);
-    v.input("flag", flag_);
-    v.output("ticks", ticks_);
+    v.input("in", in);
+    v.output("out", out);
+    v.input("flag", flag);
+    v.output("ticks", ticks);
   }
   rt::BlockStatus update(const rt::CycleContext&) noexcept override {
-    const double x = in_.get();
-    ticks_.set(ticks_.get() + 1);
+    const double x = in.get();
+    ticks.set(ticks.get() + 1);
     if (x != x) {
       return rt::BlockStatus::kFault;
     }
-    out_.set(x + 1.0);
+    out.set(x + 1.0);
     return rt::BlockStatus::kOk;
   }
 
- private:
-  rt::Input<double> in_;
-  rt::Output<double> out_;
-  rt::Input<bool> flag_;
-  rt::Output<std::int64_t> ticks_;
+  rt::Input<double> in;
+  rt::Output<double> out;
+  rt::Input<bool> flag;
+  rt::Output<std::int64_t> ticks;
 };
 
 /// A block with every parameter type, for parameter reading/writing tests.
@@ -150,43 +149,31 @@ class ParamProbe final : public rt::BlockWithParams<AllParams> {
 /// `step` (LINT) is its own output; the safe state parks it in step 0.
 struct TwoStepParams {
   double target{3.0};
-  void visit(rt::ParamVisitor& v) { v.param("target", target); }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const {
-    std::vector<rt::ParamError> errs;
-    rt::require_positive(errs, "target", target);
-    return errs;
-  }
+  void visit(rt::ParamVisitor& v) { v.param("target", target, {.range = rt::kPositive}); }
 };
 class TwoStep final : public rt::BlockWithParams<TwoStepParams, rt::CompositeBlock> {
  public:
   TwoStep() : fill_(add_child<AddOne>("fill")), drain_(add_child<Recorder>("drain")) {}
-  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
-    if (rt::is_safe_state(ctx.state)) {
-      return rt::BlockStatus::kOk;  // parked until reset
-    }
-    if (step_.get() == 0) {
-      fill_.update(ctx);
-      if (fill_out_->get() >= params_.target) {
-        step_.set(1);
-      }
-    } else {
-      drain_.update(ctx);
-    }
-    return rt::BlockStatus::kOk;
-  }
   int safe_entries{0};
 
  protected:
-  void visit_own_pins(rt::PinVisitor& v) override { v.output("step", step_); }
-  std::vector<rt::ParamError> configure_self(const rt::BlockSetup&) override {
-    // Wire the child's output back to its input, once, in C++.
-    std::vector<rt::ParamError> errs;
-    fill_out_ = child_output<double>(errs, fill_, "fill", "out");
-    if (fill_out_ != nullptr) {
-      wire_child(errs, fill_, "fill", "in", *fill_out_);
+  rt::BlockStatus update_self(const rt::CycleContext& ctx) noexcept override {
+    if (rt::is_safe_state(ctx.state)) {
+      return rt::BlockStatus::kOk;  // parked until reset
     }
-    return errs;
+    rt::BlockStatus s = rt::BlockStatus::kOk;
+    if (step_.get() == 0) {
+      s = step(fill_, ctx);
+      if (fill_.out.get() >= params_.target) {
+        step_.set(1);
+      }
+    } else {
+      s = step(drain_, ctx);
+    }
+    return s;
   }
+  void visit_own_pins(rt::PinVisitor& v) override { v.output("step", step_); }
+  void bind_self() override { fill_.in.connect(fill_.out); }  // the child fed back on itself
   void activate_self() noexcept override { step_.set(0); }
   void safe_state_self(const rt::SafeStateRequest&) noexcept override {
     ++safe_entries;
@@ -196,7 +183,6 @@ class TwoStep final : public rt::BlockWithParams<TwoStepParams, rt::CompositeBlo
  private:
   AddOne& fill_;
   Recorder& drain_;
-  const rt::Output<double>* fill_out_{nullptr};
   rt::Output<std::int64_t> step_;
 };
 

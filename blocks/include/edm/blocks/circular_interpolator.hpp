@@ -41,12 +41,14 @@ struct CircularInterpolatorParams {
   double end_tol_mm{1e-3};  // [mm] allowed | |end − C| − R |, ≥ 0
 
   void visit(rt::ParamVisitor& v) {
-    v.param("x0_mm", x0_mm, "mm", "X position at activation");
-    v.param("y0_mm", y0_mm, "mm", "Y position at activation");
-    v.param("end_tol_mm", end_tol_mm, "mm",
-            "largest accepted difference between the end point's radius and the start radius");
+    v.param("x0_mm", x0_mm, {.unit = "mm", .description = "X position at activation"});
+    v.param("y0_mm", y0_mm, {.unit = "mm", .description = "Y position at activation"});
+    v.param("end_tol_mm", end_tol_mm,
+            {.unit = "mm",
+             .description =
+                 "largest accepted difference between the end point's radius and the start radius",
+             .range = rt::kNonNegative});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolatorParams> {
@@ -68,29 +70,32 @@ class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolat
   [[nodiscard]] bool latch_move() noexcept;
   void publish(double vx_mm_s, double vy_mm_s) noexcept;
 
-  rt::Input<bool> start_;
-  rt::Input<bool> cw_;
-  rt::Input<double> i_;
-  rt::Input<double> j_;
-  rt::Input<bool> full_circle_;
-  rt::Input<std::int64_t> turns_{1};
-  rt::Input<double> ex_;
-  rt::Input<double> ey_;
-  rt::Input<double> feed_;
-  rt::Input<double> override_{1.0};
-  rt::Input<bool> hold_;
-  rt::Input<bool> load_;
-  rt::Input<double> load_x_;
-  rt::Input<double> load_y_;
-  rt::Output<double> rx_;
-  rt::Output<double> ry_;
-  rt::Output<double> vx_;
-  rt::Output<double> vy_;
-  rt::Output<double> angle_;
-  rt::Output<double> swept_;
-  rt::Output<bool> busy_;
-  rt::Output<bool> done_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<bool> start;
+  rt::Input<bool> cw;
+  rt::Input<double> i_mm;
+  rt::Input<double> j_mm;
+  rt::Input<bool> full_circle;
+  rt::Input<std::int64_t> turns{1};
+  rt::Input<double> ex_mm;
+  rt::Input<double> ey_mm;
+  rt::Input<double> feed_mm_min;
+  rt::Input<double> feed_override{1.0};
+  rt::Input<bool> hold;
+  rt::Input<bool> load;
+  rt::Input<double> load_x_mm;
+  rt::Input<double> load_y_mm;
+  rt::Output<double> rx_mm;
+  rt::Output<double> ry_mm;
+  rt::Output<double> vx_mm_s;
+  rt::Output<double> vy_mm_s;
+  rt::Output<double> angle_rad;
+  rt::Output<double> swept_rad;
+  rt::Output<bool> busy;
+  rt::Output<bool> done;
 
+ private:
   double dt_s_{0.0};
   double x_{0.0};  // [mm] current position
   double y_{0.0};

@@ -37,16 +37,28 @@ struct GapControllerPParams {
   double idle_feed_mm_s{0.0};      // [mm/s] in [−v_feed_max_mm_s, 0], Vz while valid = false
 
   void visit(rt::ParamVisitor& v) {
-    v.param("kg", kg, "mm/s/us", "gain: Vz per microsecond of Td error (> 0)");
-    v.param("tdr_default_us", tdr_default_us, "us",
-            "reference ignition delay while the tdr_us input is 0 (> 0)");
-    v.param("v_feed_max_mm_s", v_feed_max_mm_s, "mm/s", "largest downward speed (> 0)");
-    v.param("v_retract_max_mm_s", v_retract_max_mm_s, "mm/s", "largest upward speed (> 0)");
-    v.param("retract_speed_mm_s", retract_speed_mm_s, "mm/s",
-            "upward speed while retract (> 0, <= v_retract_max_mm_s)");
-    v.param("idle_feed_mm_s", idle_feed_mm_s, "mm/s",
-            "speed while no valid Td (<= 0, >= -v_feed_max_mm_s)");
+    v.param("kg", kg,
+            {.unit = "mm/s/us",
+             .description = "gain: Vz per microsecond of Td error",
+             .range = rt::kPositive});
+    v.param("tdr_default_us", tdr_default_us,
+            {.unit = "us",
+             .description = "reference ignition delay while the tdr_us input is 0",
+             .range = rt::kPositive});
+    v.param("v_feed_max_mm_s", v_feed_max_mm_s,
+            {.unit = "mm/s", .description = "largest downward speed", .range = rt::kPositive});
+    v.param("v_retract_max_mm_s", v_retract_max_mm_s,
+            {.unit = "mm/s", .description = "largest upward speed", .range = rt::kPositive});
+    v.param("retract_speed_mm_s", retract_speed_mm_s,
+            {.unit = "mm/s",
+             .description = "upward speed while retract, <= v_retract_max_mm_s",
+             .range = rt::kPositive});
+    v.param("idle_feed_mm_s", idle_feed_mm_s,
+            {.unit = "mm/s",
+             .description = "speed while no valid Td, >= -v_feed_max_mm_s",
+             .range = rt::at_most(0.0)});
   }
+  /// Cross-field rules: retract_speed <= v_retract_max, idle_feed >= -v_feed_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -59,14 +71,18 @@ class GapControllerP final : public rt::BlockWithParams<GapControllerPParams> {
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<double> td_us_;
-  rt::Input<bool> valid_{true};
-  rt::Input<bool> enable_{true};
-  rt::Input<bool> hold_;
-  rt::Input<bool> retract_;
-  rt::Input<double> tdr_us_;  // 0 (unwired): use the parameter
-  rt::Output<double> vz_mm_s_;
-  rt::Output<bool> saturated_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<double> td_us;
+  rt::Input<bool> valid{true};
+  rt::Input<bool> enable{true};
+  rt::Input<bool> hold;
+  rt::Input<bool> retract;
+  rt::Input<double> tdr_us;  // 0 (unwired): use the parameter
+  rt::Output<double> vz_mm_s;
+  rt::Output<bool> saturated;
+
+ private:
 };
 
 }  // namespace edm::blocks

@@ -35,11 +35,10 @@ struct LinearInterpolatorParams {
   double z0_mm{0.0};  // [mm]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("x0_mm", x0_mm, "mm", "X position at activation");
-    v.param("y0_mm", y0_mm, "mm", "Y position at activation");
-    v.param("z0_mm", z0_mm, "mm", "Z position at activation");
+    v.param("x0_mm", x0_mm, {.unit = "mm", .description = "X position at activation"});
+    v.param("y0_mm", y0_mm, {.unit = "mm", .description = "Y position at activation"});
+    v.param("z0_mm", z0_mm, {.unit = "mm", .description = "Z position at activation"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class LinearInterpolator final : public rt::BlockWithParams<LinearInterpolatorParams> {
@@ -62,26 +61,29 @@ class LinearInterpolator final : public rt::BlockWithParams<LinearInterpolatorPa
   [[nodiscard]] bool latch_move() noexcept;
   void publish(const Vec3& v_mm_s) noexcept;
 
-  rt::Input<bool> start_;
-  rt::Input<double> lx_;
-  rt::Input<double> ly_;
-  rt::Input<double> lz_;
-  rt::Input<double> feed_;
-  rt::Input<double> override_{1.0};
-  rt::Input<bool> hold_;
-  rt::Input<bool> load_;
-  rt::Input<double> load_x_;
-  rt::Input<double> load_y_;
-  rt::Input<double> load_z_;
-  rt::Output<double> rx_;
-  rt::Output<double> ry_;
-  rt::Output<double> rz_;
-  rt::Output<double> vx_;
-  rt::Output<double> vy_;
-  rt::Output<double> vz_;
-  rt::Output<bool> busy_;
-  rt::Output<bool> done_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<bool> start;
+  rt::Input<double> lx_mm;
+  rt::Input<double> ly_mm;
+  rt::Input<double> lz_mm;
+  rt::Input<double> feed_mm_min;
+  rt::Input<double> feed_override{1.0};
+  rt::Input<bool> hold;
+  rt::Input<bool> load;
+  rt::Input<double> load_x_mm;
+  rt::Input<double> load_y_mm;
+  rt::Input<double> load_z_mm;
+  rt::Output<double> rx_mm;
+  rt::Output<double> ry_mm;
+  rt::Output<double> rz_mm;
+  rt::Output<double> vx_mm_s;
+  rt::Output<double> vy_mm_s;
+  rt::Output<double> vz_mm_s;
+  rt::Output<bool> busy;
+  rt::Output<bool> done;
 
+ private:
   double dt_s_{0.0};
   Vec3 pos_{};       // [mm] current position
   Vec3 p0_{};        // [mm] position when the move was latched

@@ -31,22 +31,32 @@
 namespace edm::blocks {
 
 struct OrbitExpanderParams {
+  static constexpr std::int64_t kMaxSamplesPerRev = 1'000'000'000;
+
   double kr{1e-4};                  // [mm/µs] Δr per µs of mean ignition delay, ≥ 0
   double dr_max_mm{0.01};           // [mm] largest Δr per revolution, ≥ 0
   std::int64_t samples_per_rev{0};  // samples per revolution; 0 = revolutions from rev_pulse
 
   void visit(rt::ParamVisitor& v) {
-    v.param("kr", kr, "mm/us", "radius growth per revolution per us of mean ignition delay");
-    v.param("dr_max_mm", dr_max_mm, "mm", "largest radius growth per revolution");
-    v.param("samples_per_rev", samples_per_rev, "",
-            "samples per revolution (0: a rising edge of rev_pulse ends a revolution)");
+    v.param("kr", kr,
+            {.unit = "mm/us",
+             .description = "radius growth per revolution per us of mean ignition delay",
+             .range = rt::kNonNegative});
+    v.param("dr_max_mm", dr_max_mm,
+            {.unit = "mm",
+             .description = "largest radius growth per revolution",
+             .range = rt::kNonNegative});
+    v.param("samples_per_rev", samples_per_rev,
+            {.unit = "",
+             .description = "samples per revolution (0: a rising edge of rev_pulse ends a "
+                            "revolution)",
+             .range = rt::closed(0.0, static_cast<double>(kMaxSamplesPerRev))});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
  public:
-  static constexpr std::int64_t kMaxSamplesPerRev = 1'000'000'000;
+  static constexpr std::int64_t kMaxSamplesPerRev = OrbitExpanderParams::kMaxSamplesPerRev;
 
   void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Idle, radius 0.
@@ -57,20 +67,23 @@ class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
  private:
   void publish() noexcept;
 
-  rt::Input<bool> start_;
-  rt::Input<double> r0_;
-  rt::Input<double> final_radius_;
-  rt::Input<bool> enable_{true};
-  rt::Input<double> td_;
-  rt::Input<bool> valid_;
-  rt::Input<bool> rev_pulse_;
-  rt::Output<double> radius_;
-  rt::Output<double> dr_;
-  rt::Output<double> tdm_;
-  rt::Output<std::int64_t> revolutions_;
-  rt::Output<bool> busy_;
-  rt::Output<bool> done_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<bool> start;
+  rt::Input<double> r0_mm;
+  rt::Input<double> final_radius_mm;
+  rt::Input<bool> enable{true};
+  rt::Input<double> td_us;
+  rt::Input<bool> valid;
+  rt::Input<bool> rev_pulse;
+  rt::Output<double> radius_mm;
+  rt::Output<double> dr_mm;
+  rt::Output<double> tdm_us;
+  rt::Output<std::int64_t> revolutions;
+  rt::Output<bool> busy;
+  rt::Output<bool> done;
 
+ private:
   double radius_mm_{0.0};
   double final_mm_{0.0};
   double dr_mm_{0.0};

@@ -34,11 +34,14 @@ struct PolaritySwitchParams {
   bool initial_positive{false};  // polarity after activate(); false = negative (drilling)
 
   void visit(rt::ParamVisitor& v) {
-    v.param("settle", settle, "s", "generator-off time before and after a switch (> 0)");
-    v.param("initial_positive", initial_positive, "",
-            "polarity after activation (false: negative, electrode -)");
+    v.param("settle", settle,
+            {.unit = "s",
+             .description = "generator-off time before and after a switch",
+             .range = rt::kPositive});
+    v.param(
+        "initial_positive", initial_positive,
+        {.unit = "", .description = "polarity after activation (false: negative, electrode -)"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class PolaritySwitch final : public rt::BlockWithParams<PolaritySwitchParams> {
@@ -51,12 +54,15 @@ class PolaritySwitch final : public rt::BlockWithParams<PolaritySwitchParams> {
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<bool> request_positive_;
-  rt::Input<bool> generator_on_request_;
-  rt::Output<bool> polarity_positive_;
-  rt::Output<bool> generator_on_;
-  rt::Output<bool> switching_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<bool> request_positive;
+  rt::Input<bool> generator_on_request;
+  rt::Output<bool> polarity_positive;
+  rt::Output<bool> generator_on;
+  rt::Output<bool> switching;
 
+ private:
   bool polarity_{false};         // polarity_positive as last output
   bool gen_on_{false};           // generator_on as last output
   rt::TimePoint off_since_{};    // release of the first cycle of the current generator-off run

@@ -35,16 +35,28 @@ struct PositionLoopParams {
   std::int64_t in_pos_cycles{5};  // [cycles] ≥ 1
 
   void visit(rt::ParamVisitor& v) {
-    v.param("kv", kv, "1/s", "position gain: v_cmd per mm of following error (>= 0)");
-    v.param("ki", ki, "1/s^2", "integral gain (>= 0; 0 = P loop)");
-    v.param("kff", kff, "", "velocity feed-forward weight (0..1.5)");
-    v.param("v_max_mm_s", v_max_mm_s, "mm/s", "velocity command limit (> 0)");
-    v.param("f_err_max_mm", f_err_max_mm, "mm", "following-error limit (> 0)");
-    v.param("in_pos_tol_mm", in_pos_tol_mm, "mm", "in-position window, |e| <= tol (>= 0)");
-    v.param("in_pos_cycles", in_pos_cycles, "cycles",
-            "cycles |e| must stay in the window before in_position (>= 1)");
+    v.param("kv", kv,
+            {.unit = "1/s",
+             .description = "position gain: v_cmd per mm of following error",
+             .range = rt::kNonNegative});
+    v.param(
+        "ki", ki,
+        {.unit = "1/s^2", .description = "integral gain (0 = P loop)", .range = rt::kNonNegative});
+    v.param(
+        "kff", kff,
+        {.unit = "", .description = "velocity feed-forward weight", .range = rt::closed(0.0, 1.5)});
+    v.param("v_max_mm_s", v_max_mm_s,
+            {.unit = "mm/s", .description = "velocity command limit", .range = rt::kPositive});
+    v.param("f_err_max_mm", f_err_max_mm,
+            {.unit = "mm", .description = "following-error limit", .range = rt::kPositive});
+    v.param(
+        "in_pos_tol_mm", in_pos_tol_mm,
+        {.unit = "mm", .description = "in-position window, |e| <= tol", .range = rt::kNonNegative});
+    v.param("in_pos_cycles", in_pos_cycles,
+            {.unit = "cycles",
+             .description = "cycles |e| must stay in the window before in_position",
+             .range = rt::closed(1.0, 1.0e9)});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class PositionLoop final : public rt::BlockWithParams<PositionLoopParams> {
@@ -61,16 +73,20 @@ class PositionLoop final : public rt::BlockWithParams<PositionLoopParams> {
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
 
  private:
-  rt::Input<double> x_ref_mm_;
-  rt::Input<double> v_ff_mm_s_;
-  rt::Input<double> x_mm_;
-  rt::Input<bool> enable_{true};
-  rt::Input<bool> reset_;
-  rt::Output<double> v_cmd_mm_s_;
-  rt::Output<double> error_mm_;
-  rt::Output<bool> in_position_;
-  rt::Output<bool> following_error_fault_;
-  rt::Output<bool> saturated_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<double> x_ref_mm;
+  rt::Input<double> v_ff_mm_s;
+  rt::Input<double> x_mm;
+  rt::Input<bool> enable{true};
+  rt::Input<bool> reset;
+  rt::Output<double> v_cmd_mm_s;
+  rt::Output<double> error_mm;
+  rt::Output<bool> in_position;
+  rt::Output<bool> following_error_fault;
+  rt::Output<bool> saturated;
+
+ private:
   double dt_s_{0.0};
   double integral_mm_s_{0.0};  // ∫e dt [mm·s]
   std::int64_t in_pos_count_{0};

@@ -37,13 +37,21 @@ struct TdDetectorParams {
   double empty_td_us{0.0};  // [µs] ≥ 0: td_us after activate(), and when empty and not holding
 
   void visit(rt::ParamVisitor& v) {
-    v.param("window", window, "cycles", "number of cycles pooled (1..65536), load time only");
-    v.param("hold_when_empty", hold_when_empty, "",
-            "with no ignited pulse in the window keep the last td_us (else output empty_td_us)");
-    v.param("empty_td_us", empty_td_us, "us",
-            "td_us after activation, and with an empty window when not holding (>= 0)");
+    v.param("window", window,
+            {.unit = "cycles",
+             .description = "number of cycles pooled",
+             .range = rt::closed(1.0, static_cast<double>(kMaxWindow)),
+             .load_time_only = true});
+    v.param(
+        "hold_when_empty", hold_when_empty,
+        {.unit = "",
+         .description =
+             "with no ignited pulse in the window keep the last td_us (else output empty_td_us)"});
+    v.param("empty_td_us", empty_td_us,
+            {.unit = "us",
+             .description = "td_us after activation, and with an empty window when not holding",
+             .range = rt::kNonNegative});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
@@ -59,8 +67,6 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
   void activate() noexcept override;
   /// RT-safe. kOk, or kFault (nothing stored, outputs held) on inconsistent counters.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses `window` (it sized the ring at configure()).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
  private:
   struct Counts {
@@ -71,9 +77,13 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
     std::int64_t n_total{0};
   };
 
-  rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_, n_total_;
-  rt::Output<double> td_us_, td_raw_us_, open_ratio_, short_ratio_;
-  rt::Output<bool> valid_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short, n_total;
+  rt::Output<double> td_us, td_raw_us, open_ratio, short_ratio;
+  rt::Output<bool> valid;
+
+ private:
   WindowRing<Counts> window_;  // allocated in configure(); its capacity is the window in use
   Counts sum_;                 // sums over the ring
 };

@@ -25,7 +25,9 @@
 // as in Integrator: a retained value restored into it is where accumulation continues (the front
 // and high-water mark restart at 0 there). configure() and reset_wear = true set wear_mm, the
 // front and the high-water mark to 0; activate() leaves them alone.
-// wear_ratio is clamped to [0, wear_ratio_max] (kSaturated when cut).
+// While the wear_ratio input is <= 0 (an unwired input reads 0) the parameter wear_ratio_default
+// is θ instead (default 0: no compensation without an estimate). θ is clamped to
+// [0, wear_ratio_max]; kSaturated when it was cut or the input was negative.
 // Non-finite vz_in: vz_out = 0 (stop the axis), kFault. Non-finite wear_ratio: no compensation
 // (vz_out = vz_in) for that cycle, kFault — a broken estimate must not stop nor drive the axis.
 // RT-safe: update(), params_changed(). Not thread-safe: the owning task calls every member except
@@ -42,14 +44,28 @@ struct WearCompensatorParams {
   // Defaults: a Ø1.1 mm hole drilled with a Ø1.0/Ø0.3 mm tube electrode.
   double hole_area_mm2{std::numbers::pi / 4.0 * 1.1 * 1.1};                     // ≈ 0.9503
   double electrode_area_mm2{std::numbers::pi / 4.0 * (1.0 * 1.0 - 0.3 * 0.3)};  // ≈ 0.7147
-  double wear_ratio_max{5.0};  // [-] upper clamp for the wear_ratio input
+  double wear_ratio_max{5.0};      // [-] upper clamp for the wear_ratio input
+  double wear_ratio_default{0.0};  // [-] θ while the wear_ratio input is <= 0 (unwired)
 
   void visit(rt::ParamVisitor& v) {
-    v.param("hole_area_mm2", hole_area_mm2, "mm^2", "cross-section of the hole A_hole (> 0)");
-    v.param("electrode_area_mm2", electrode_area_mm2, "mm^2",
-            "cross-section of the electrode material A_e (> 0; a tube: pi/4*(D^2-d^2))");
-    v.param("wear_ratio_max", wear_ratio_max, "", "upper clamp of the wear_ratio input (> 0)");
+    v.param("hole_area_mm2", hole_area_mm2,
+            {.unit = "mm^2",
+             .description = "cross-section of the hole A_hole",
+             .range = rt::kPositive});
+    v.param("electrode_area_mm2", electrode_area_mm2,
+            {.unit = "mm^2",
+             .description = "cross-section of the electrode material A_e (a tube: pi/4*(D^2-d^2))",
+             .range = rt::kPositive});
+    v.param(
+        "wear_ratio_max", wear_ratio_max,
+        {.unit = "", .description = "upper clamp of the wear_ratio input", .range = rt::kPositive});
+    v.param("wear_ratio_default", wear_ratio_default,
+            {.unit = "",
+             .description = "wear ratio used while the wear_ratio input is <= 0 (unwired), "
+                            "<= wear_ratio_max",
+             .range = rt::kNonNegative});
   }
+  /// Cross-field rule: wear_ratio_default <= wear_ratio_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -67,13 +83,17 @@ class WearCompensator final : public rt::BlockWithParams<WearCompensatorParams> 
  private:
   void compute_ratio() noexcept;
 
-  rt::Input<double> vz_in_mm_s_;
-  rt::Input<double> wear_ratio_;
-  rt::Input<bool> enable_{true};
-  rt::Input<bool> reset_wear_;
-  rt::Output<double> vz_out_mm_s_;
-  rt::Output<double> vd_mm_s_;
-  rt::Output<double> wear_mm_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<double> vz_in_mm_s;
+  rt::Input<double> wear_ratio;
+  rt::Input<bool> enable{true};
+  rt::Input<bool> reset_wear;
+  rt::Output<double> vz_out_mm_s;
+  rt::Output<double> vd_mm_s;
+  rt::Output<double> wear_mm;
+
+ private:
   double dt_s_{0.0};
   double area_ratio_{1.0};    // A_hole / A_e
   double front_mm_{0.0};      // ∫ vz_in dt since the last reset (0 = where the reset happened)

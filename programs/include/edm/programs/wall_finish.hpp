@@ -3,7 +3,7 @@
 // with negative polarity, switch to positive polarity and orbit the electrode in XY about the hole
 // centre with a radius that grows once per revolution by Δr = kr·Tdm (eq. 20–21).
 //
-// Children (variables program.<instance>.<child>.<pin>):
+// Children (their pins and parameters are variables program.<instance>.<child>.<name>):
 //   pol    PolaritySwitch  switches the polarity only with the generator off (settle each side)
 //   td     TdDetector      mean ignition delay from the pulse counters
 //   orbit  OrbitExpander   orbit offset r: r0 = start_offset_mm, grows by clamp(kr·Tdm) per
@@ -30,9 +30,16 @@
 // Safe state (FAULT / ESTOP): generator off and v = 0 at once (the loops' own safe state); a
 // running cycle ends in IDLE (done false). `start` is ignored while in a safe state.
 //
-// Parameters kr, dr_max_mm (→ orbit), kv, v_max_mm_s, f_err_max_mm (→ px, py), settle (→ pol) and
-// td_window (→ td, load time only) are copied into the children at configure time; kr, dr_max_mm,
-// kv are copied again on a runtime write.
+// The children's parameters are set in YAML under this block's params (`orbit: {kr: 1e-4}`,
+// `px: {kv: 20}`, `pol: {settle: 20ms}`, `td: {window: 8}`). This program's defaults for them:
+// orbit.kr = 1e-4 mm/µs, orbit.dr_max_mm = 0.002 mm (calibrated on the simulator's drill preset,
+// config/machines/finish-sim-program.yaml), orbit.samples_per_rev = 0 (revolutions come from the
+// orbit phase: another value is refused), pol.initial_positive = false, px/py.v_max_mm_s = 5.
+// Connected by member in bind_self(): td's counters and px/py's positions follow this block's
+// inputs; orbit.td_us/valid ← td; the rest come from this block's outputs below.
+// Extra outputs (the signals the sequence gives its children): polarity_request,
+// generator_request, orbit_start, orbit_enable, rev_pulse, orbit_r0_mm, orbit_final_mm,
+// x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s, loop_enable.
 //
 // RT-safety: update() and enter_safe_state() are RT-safe (noexcept, no allocation, no locks).
 // Not thread-safe: the owning task calls every member except the pins (see pin.hpp).
@@ -50,23 +57,15 @@
 namespace edm::programs {
 
 struct WallFinishParams {
-  double orbit_period_s{0.5};                   // [s] > 0, time of one revolution
-  double radial_speed_mm_s{0.05};               // [mm/s] > 0, slew of the reference radius
-  std::int64_t spark_out_revs{2};               // ≥ 0 revolutions at the final radius before BACK
-  double centre_tol_mm{0.002};                  // [mm] > 0, BACK ends within this of the centre
-  double kr{blocks::OrbitExpanderParams{}.kr};  // [mm/µs] ≥ 0 → orbit.kr
-  double dr_max_mm{0.005};                      // [mm] ≥ 0 → orbit.dr_max_mm
-  double kv{blocks::PositionLoopParams{}.kv};   // [1/s] ≥ 0 → px, py
-  double v_max_mm_s{5.0};                       // [mm/s] > 0 → px, py
-  double f_err_max_mm{blocks::PositionLoopParams{}.f_err_max_mm};  // [mm] > 0 → px, py
-  rt::Duration settle{blocks::PolaritySwitchParams{}.settle};      // > 0 → pol (load time only)
-  std::int64_t td_window{8};  // cycles, → td.window (load time only)
+  double orbit_period_s{0.5};      // [s] time of one revolution
+  double radial_speed_mm_s{0.05};  // [mm/s] slew of the reference radius
+  std::int64_t spark_out_revs{4};  // revolutions at the final radius before BACK
+  double centre_tol_mm{0.002};     // [mm] BACK ends within this of the centre
   // ORBIT without a single ignited or shorted pulse for this long (outside spark-out) is a fault:
   // no work, no generator, a wrong offset. 0 s: off.
-  rt::Duration no_spark_timeout{std::chrono::seconds(30)};  // ≥ 0
+  rt::Duration no_spark_timeout{std::chrono::seconds(30)};
 
   void visit(rt::ParamVisitor& v);
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::CompositeBlock> {
@@ -75,21 +74,42 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
 
   WallFinish();
 
-  /// RT-safe. kOk, or the worst status of the children stepped this cycle.
-  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses settle and td_window (load time only).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
+  // Pins (named as in visit_own_pins).
+  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  rt::Input<double> x_mm, y_mm;
+  rt::Input<bool> start;
+  rt::Input<double> start_offset_mm;
+  rt::Input<double> final_offset_mm;
+  rt::Input<bool> hold;       // feed hold in the orbit
+  rt::Output<bool> no_spark;  // the no-spark timeout tripped (a fault)
+  rt::Output<double> vx_cmd_mm_s, vy_cmd_mm_s;
+  rt::Output<bool> gen_on;
+  rt::Output<bool> polarity_positive;
+  rt::Output<std::int64_t> state;
+  rt::Output<double> offset_mm;
+  rt::Output<double> rho_mm;  // reference radius actually commanded
+  rt::Output<std::int64_t> revolutions;
+  rt::Output<bool> done;
+  // The signals the sequence gives its children.
+  rt::Output<bool> polarity_request, generator_request;
+  rt::Output<bool> orbit_start, orbit_enable, rev_pulse;
+  rt::Output<double> orbit_r0_mm, orbit_final_mm;
+  rt::Output<double> x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s;
+  rt::Output<bool> loop_enable;
 
  protected:
   void visit_own_pins(rt::PinVisitor& v) override;
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
+  void bind_self() override;
   void activate_self() noexcept override;
   void safe_state_self(const rt::SafeStateRequest& request) noexcept override;
-  void params_changed() noexcept override;
+  /// RT-safe. kOk, or the worst status of the children stepped this cycle.
+  rt::BlockStatus update_self(const rt::CycleContext& ctx) noexcept override;
 
  private:
   void set_state(State s) noexcept;
   void stop_outputs() noexcept;
+  void set_reference(double x, double y) noexcept;
 
   blocks::PolaritySwitch& pol_;
   blocks::TdDetector& td_;
@@ -97,46 +117,13 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   blocks::PositionLoop& px_;
   blocks::PositionLoop& py_;
 
-  // Own pins.
-  rt::Input<std::int64_t> td_sum_ns_, td_count_, n_open_, n_short_;
-  rt::Input<double> x_mm_, y_mm_;
-  rt::Input<bool> start_;
-  rt::Input<bool> hold_;       // feed hold in the orbit
-  rt::Output<bool> no_spark_;  // the no-spark timeout tripped (a fault)
-  double dark_s_{0.0};         // time in ORBIT since the last ignited or shorted pulse
-  rt::Input<double> start_offset_mm_;
-  rt::Input<double> final_offset_mm_;
-  rt::Output<double> vx_cmd_mm_s_, vy_cmd_mm_s_;
-  rt::Output<bool> gen_on_;
-  rt::Output<bool> polarity_positive_;
-  rt::Output<std::int64_t> state_;
-  rt::Output<double> offset_mm_;
-  rt::Output<double> rho_mm_;  // reference radius actually commanded
-  rt::Output<std::int64_t> revolutions_;
-  rt::Output<bool> done_;
-
-  // Private cells the children's inputs are wired to.
-  rt::Output<std::int64_t> c_td_sum_ns_, c_td_count_, c_n_open_, c_n_short_;
-  rt::Output<bool> c_pol_req_, c_gen_req_;
-  rt::Output<bool> c_orbit_start_, c_orbit_enable_, c_rev_pulse_;
-  rt::Output<double> c_r0_, c_final_;
-  rt::Output<double> c_xref_, c_yref_, c_vffx_, c_vffy_, c_x_, c_y_;
-  rt::Output<bool> c_loop_enable_;
-  // Children's outputs read by the sequence.
-  const rt::Output<bool>* pol_positive_{nullptr};
-  const rt::Output<bool>* pol_gen_{nullptr};
-  const rt::Output<bool>* pol_switching_{nullptr};
-  const rt::Output<double>* orbit_radius_{nullptr};
-  const rt::Output<bool>* orbit_done_{nullptr};
-  const rt::Output<std::int64_t>* orbit_revs_{nullptr};
-  const rt::Output<double>* px_v_{nullptr};
-  const rt::Output<double>* py_v_{nullptr};
-
   State state_value_{State::kIdle};
   bool prev_start_{false};
+  double dark_s_{0.0};  // time in ORBIT since the last ignited or shorted pulse
   double x0_{0.0}, y0_{0.0};
-  double rho_{0.0};    // [mm] reference radius
-  double theta_{0.0};  // [rad] in [0, 2π)
+  double x_ref_{0.0}, y_ref_{0.0};  // the reference point last given to the loops
+  double rho_{0.0};                 // [mm] reference radius
+  double theta_{0.0};               // [rad] in [0, 2π)
   std::int64_t revs_{0};
   std::int64_t spark_out_left_{0};
   bool spark_out_{false};

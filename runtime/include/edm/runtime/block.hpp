@@ -1,12 +1,14 @@
 #pragma once
 // The function-block interface (IEC 61131-3 FB, ros2_control-style lifecycle).
 //
-//   non-RT  visit_params() (loader fills Params) → validate() → configure() → activate()
+//   non-RT  visit_params() (loader fills Params) → validate() → configure() → (YAML wiring)
+//           → bind() → activate()
 //   RT      update() every cycle of the owning task; params_changed() after a runtime write;
 //           enter_safe_state() on entry into FAULT/ESTOP
 //
 // A block type derives from BlockWithParams<Params> (or Block for parameterless blocks),
 // declares its pins in visit_pins() and is registered by name in register_builtin_blocks().
+// Pins are public Input<T>/Output<T> members, so a C++ PROGRAM connects its children by member.
 
 #include <cstdint>
 #include <memory>
@@ -78,12 +80,19 @@ class Block : public SafeStateHandler {
   [[nodiscard]] virtual std::vector<ParamError> validate() const { return {}; }
   /// Prepares for running on a task (precompute, allocate). Non-RT. Returns problems, if any.
   virtual std::vector<ParamError> configure(const BlockSetup& /*setup*/) { return {}; }
+  /// Called once the YAML wiring is resolved, before activate(): a composite connects its
+  /// children here, seeing its own final inputs. Non-RT.
+  virtual void bind() {}
   /// Resets internal state before the first cycle. Non-RT.
   virtual void activate() noexcept {}
   /// One scan. RT-safe: must not allocate, lock, log synchronously or throw.
   virtual BlockStatus update(const CycleContext& ctx) noexcept = 0;
   /// Default safe state: nothing to do. RT-safe.
   void enter_safe_state(const SafeStateRequest& /*request*/) noexcept override {}
+  /// After update() returned kFault: the full name of the block that raised it when that is a
+  /// child ("cnc.job.drill.gap"), or nullptr for the block itself. RT-safe; the string lives as
+  /// long as the block.
+  [[nodiscard]] virtual const char* fault_source() const noexcept { return nullptr; }
 
   // Runtime parameter access (variable registry). Blocks get these from BlockWithParams.
   /// Number of parameter fields.
@@ -101,38 +110,68 @@ class Block : public SafeStateHandler {
 
 /// Base for blocks with a Params struct: live parameters (read by update()) and a shadow copy
 /// (non-RT) on which runtime writes are validated before being queued to the RT thread.
-/// Base is Block, or another Block-derived interface such as IoDriver.
+/// Base is Block, or another Block-derived interface such as IoDriver or CompositeBlock; the
+/// Base's own parameters (a composite's children's) follow this block's in index order.
 template <class P, class Base = Block>
 class BlockWithParams : public Base {
  public:
   using Params = P;
 
-  void visit_params(ParamVisitor& v) override { params_.visit(v); }
-  [[nodiscard]] std::vector<ParamError> validate() const override { return params_.validate(); }
-  [[nodiscard]] std::size_t param_count() override { return field_refs(shadow_).size(); }
+  void visit_params(ParamVisitor& v) override {
+    params_.visit(v);
+    Base::visit_params(v);
+  }
+  [[nodiscard]] std::vector<ParamError> validate() const override {
+    std::vector<ParamError> errs = validate_params(params_);
+    for (ParamError& e : Base::validate()) {
+      errs.push_back(std::move(e));
+    }
+    return errs;
+  }
+  /// RT-safe (counts without allocating).
+  [[nodiscard]] std::size_t param_count() override { return own_count() + Base::param_count(); }
   std::vector<ParamError> stage_param(std::size_t index, const ParamValue& v) override {
+    if (index >= own_count()) {
+      return Base::stage_param(index - own_count(), v);
+    }
     P candidate = shadow_;
-    auto refs = field_refs(candidate);
-    if (index >= refs.size() || !write_param(refs[index], v)) {
+    ParamAt at(index);
+    candidate.visit(at);
+    if (at.spec.load_time_only) {
+      return {{"", "load time only (set it in the config)"}};
+    }
+    if (!write_param(at.ref, v)) {
       return {{"", "parameter type mismatch or not writable at run time"}};
     }
-    auto errs = candidate.validate();
+    auto errs = validate_params(candidate);
     if (errs.empty()) {
       shadow_ = candidate;
     }
     return errs;
   }
   void apply_param(std::size_t index, const ParamValue& v) noexcept override {
-    IndexWriter w{index, v};
-    params_.visit(w);
+    if (index >= own_count()) {
+      Base::apply_param(index - own_count(), v);
+      return;
+    }
+    ParamAt at(index);
+    params_.visit(at);
+    write_param(at.ref, v);
     params_changed();
   }
   [[nodiscard]] ParamValue read_param(std::size_t index) const override {
+    if (index >= own_count()) {
+      return Base::read_param(index - own_count());
+    }
     P copy = shadow_;
-    auto refs = field_refs(copy);
-    return index < refs.size() ? edm::rt::read_param(refs[index]) : ParamValue{};
+    ParamAt at(index);
+    copy.visit(at);
+    return at.found ? edm::rt::read_param(at.ref) : ParamValue{};
   }
-  void commit_params() override { shadow_ = params_; }
+  void commit_params() override {
+    shadow_ = params_;
+    Base::commit_params();
+  }
 
   [[nodiscard]] const P& params() const noexcept { return params_; }
   /// Sets the live parameters directly (tests and C++ programs, before activate()). Non-RT.
@@ -148,30 +187,14 @@ class BlockWithParams : public Base {
   P params_{};
 
  private:
-  // Writes one field chosen by index; allocation-free so it can run on the RT thread.
-  class IndexWriter final : public ParamVisitor {
-   public:
-    IndexWriter(std::size_t index, const ParamValue& v) : index_(index), value_(v) {}
-
-   protected:
-    void on_param(std::string_view, ParamRef ref, ParamInfo) override {
-      if (n_++ == index_) {
-        write_param(ref, value_);
-      }
-    }
-
-   private:
-    std::size_t index_;
-    ParamValue value_;
-    std::size_t n_{0};
-  };
-  static std::vector<ParamRef> field_refs(P& p) {
-    struct Collect final : ParamVisitor {
-      std::vector<ParamRef> refs;
-      void on_param(std::string_view, ParamRef ref, ParamInfo) override { refs.push_back(ref); }
-    } c;
-    p.visit(c);
-    return c.refs;
+  [[nodiscard]] std::size_t own_count() const noexcept {
+    static const std::size_t n = [] {
+      P p{};
+      ParamCounter c;
+      p.visit(c);
+      return c.count;
+    }();
+    return n;
   }
 
   P shadow_{};

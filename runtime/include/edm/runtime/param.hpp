@@ -1,18 +1,26 @@
 #pragma once
-// Block parameters: a plain struct per block type with defaults, a visit() that names each field
-// for the loader and the variable registry, and a validate() that says what is wrong.
+// Block parameters: a plain struct per block type with defaults and one visit() that declares
+// each field once — its name, unit, description, range, finiteness and whether it may change at
+// run time. Validation, the refusal of a runtime write, `edmplc --list-vars` and the parameter
+// tables of docs/blocks.md all come from that declaration:
 //
 //   struct LowPassParams {
 //     double tau_s{0.01};
-//     void visit(ParamVisitor& v) { v.param("tau", tau_s, "s", "time constant"); }
-//     std::vector<ParamError> validate() const;
+//     void visit(ParamVisitor& v) {
+//       v.param("tau", tau_s, {.unit = "s", .description = "time constant", .range = kPositive});
+//     }
 //   };
+//
+// A Params struct may add `std::vector<ParamError> validate() const` for rules that tie fields
+// together (e.g. "max >= min"); it runs only once every field is in its own range.
 //
 // The loader fills the struct through a ParamVisitor (blocks never see YAML). At run time a
 // parameter write is validated on a shadow copy (non-RT) and then applied by the owning task at
 // the start of its next cycle (RT), see BlockWithParams.
 
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -54,39 +62,83 @@ struct ParamRef {
   void* field{nullptr};
 };
 
-/// Static description of a parameter, for docs and listings.
-struct ParamInfo {
-  std::string_view unit;
-  std::string_view description;
+/// The allowed values of a numeric parameter (INT, REAL; TIME in seconds): a lower and an upper
+/// bound, each open or closed; an infinite bound is no bound.
+struct Range {
+  double lo{-std::numeric_limits<double>::infinity()};
+  double hi{std::numeric_limits<double>::infinity()};
+  bool lo_open{false};
+  bool hi_open{false};
+
+  [[nodiscard]] bool contains(double v) const noexcept {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  [[nodiscard]] bool unbounded() const noexcept;
+  /// "> 0", ">= 1", "< 5", "<= 5", "[0, 1]", "(0, 1]", … ; empty when unbounded.
+  [[nodiscard]] std::string text() const;
 };
+
+constexpr Range above(double lo) noexcept {
+  return {lo, std::numeric_limits<double>::infinity(), true, false};
+}
+constexpr Range at_least(double lo) noexcept {
+  return {lo, std::numeric_limits<double>::infinity(), false, false};
+}
+constexpr Range below(double hi) noexcept {
+  return {-std::numeric_limits<double>::infinity(), hi, false, true};
+}
+constexpr Range at_most(double hi) noexcept {
+  return {-std::numeric_limits<double>::infinity(), hi, false, false};
+}
+constexpr Range closed(double lo, double hi) noexcept { return {lo, hi, false, false}; }
+constexpr Range open_closed(double lo, double hi) noexcept { return {lo, hi, true, false}; }
+constexpr Range closed_open(double lo, double hi) noexcept { return {lo, hi, false, true}; }
+constexpr Range open(double lo, double hi) noexcept { return {lo, hi, true, true}; }
+inline constexpr Range kPositive = above(0.0);
+inline constexpr Range kNonNegative = at_least(0.0);
+
+/// Everything said about a parameter, declared once in the Params struct's visit().
+struct ParamSpec {
+  std::string_view unit{};         // "mm/s", "us", "" (dimensionless)
+  std::string_view description{};  // one line, for listings and docs/blocks.md
+  Range range{};                 // checked for INT, REAL and TIME (seconds) fields
+  bool finite{true};             // REAL: NaN and ±inf are refused
+  bool load_time_only{false};    // a runtime write is refused (sizes buffers, precomputed)
+};
+using ParamInfo = ParamSpec;  // the older name, kept for visitors outside the runtime
 
 /// Visits the fields of a Params struct in declaration order.
 class ParamVisitor {
  public:
   virtual ~ParamVisitor() = default;
-  void param(std::string_view name, bool& v, std::string_view unit = {},
-             std::string_view description = {}) {
-    on_param(name, {ParamType::kBool, &v}, {unit, description});
+  void param(std::string_view name, bool& v, const ParamSpec& spec = {}) {
+    on_param(name, {ParamType::kBool, &v}, spec);
   }
-  void param(std::string_view name, std::int64_t& v, std::string_view unit = {},
-             std::string_view description = {}) {
-    on_param(name, {ParamType::kInt, &v}, {unit, description});
+  void param(std::string_view name, std::int64_t& v, const ParamSpec& spec = {}) {
+    on_param(name, {ParamType::kInt, &v}, spec);
   }
-  void param(std::string_view name, double& v, std::string_view unit = {},
-             std::string_view description = {}) {
-    on_param(name, {ParamType::kReal, &v}, {unit, description});
+  void param(std::string_view name, double& v, const ParamSpec& spec = {}) {
+    on_param(name, {ParamType::kReal, &v}, spec);
   }
-  void param(std::string_view name, Duration& v, std::string_view unit = {},
-             std::string_view description = {}) {
-    on_param(name, {ParamType::kDuration, &v}, {unit, description});
+  void param(std::string_view name, Duration& v, const ParamSpec& spec = {}) {
+    on_param(name, {ParamType::kDuration, &v}, spec);
   }
-  void param(std::string_view name, std::string& v, std::string_view unit = {},
+  void param(std::string_view name, std::string& v, const ParamSpec& spec = {}) {
+    on_param(name, {ParamType::kString, &v}, spec);
+  }
+  /// The older form: unit and description only, no range. Being replaced by ParamSpec.
+  template <class T>
+  void param(std::string_view name, T& v, std::string_view unit,
              std::string_view description = {}) {
-    on_param(name, {ParamType::kString, &v}, {unit, description});
+    param(name, v, ParamSpec{unit, description});
+  }
+  /// Passes on an already type-erased field (composites re-expose their children's).
+  void forward(std::string_view name, ParamRef ref, const ParamSpec& spec) {
+    on_param(name, ref, spec);
   }
 
  protected:
-  virtual void on_param(std::string_view name, ParamRef ref, ParamInfo info) = 0;
+  virtual void on_param(std::string_view name, ParamRef ref, ParamSpec spec) = 0;
 };
 
 /// Reads a field as a value (strings give an empty kString value). RT-safe.
@@ -105,10 +157,79 @@ void require_finite(std::vector<ParamError>& errs, std::string_view field, doubl
 void require_ordered(std::vector<ParamError>& errs, std::string_view lo_field, double lo,
                      std::string_view hi_field, double hi);
 
+/// The problem with one field's value against its ParamSpec (range, finiteness), if any.
+/// Non-RT (builds a message).
+void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef ref,
+                 const ParamSpec& spec);
+
+/// Checks every field of a Params struct against its ParamSpec. Non-RT.
+class SpecChecker final : public ParamVisitor {
+ public:
+  std::vector<ParamError> errors;
+
+ protected:
+  void on_param(std::string_view name, ParamRef ref, ParamSpec spec) override {
+    check_field(errors, name, ref, spec);
+  }
+};
+
+/// Counts fields without allocating. RT-safe.
+class ParamCounter final : public ParamVisitor {
+ public:
+  std::size_t count{0};
+
+ protected:
+  void on_param(std::string_view, ParamRef, ParamSpec) override { ++count; }
+};
+
+/// The field at `index` (visit order): its reference and spec. RT-safe (no allocation).
+class ParamAt final : public ParamVisitor {
+ public:
+  explicit ParamAt(std::size_t index) noexcept : index_(index) {}
+  ParamRef ref{};
+  ParamSpec spec{};
+  bool found{false};
+
+ protected:
+  void on_param(std::string_view, ParamRef r, ParamSpec s) override {
+    if (n_++ == index_) {
+      ref = r;
+      spec = s;
+      found = true;
+    }
+  }
+
+ private:
+  std::size_t index_;
+  std::size_t n_{0};
+};
+
+/// A Params struct's own cross-field rules, if it declares validate(); none otherwise.
+template <class P>
+std::vector<ParamError> cross_field_errors(const P& p) {
+  if constexpr (requires { p.validate(); }) {
+    return p.validate();
+  } else {
+    return {};
+  }
+}
+
+/// Every problem of a Params struct: each field against its spec, then (only if every field is
+/// in range) the struct's cross-field rules. Non-RT.
+template <class P>
+std::vector<ParamError> validate_params(const P& p) {
+  P copy = p;  // visit() takes non-const references
+  SpecChecker c;
+  copy.visit(c);
+  if (!c.errors.empty()) {
+    return std::move(c.errors);
+  }
+  return cross_field_errors(p);
+}
+
 /// Parameters of a block that has none.
 struct NoParams {
   void visit(ParamVisitor& /*v*/) {}
-  [[nodiscard]] std::vector<ParamError> validate() const { return {}; }
 };
 
 }  // namespace edm::rt

@@ -15,7 +15,7 @@
 // The runtime releases every force when the machine enters FAULT or ESTOP (the safe state
 // wins over forces; docs/runtime.md "Forcing").
 //
-// RT-safe: get(), set(). Non-RT: connect(), set_constant(). force()/unforce() may be called from
+// RT-safe: get(), set(). Non-RT: connect(), follow(), set_constant(). force()/unforce() may be called from
 // any thread. Pins are neither copyable nor movable (wires point at them).
 
 #include <atomic>
@@ -104,18 +104,29 @@ class Input {
     if (forced_.load(std::memory_order_acquire)) {
       return force_value_.load(std::memory_order_relaxed);
     }
+    if (via_ != nullptr) {
+      return via_->get();
+    }
     return src_->load(std::memory_order_relaxed);
   }
 
   /// Wires this input to an output. Non-RT (load time only).
   void connect(const Output<T>& source) noexcept {
     src_ = &source.cell();
+    via_ = nullptr;
+    connected_ = true;
+  }
+  /// Reads whatever `outer` reads: its wire, its constant, or its forced value. A composite
+  /// hands one of its own inputs to a child this way. Non-RT (bind time).
+  void follow(const Input& outer) noexcept {
+    via_ = &outer;
     connected_ = true;
   }
   /// Makes this input read a constant. Non-RT (load time only).
   void set_constant(T v) noexcept {
     constant_.store(v, std::memory_order_relaxed);
     src_ = &constant_;
+    via_ = nullptr;
     connected_ = false;
   }
   [[nodiscard]] bool connected() const noexcept { return connected_; }
@@ -130,6 +141,7 @@ class Input {
  private:
   std::atomic<T> constant_;
   const std::atomic<T>* src_{&constant_};
+  const Input* via_{nullptr};  // follow(): read through another input
   std::atomic<T> force_value_{};
   std::atomic<bool> forced_{false};
   bool connected_{false};

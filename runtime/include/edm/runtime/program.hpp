@@ -25,6 +25,7 @@ class Program final : public SafeStateHandler {
     std::string full_name;  // "program.block" (also the alarm source)
     std::unique_ptr<Block> block;
     BlockStatus last{BlockStatus::kOk};
+    const char* fault_source{nullptr};  // alarm source of the running fault episode
   };
 
   Program(std::string name, Machine& machine) : name_(std::move(name)), machine_(&machine) {}

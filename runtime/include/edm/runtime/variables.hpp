@@ -45,11 +45,19 @@ struct Variable {
   ParamType param_type{ParamType::kReal};
   std::string unit;
   Task* owner{nullptr};  // the task whose thread updates it
+  // Parameters: from the block's ParamSpec.
+  std::string description;
+  std::string range;  // "> 0", "[1, 65536]", "" (any)
+  bool load_time_only{false};
 
   [[nodiscard]] bool is_pin() const noexcept { return kind != VarKind::kParam; }
   /// The IEC type name: BOOL, LINT, LREAL, TIME, STRING.
   [[nodiscard]] std::string_view type_name() const noexcept;
 };
+
+/// One line of `edmplc --list-vars`: name, kind, type, unit, task, then for parameters the
+/// range, "load-time" or "runtime", and the description; tab-separated, "-" for empty.
+std::string list_row(const Variable& v);
 
 enum class VarResult : std::uint8_t {
   kOk,

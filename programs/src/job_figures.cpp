@@ -1,0 +1,41 @@
+#include "edm/programs/job_figures.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace edm::programs {
+
+void JobFigures::visit(rt::PinVisitor& v) {
+  v.output("job_time_s", job_time_s, "s");
+  v.output("job_pulses", job_pulses);
+  v.output("job_shorts", job_shorts);
+  v.output("job_arcs", job_arcs);
+  v.output("job_depth_mm", job_depth_mm, "mm");
+  v.output("job_wear_mm", job_wear_mm, "mm");
+}
+
+void JobFigures::begin(rt::TimePoint start) noexcept {
+  start_ = start;
+  wear_before_block_ = 0.0;
+  job_time_s.set(0.0);
+  job_pulses.set(0);
+  job_shorts.set(0);
+  job_arcs.set(0);
+  job_depth_mm.set(0.0);
+  job_wear_mm.set(0.0);
+}
+
+void JobFigures::count(rt::TimePoint now, const Counts& c) noexcept {
+  job_time_s.set(std::chrono::duration<double>(now - start_).count());
+  const std::int64_t arcs = c.n_transient_arc + c.n_stable_arc;
+  job_pulses.set(job_pulses.get() + c.n_open + c.n_normal + arcs + c.n_short);
+  job_shorts.set(job_shorts.get() + c.n_short);
+  job_arcs.set(job_arcs.get() + arcs);
+}
+
+void JobFigures::note_drill(double depth_mm, double wear_mm) noexcept {
+  job_depth_mm.set(std::max(job_depth_mm.get(), depth_mm));
+  job_wear_mm.set(wear_before_block_ + wear_mm);
+}
+
+}  // namespace edm::programs
