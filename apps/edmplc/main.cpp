@@ -130,7 +130,8 @@ std::variant<Options, int> parse_args(int argc, char** argv) {
   app.add_flag("--check", o.check,
                "validate the config and exit (0 ok, 2 invalid: file:line:col: message)");
   app.add_flag("--list-vars", o.list_vars,
-               "print every variable (name, kind, type, unit, task) and exit");
+               "print every variable (name, kind, type, unit, task; parameters also range, "
+               "load-time or runtime, description) and exit");
   app.add_option_function<std::string>(
       "--log-level",
       [&](const std::string& v) {
@@ -216,9 +217,7 @@ int main(int argc, char** argv) {
   if (opt.list_vars) {
     edm::rt::shutdown_logging();
     for (const auto& v : rt->variables().all()) {
-      std::cout << v.name << "\t" << to_string(v.kind) << "\t" << v.type_name() << "\t"
-                << (v.unit.empty() ? "-" : v.unit) << "\t"
-                << (v.owner != nullptr ? v.owner->name() : "-") << "\n";
+      std::cout << edm::rt::list_row(v) << "\n";
     }
     return kExitOk;
   }
