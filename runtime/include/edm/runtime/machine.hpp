@@ -56,8 +56,8 @@ enum class AlarmCode : std::uint16_t {
   kBlockFault = 110,       // a block's update() returned kFault
   kIoFault = 120,          // the I/O driver reported a fault
   kEstop = 130,            // emergency stop requested
-  kFollowingError = 140,   // reserved: axis following error
-  kSoftLimit = 141,        // reserved: soft-limit violation
+  kFollowingError = 140,   // axis following error (EdmJob)
+  kSoftLimit = 141,        // soft-limit violation (EdmJob)
   kShortCircuit = 150,     // reserved: sustained short circuit after N retracts
   kElectrodeUsedUp = 160,  // reserved: electrode length exhausted
   kWireBreak = 170,        // reserved: wire EDM wire break
