@@ -99,16 +99,16 @@ int main(int argc, char** argv) {
   app.add_option("--edmplc", o.edmplc, "the edmplc binary")->required();
   app.add_option("--root", o.root, "the source tree")->capture_default_str();
   app.add_option("--duration", o.duration_s, "seconds per RT latency run")
-      ->check(CLI::PositiveNumber)
+      ->check(edm::apps::kPositive)
       ->capture_default_str();
   app.add_option("--clients", o.clients, "status subscribers")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   app.add_option("--port", o.port, "edmplc's bridge port")
       ->check(CLI::Range(1, 65535))
       ->capture_default_str();
   app.add_option("--blocks", o.blocks, "blocks of the uploaded program")
-      ->check(CLI::PositiveNumber)
+      ->check(edm::apps::kPositive)
       ->capture_default_str();
   if (const auto code = edm::apps::parse(app, argc, argv,
                                          "edm-bench-bridge --edmplc PATH [--root DIR] "

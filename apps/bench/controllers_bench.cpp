@@ -63,11 +63,11 @@ int main(int argc, char** argv) {
                "edm-bench-controllers");
   app.add_flag("--quick", quick, "5 seeds and short scenarios");
   app.add_option("--seeds", n_seeds, "seeds per scenario (default 20, 5 with --quick)")
-      ->check(CLI::PositiveNumber);
+      ->check(edm::apps::kPositive);
   app.add_option("--first-seed", first_seed, "the first seed (the benchmark's are 1 ... N)")
-      ->check(CLI::PositiveNumber)
+      ->check(edm::apps::kPositive)
       ->capture_default_str();
-  app.add_option("--jobs", jobs, "parallel runs")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--jobs", jobs, "parallel runs")->check(edm::apps::kPositive)->capture_default_str();
   app.add_option("--root", root, "the source tree")->capture_default_str();
   app.add_option("--out", out_dir, "output directory (default ROOT/out/bench/controllers)");
   app.add_option_function<std::string>(

@@ -457,7 +457,7 @@ int main(int argc, char** argv) {
       },
       "hostile kinds not run, KIND,...");
   app.add_option("--max-stall-s", o.max_stall_s, "a job stalled longer fails the soak")
-      ->check(CLI::PositiveNumber)
+      ->check(edm::apps::kPositive)
       ->capture_default_str();
   if (const auto code = edm::apps::parse(
           app, argc, argv,
