@@ -5,17 +5,6 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> ButterworthLowPassParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_finite(errs, "cutoff", cutoff);
-  rt::require_finite(errs, "initial", initial);
-  if (errs.empty() && !(cutoff > 0.0 && cutoff < 1.0)) {
-    errs.push_back({"cutoff", "must be in (0, 1): a fraction of the Nyquist frequency (got " +
-                                  std::to_string(cutoff) + ")"});
-  }
-  return errs;
-}
-
 ButterworthLowPass::Coefficients ButterworthLowPass::design(double wn) noexcept {
   if (!(wn > 0.0 && wn < 1.0)) {
     return {};

@@ -13,13 +13,6 @@ constexpr std::int64_t spread(std::int64_t i, std::int64_t a, std::int64_t total
 
 }  // namespace
 
-std::vector<rt::ParamError> DischargeStateCounterParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "interval", static_cast<double>(interval), 1.0,
-                    static_cast<double>(kMaxInterval));
-  return errs;
-}
-
 void DischargeStateCounter::visit_pins(rt::PinVisitor& v) {
   v.input("n_open", n_open_, "pulses");
   v.input("n_normal", n_normal_, "pulses");

@@ -11,16 +11,6 @@ constexpr int kWindow = 32;  // pulses in the seed-003 shift registers
 
 }  // namespace
 
-std::vector<rt::ParamError> FuzzyServoLUTParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "samples", static_cast<double>(samples), 3.0, 100000.0);
-  rt::require_finite(errs, "v_max_mm_s", v_max_mm_s);
-  if (errs.empty()) {
-    rt::require_positive(errs, "v_max_mm_s", v_max_mm_s);
-  }
-  return errs;
-}
-
 void FuzzyServoLUT::visit_pins(rt::PinVisitor& v) {
   v.input("open_count", open_count_, "pulses");
   v.input("short_count", short_count_, "pulses");
@@ -28,7 +18,7 @@ void FuzzyServoLUT::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> FuzzyServoLUT::configure(const rt::BlockSetup& /*setup*/) {
-  std::vector<rt::ParamError> errs = params_.validate();
+  std::vector<rt::ParamError> errs = rt::validate_params(params_);
   if (!errs.empty()) {
     return errs;
   }

@@ -2,16 +2,7 @@
 
 #include <cmath>
 
-#include "edm/blocks/validation.hpp"
-
 namespace edm::blocks {
-
-std::vector<rt::ParamError> GainParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  require_finite(errs, "k", k);
-  require_finite(errs, "offset", offset);
-  return errs;
-}
 
 void Gain::visit_pins(rt::PinVisitor& v) {
   v.input("in", in_);

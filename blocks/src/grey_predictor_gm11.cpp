@@ -4,24 +4,9 @@
 #include <cmath>
 
 namespace edm::blocks {
-namespace {
-
-// Index of `window` in GreyPredictorGM11Params::visit().
-constexpr std::size_t kWindowIndex = 0;
-
-}  // namespace
-
 std::vector<rt::ParamError> GreyPredictorGM11Params::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "window", static_cast<double>(window), 4.0,
-                    static_cast<double>(kMaxWindow));
-  rt::require_range(errs, "horizon", static_cast<double>(horizon), 0.0,
-                    static_cast<double>(kMaxHorizon));
-  rt::require_finite(errs, "out_min", out_min);
-  rt::require_finite(errs, "out_max", out_max);
-  if (errs.empty()) {
-    rt::require_ordered(errs, "out_min", out_min, "out_max", out_max);
-  }
+  rt::require_ordered(errs, "out_min", out_min, "out_max", out_max);
   return errs;
 }
 
@@ -91,7 +76,7 @@ void GreyPredictorGM11::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> GreyPredictorGM11::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = params_.validate();
+  auto errs = rt::validate_params(params_);
   if (!errs.empty()) {
     return errs;
   }
@@ -133,14 +118,6 @@ rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexc
   out_.set(clamped(f.valid ? f.prediction : x));
   valid_.set(f.valid);
   return rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> GreyPredictorGM11::stage_param(std::size_t index,
-                                                           const rt::ParamValue& v) {
-  if (index == kWindowIndex) {
-    return {{"window", "cannot change at run time (it sizes the ring); reload the config"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

@@ -9,13 +9,7 @@ namespace edm::blocks {
 
 std::vector<rt::ParamError> IntegratorParams::validate() const {
   std::vector<rt::ParamError> errs;
-  require_finite(errs, "k", k);
-  require_finite(errs, "min", min);
-  require_finite(errs, "max", max);
-  require_finite(errs, "initial", initial);
-  if (errs.empty()) {
-    require_ordered(errs, "min", min, "max", max);
-  }
+  require_ordered(errs, "min", min, "max", max);
   return errs;
 }
 

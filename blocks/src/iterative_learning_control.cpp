@@ -4,41 +4,14 @@
 #include <cmath>
 
 namespace edm::blocks {
-namespace {
-
-// Positions in IterativeLearningControlParams::visit().
-constexpr std::size_t kSamplesIndex = 0;      // n_samples
-constexpr std::size_t kWarmCyclesIndex = 11;  // warm_cycles
-
-}  // namespace
-
 std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "n_samples", static_cast<double>(n_samples), 2.0,
-                    static_cast<double>(kMaxSamples));
-  rt::require_range(errs, "warm_cycles", static_cast<double>(warm_cycles), 0.0, 1e6);
-  const std::pair<const char*, double> all[] = {
-      {"p0", p0},           {"k_delta", k_delta}, {"q_pole", q_pole},       {"lambda1", lambda1},
-      {"lambda2", lambda2}, {"lambda3", lambda3}, {"u_initial", u_initial}, {"u_min", u_min},
-      {"u_max", u_max},     {"e_max", e_max}};
-  for (const auto& [name, value] : all) {
-    rt::require_finite(errs, name, value);
-  }
-  if (!errs.empty()) {
-    return errs;
-  }
   if (p0 == 0.0) {
     errs.push_back({"p0", "must be != 0 (l1 divides by it)"});
   }
   if (k_delta == 0.0) {
     errs.push_back({"k_delta", "must be != 0 (the gains divide by it)"});
   }
-  rt::require_range(errs, "q_pole", q_pole, 0.0, 1.0 - 1e-9);
-  constexpr double kPole = 1.0 - 1e-9;
-  rt::require_range(errs, "lambda1", lambda1, -kPole, kPole);
-  rt::require_range(errs, "lambda2", lambda2, -kPole, kPole);
-  rt::require_range(errs, "lambda3", lambda3, -kPole, kPole);
-  rt::require_non_negative(errs, "e_max", e_max);
   rt::require_ordered(errs, "u_min", u_min, "u_max", u_max);
   if (errs.empty()) {
     rt::require_range(errs, "u_initial", u_initial, u_min, u_max);
@@ -74,7 +47,7 @@ void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> IterativeLearningControl::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = params_.validate();
+  auto errs = rt::validate_params(params_);
   if (!errs.empty()) {
     return errs;
   }
@@ -217,17 +190,6 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   u_out_.set(u_[static_cast<std::size_t>(idx_)]);
   sample_.set(idx_);
   return overrun_ ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> IterativeLearningControl::stage_param(std::size_t index,
-                                                                  const rt::ParamValue& v) {
-  if (index == kSamplesIndex) {
-    return {{"n_samples", "cannot change at run time (it sizes the buffers); reload the config"}};
-  }
-  if (index == kWarmCyclesIndex) {
-    return {{"warm_cycles", "cannot change at run time (the warm-up starts at activation)"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

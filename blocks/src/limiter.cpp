@@ -9,13 +9,7 @@ namespace edm::blocks {
 
 std::vector<rt::ParamError> LimiterParams::validate() const {
   std::vector<rt::ParamError> errs;
-  require_finite(errs, "min", min);
-  require_finite(errs, "max", max);
-  require_finite(errs, "rate", rate);
-  if (errs.empty()) {
-    require_ordered(errs, "min", min, "max", max);
-    rt::require_non_negative(errs, "rate", rate);
-  }
+  require_ordered(errs, "min", min, "max", max);
   return errs;
 }
 

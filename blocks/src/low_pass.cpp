@@ -6,13 +6,6 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> LowPassParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_positive(errs, "tau", rt::to_seconds(tau));
-  require_finite(errs, "initial", initial);
-  return errs;
-}
-
 void LowPass::visit_pins(rt::PinVisitor& v) {
   v.input("in", in_);
   v.output("out", out_);

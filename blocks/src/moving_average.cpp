@@ -4,20 +4,6 @@
 #include <cmath>
 
 namespace edm::blocks {
-namespace {
-
-// Index of `window` in MovingAverageParams::visit().
-constexpr std::size_t kWindowIndex = 0;
-
-}  // namespace
-
-std::vector<rt::ParamError> MovingAverageParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "window", static_cast<double>(window), 1.0,
-                    static_cast<double>(kMaxWindow));
-  return errs;
-}
-
 void MovingAverage::CompensatedSum::add(double x) noexcept {
   // Knuth's TwoSum: s + e == hi + x exactly (needs strict IEEE evaluation: no -ffast-math).
   const double s = hi + x;
@@ -34,7 +20,7 @@ void MovingAverage::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> MovingAverage::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = params_.validate();
+  auto errs = rt::validate_params(params_);
   if (!errs.empty()) {
     return errs;
   }
@@ -72,13 +58,6 @@ rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept 
   }
   out_.set(mean);
   return rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> MovingAverage::stage_param(std::size_t index, const rt::ParamValue& v) {
-  if (index == kWindowIndex) {
-    return {{"window", "cannot change at run time (it sizes the buffer); reload the config"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

@@ -3,30 +3,9 @@
 #include <cmath>
 
 namespace edm::blocks {
-namespace {
-
-constexpr std::size_t kNParamsIndex = 0;  // n_params in RecursiveLeastSquaresParams::visit()
-
-}  // namespace
 
 std::vector<rt::ParamError> RecursiveLeastSquaresParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "n_params", static_cast<double>(n_params), 1.0,
-                    static_cast<double>(RlsCore::kMaxParams));
-  for (const auto& [name, value] : {std::pair<const char*, double>{"lambda", lambda},
-                                    {"p0", p0},
-                                    {"trace_max", trace_max},
-                                    {"theta0_init", theta0_init},
-                                    {"theta1_init", theta1_init},
-                                    {"theta2_init", theta2_init},
-                                    {"theta3_init", theta3_init}}) {
-    rt::require_finite(errs, name, value);
-  }
-  if (!errs.empty()) {
-    return errs;
-  }
-  rt::require_range(errs, "lambda", lambda, 1e-3, 1.0);
-  rt::require_positive(errs, "p0", p0);
   rt::require_ordered(errs, "p0", p0, "trace_max", trace_max);
   return errs;
 }
@@ -90,14 +69,6 @@ rt::BlockStatus RecursiveLeastSquares::update(const rt::CycleContext& /*ctx*/) n
   trace_p_.set(rls_.trace());
   bounded_.set(r.bounded);
   return r.bounded ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> RecursiveLeastSquares::stage_param(std::size_t index,
-                                                               const rt::ParamValue& v) {
-  if (index == kNParamsIndex) {
-    return {{"n_params", "cannot change at run time (the estimate's dimension); reload"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

@@ -7,14 +7,6 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> SelectParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  if (ramp_time < rt::Duration::zero()) {
-    errs.push_back({"ramp_time", "must be >= 0"});
-  }
-  return errs;
-}
-
 void Select::visit_pins(rt::PinVisitor& v) {
   v.input("g", g_);
   v.input("in0", in0_);

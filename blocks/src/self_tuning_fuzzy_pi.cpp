@@ -17,39 +17,6 @@ double mu(double x, int peak) noexcept {
 
 std::vector<rt::ParamError> SelfTuningFuzzyPIParams::validate() const {
   std::vector<rt::ParamError> errs;
-  const std::pair<const char*, double> all[] = {{"ge", ge},
-                                                {"gce", gce},
-                                                {"alpha", alpha},
-                                                {"ol", ol},
-                                                {"ku", ku},
-                                                {"kv", kv},
-                                                {"rab_ref_default", rab_ref_default},
-                                                {"overload_error", overload_error},
-                                                {"dpf_gain", dpf_gain},
-                                                {"psi_min", psi_min},
-                                                {"u_min_us", u_min_us},
-                                                {"u_max_us", u_max_us},
-                                                {"u_initial_us", u_initial_us},
-                                                {"v_min_v", v_min_v},
-                                                {"v_max_v", v_max_v},
-                                                {"v_initial_v", v_initial_v}};
-  for (const auto& [name, value] : all) {
-    rt::require_finite(errs, name, value);
-  }
-  if (!errs.empty()) {
-    return errs;
-  }
-  rt::require_positive(errs, "ge", ge);
-  rt::require_positive(errs, "gce", gce);
-  rt::require_range(errs, "alpha", alpha, 1e-9, 1.0);
-  rt::require_positive(errs, "ol", ol);
-  rt::require_non_negative(errs, "ku", ku);
-  rt::require_non_negative(errs, "kv", kv);
-  rt::require_range(errs, "rab_ref_default", rab_ref_default, 1e-9, 1.0);
-  rt::require_range(errs, "overload_error", overload_error, -1.0, 0.0);
-  rt::require_non_negative(errs, "dpf_gain", dpf_gain);
-  rt::require_non_negative(errs, "psi_min", psi_min);
-  rt::require_range(errs, "settle_samples", static_cast<double>(settle_samples), 0.0, 1e9);
   rt::require_ordered(errs, "u_min_us", u_min_us, "u_max_us", u_max_us);
   rt::require_ordered(errs, "v_min_v", v_min_v, "v_max_v", v_max_v);
   if (errs.empty()) {

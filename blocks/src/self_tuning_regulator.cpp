@@ -4,64 +4,15 @@
 #include <cmath>
 
 namespace edm::blocks {
-namespace {
-
-constexpr std::size_t kDelayIndex = 0;  // delay_v in SelfTuningRegulatorParams::visit()
-
-}  // namespace
 
 std::vector<rt::ParamError> SelfTuningRegulatorParams::validate() const {
   std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "delay_v", static_cast<double>(delay_v), 0.0,
-                    static_cast<double>(kMaxDelay));
-  const std::pair<const char*, double> all[] = {{"beta00", beta00},
-                                                {"us_per_unit_v", us_per_unit_v},
-                                                {"u_v_min", u_v_min},
-                                                {"u_v_max", u_v_max},
-                                                {"u_v_initial", u_v_initial},
-                                                {"beta01_init", beta01_init},
-                                                {"beta0c_init", beta0c_init},
-                                                {"ti_us", ti_us},
-                                                {"to_min_us", to_min_us},
-                                                {"to_max_us", to_max_us},
-                                                {"to_initial_us", to_initial_us},
-                                                {"beta1c_init", beta1c_init},
-                                                {"lambda", lambda},
-                                                {"p0", p0},
-                                                {"trace_max", trace_max},
-                                                {"y_rv_good", y_rv_good},
-                                                {"y_rt_good", y_rt_good},
-                                                {"transient_arc_limit", transient_arc_limit},
-                                                {"stable_arc_limit", stable_arc_limit},
-                                                {"ref_rise", ref_rise},
-                                                {"ref_step", ref_step},
-                                                {"y_rv_min", y_rv_min},
-                                                {"y_rt_min", y_rt_min}};
-  for (const auto& [name, value] : all) {
-    rt::require_finite(errs, name, value);
-  }
-  if (!errs.empty()) {
-    return errs;
-  }
   if (beta00 == 0.0) {
     errs.push_back({"beta00", "must be != 0 (the law divides by it)"});
   }
-  rt::require_positive(errs, "us_per_unit_v", us_per_unit_v);
   rt::require_ordered(errs, "u_v_min", u_v_min, "u_v_max", u_v_max);
-  rt::require_positive(errs, "ti_us", ti_us);
-  rt::require_positive(errs, "to_min_us", to_min_us);
   rt::require_ordered(errs, "to_min_us", to_min_us, "to_max_us", to_max_us);
-  rt::require_range(errs, "lambda", lambda, 0.5, 1.0);
-  rt::require_positive(errs, "p0", p0);
   rt::require_ordered(errs, "p0", 2.0 * p0, "trace_max", trace_max);
-  rt::require_range(errs, "y_rv_good", y_rv_good, 0.0, 2.0);
-  rt::require_range(errs, "y_rt_good", y_rt_good, 0.0, 2.0);
-  rt::require_range(errs, "transient_arc_limit", transient_arc_limit, 0.0, 1.0);
-  rt::require_range(errs, "stable_arc_limit", stable_arc_limit, 0.0, 1.0);
-  rt::require_range(errs, "ref_rise", ref_rise, 1e-9, 1.0);
-  rt::require_non_negative(errs, "ref_step", ref_step);
-  rt::require_range(errs, "y_rv_min", y_rv_min, 0.0, 2.0);
-  rt::require_range(errs, "y_rt_min", y_rt_min, 0.0, 2.0);
   if (errs.empty()) {
     rt::require_range(errs, "u_v_initial", u_v_initial, u_v_min, u_v_max);
     rt::require_range(errs, "to_initial_us", to_initial_us, to_min_us, to_max_us);
@@ -190,14 +141,6 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
   saturated_.set(saturated);
   publish();
   return saturated ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-}
-
-std::vector<rt::ParamError> SelfTuningRegulator::stage_param(std::size_t index,
-                                                             const rt::ParamValue& v) {
-  if (index == kDelayIndex) {
-    return {{"delay_v", "cannot change at run time (regressor history); reload the config"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 }  // namespace edm::blocks

@@ -8,9 +8,6 @@
 namespace edm::blocks {
 namespace {
 
-// Index of `history_capacity` in ShortRetractParams::visit().
-constexpr std::size_t kHistoryCapacityIndex = 0;
-
 double distance(double ax, double ay, double az, double bx, double by, double bz) noexcept {
   const double dx = bx - ax;
   const double dy = by - ay;
@@ -19,21 +16,6 @@ double distance(double ax, double ay, double az, double bx, double by, double bz
 }
 
 }  // namespace
-
-std::vector<rt::ParamError> ShortRetractParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  rt::require_range(errs, "history_capacity", static_cast<double>(history_capacity), 2.0,
-                    static_cast<double>(kMaxHistory));
-  rt::require_range(errs, "min_spacing_mm", min_spacing_mm, 0.0, 1.0e3);
-  rt::require_range(errs, "short_cycles", static_cast<double>(short_cycles), 1.0, 1.0e9);
-  rt::require_range(errs, "retract_distance_mm", retract_distance_mm, 1.0e-9, 1.0e4);
-  rt::require_range(errs, "retract_speed_mm_s", retract_speed_mm_s, 1.0e-9, 1.0e4);
-  rt::require_range(errs, "resume_speed_mm_s", resume_speed_mm_s, 1.0e-9, 1.0e4);
-  rt::require_range(errs, "resume_ramp_ms", resume_ramp_ms, 0.0, 60000.0);
-  rt::require_range(errs, "max_tries", static_cast<double>(max_tries), 0.0, 1.0e6);
-  rt::require_range(errs, "progress_mm", progress_mm, 0.0, 1.0e4);
-  return errs;
-}
 
 void ShortRetract::visit_pins(rt::PinVisitor& v) {
   v.input("x_mm", x_mm_, "mm");
@@ -53,7 +35,7 @@ void ShortRetract::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup) {
-  auto errs = params_.validate();
+  auto errs = rt::validate_params(params_);
   require_task_period(errs, setup.period);
   if (!errs.empty()) {
     return errs;
@@ -82,14 +64,6 @@ void ShortRetract::activate() noexcept {
   tries_out_.set(0);
   alarm_out_.set(false);
   hold_out_.set(false);
-}
-
-std::vector<rt::ParamError> ShortRetract::stage_param(std::size_t index, const rt::ParamValue& v) {
-  if (index == kHistoryCapacityIndex) {
-    return {{"history_capacity",
-             "cannot change at run time (it sizes the path ring); reload the config"}};
-  }
-  return BlockWithParams::stage_param(index, v);
 }
 
 void ShortRetract::params_changed() noexcept { compute_ramp(); }

@@ -7,18 +7,6 @@
 
 namespace edm::blocks {
 
-std::vector<rt::ParamError> SineSourceParams::validate() const {
-  std::vector<rt::ParamError> errs;
-  require_finite(errs, "amplitude", amplitude);
-  require_finite(errs, "frequency_hz", frequency_hz);
-  require_finite(errs, "phase_rad", phase_rad);
-  require_finite(errs, "offset", offset);
-  if (std::isfinite(frequency_hz)) {
-    rt::require_positive(errs, "frequency_hz", frequency_hz);
-  }
-  return errs;
-}
-
 void SineSource::visit_pins(rt::PinVisitor& v) { v.output("out", out_); }
 
 std::vector<rt::ParamError> SineSource::configure(const rt::BlockSetup& setup) {

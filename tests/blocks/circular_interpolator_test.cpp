@@ -337,9 +337,9 @@ TEST(CircularInterpolatorTest, load_sets_the_position_and_cancels) {
 }
 
 TEST(CircularInterpolatorTest, validate_and_configure_refuse_bad_setups) {
-  EXPECT_TRUE(CircularInterpolatorParams{}.validate().empty());
-  EXPECT_FALSE(CircularInterpolatorParams{.end_tol_mm = -1.0}.validate().empty());
-  EXPECT_FALSE(CircularInterpolatorParams{.x0_mm = kNaN}.validate().empty());
+  EXPECT_TRUE(rt::validate_params(CircularInterpolatorParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(CircularInterpolatorParams{.end_tol_mm = -1.0}).empty());
+  EXPECT_FALSE(rt::validate_params(CircularInterpolatorParams{.x0_mm = kNaN}).empty());
   BlockHarness<CircularInterpolator> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());
 }

@@ -55,7 +55,7 @@ TEST(GainTest, zero_gain_still_faults_on_nan) {
 }
 
 TEST(GainTest, validate_refuses_non_finite_parameters) {
-  const auto errs = GainParams{.k = kNaN, .offset = kInf}.validate();
+  const auto errs = rt::validate_params(GainParams{.k = kNaN, .offset = kInf});
   ASSERT_EQ(errs.size(), 2u);
   EXPECT_EQ(errs[0].field, "k");
   EXPECT_EQ(errs[1].field, "offset");

@@ -200,12 +200,12 @@ TEST_F(GapControllerPTest, runtime_write_of_gain_applies_next_cycle) {
 }
 
 TEST(GapControllerPParamsTest, validate_refuses_bad_values) {
-  EXPECT_TRUE(GapControllerPParams{}.validate().empty());
-  EXPECT_TRUE(kParams.validate().empty());
+  EXPECT_TRUE(rt::validate_params(GapControllerPParams{}).empty());
+  EXPECT_TRUE(rt::validate_params(kParams).empty());
   auto with = [](auto edit) {
     GapControllerPParams p = kParams;
     edit(p);
-    return p.validate();
+    return rt::validate_params(p);
   };
   EXPECT_FALSE(with([](auto& p) { p.kg = 0.0; }).empty());
   EXPECT_FALSE(with([](auto& p) { p.kg = -0.1; }).empty());

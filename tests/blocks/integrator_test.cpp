@@ -129,9 +129,10 @@ TEST(IntegratorTest, runtime_write_of_k_and_limits) {
 }
 
 TEST(IntegratorTest, validate_refuses_bad_parameters) {
-  EXPECT_TRUE(IntegratorParams{}.validate().empty());
-  EXPECT_FALSE((IntegratorParams{.min = 1.0, .max = -1.0}.validate().empty()));
-  EXPECT_FALSE(IntegratorParams{.k = std::numeric_limits<double>::quiet_NaN()}.validate().empty());
+  EXPECT_TRUE(rt::validate_params(IntegratorParams{}).empty());
+  EXPECT_FALSE((rt::validate_params(IntegratorParams{.min = 1.0, .max = -1.0}).empty()));
+  EXPECT_FALSE(
+      rt::validate_params(IntegratorParams{.k = std::numeric_limits<double>::quiet_NaN()}).empty());
   BlockHarness<Integrator> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());
 }

@@ -161,25 +161,25 @@ TEST(JumpCycleTest, a_broken_servo_signal_stops_the_axis_but_not_a_running_jump)
 TEST(JumpCycleTest, bad_parameters_are_refused) {
   auto p = small();
   p.period = 9ms;  // = up + down: no time for the servo
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = small();
   p.up_time = 0ms;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = small();
   p.down_speed_mm_s = 0.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = small();
   p.up_speed_mm_s = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = small();
   p.settle_time = -1ms;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = small();
   p.settle_time = 91ms;  // up + down + settle = period: no time for the servo
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p.settle_time = 90ms;
-  EXPECT_TRUE(p.validate().empty());
-  EXPECT_TRUE(small().validate().empty());
+  EXPECT_TRUE(rt::validate_params(p).empty());
+  EXPECT_TRUE(rt::validate_params(small()).empty());
 }
 
 }  // namespace

@@ -128,17 +128,18 @@ TEST(LimiterTest, non_finite_input_holds_outputs_and_faults) {
 }
 
 TEST(LimiterTest, validate_refuses_inverted_range_negative_rate_and_nan) {
-  auto errs = LimiterParams{.min = 1.0, .max = 0.0, .rate = 0.0}.validate();
+  auto errs = rt::validate_params(LimiterParams{.min = 1.0, .max = 0.0, .rate = 0.0});
   ASSERT_EQ(errs.size(), 1u);
   EXPECT_EQ(errs[0].field, "max");
-  errs = LimiterParams{.min = 0.0, .max = 1.0, .rate = -1.0}.validate();
+  errs = rt::validate_params(LimiterParams{.min = 0.0, .max = 1.0, .rate = -1.0});
   ASSERT_EQ(errs.size(), 1u);
   EXPECT_EQ(errs[0].field, "rate");
-  errs = LimiterParams{.min = std::numeric_limits<double>::quiet_NaN(), .max = 1.0}.validate();
+  errs = rt::validate_params(
+      LimiterParams{.min = std::numeric_limits<double>::quiet_NaN(), .max = 1.0});
   ASSERT_FALSE(errs.empty());
   EXPECT_EQ(errs[0].field, "min");
-  EXPECT_TRUE((LimiterParams{.min = 2.0, .max = 2.0, .rate = 0.0}.validate().empty()));
-  EXPECT_TRUE(LimiterParams{}.validate().empty());
+  EXPECT_TRUE((rt::validate_params(LimiterParams{.min = 2.0, .max = 2.0, .rate = 0.0}).empty()));
+  EXPECT_TRUE(rt::validate_params(LimiterParams{}).empty());
 }
 
 TEST(LimiterTest, activate_restarts_from_the_input) {

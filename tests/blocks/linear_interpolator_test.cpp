@@ -345,8 +345,8 @@ TEST(LinearInterpolatorTest, safe_state_cancels_the_move) {
 }
 
 TEST(LinearInterpolatorTest, validate_and_configure_refuse_bad_setups) {
-  EXPECT_TRUE(LinearInterpolatorParams{}.validate().empty());
-  EXPECT_FALSE(LinearInterpolatorParams{.x0_mm = kNaN}.validate().empty());
+  EXPECT_TRUE(rt::validate_params(LinearInterpolatorParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(LinearInterpolatorParams{.x0_mm = kNaN}).empty());
   BlockHarness<LinearInterpolator> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());
 }

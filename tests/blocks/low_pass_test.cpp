@@ -118,10 +118,10 @@ TEST(LowPassTest, non_finite_input_holds_state_and_faults) {
 }
 
 TEST(LowPassTest, validate_and_configure_refuse_bad_setups) {
-  EXPECT_FALSE((LowPassParams{.tau = Duration{0}, .initial = 0.0}.validate().empty()));
+  EXPECT_FALSE((rt::validate_params(LowPassParams{.tau = Duration{0}, .initial = 0.0}).empty()));
   const LowPassParams nan_initial{.tau = 1ms, .initial = std::numeric_limits<double>::quiet_NaN()};
-  EXPECT_FALSE(nan_initial.validate().empty());
-  EXPECT_TRUE(LowPassParams{}.validate().empty());
+  EXPECT_FALSE(rt::validate_params(nan_initial).empty());
+  EXPECT_TRUE(rt::validate_params(LowPassParams{}).empty());
   EXPECT_EQ(LowPassParams{}.tau, 10ms);
 
   BlockHarness<LowPass> no_task(Duration{0});

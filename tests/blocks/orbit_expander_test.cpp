@@ -234,11 +234,11 @@ TEST(OrbitExpanderTest, start_latches_r0_and_rejects_bad_radii) {
 }
 
 TEST(OrbitExpanderTest, validate_refuses_bad_parameters) {
-  EXPECT_TRUE(OrbitExpanderParams{}.validate().empty());
-  EXPECT_FALSE(OrbitExpanderParams{.kr = -1.0}.validate().empty());
-  EXPECT_FALSE(OrbitExpanderParams{.kr = kNaN}.validate().empty());
-  EXPECT_FALSE(OrbitExpanderParams{.dr_max_mm = -0.1}.validate().empty());
-  EXPECT_FALSE(OrbitExpanderParams{.samples_per_rev = -1}.validate().empty());
+  EXPECT_TRUE(rt::validate_params(OrbitExpanderParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(OrbitExpanderParams{.kr = -1.0}).empty());
+  EXPECT_FALSE(rt::validate_params(OrbitExpanderParams{.kr = kNaN}).empty());
+  EXPECT_FALSE(rt::validate_params(OrbitExpanderParams{.dr_max_mm = -0.1}).empty());
+  EXPECT_FALSE(rt::validate_params(OrbitExpanderParams{.samples_per_rev = -1}).empty());
 }
 
 }  // namespace

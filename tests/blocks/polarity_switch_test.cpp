@@ -199,11 +199,11 @@ TEST_F(PolaritySwitchTest, random_requests_never_switch_near_a_running_generator
 }
 
 TEST_F(PolaritySwitchTest, validate_and_runtime_write_of_settle) {
-  EXPECT_TRUE(PolaritySwitchParams{}.validate().empty());
+  EXPECT_TRUE(rt::validate_params(PolaritySwitchParams{}).empty());
   EXPECT_EQ(PolaritySwitchParams{}.settle, 20ms);
   EXPECT_FALSE(PolaritySwitchParams{}.initial_positive);
-  EXPECT_FALSE(PolaritySwitchParams{.settle = Duration{0}}.validate().empty());
-  EXPECT_FALSE(PolaritySwitchParams{.settle = -1ms}.validate().empty());
+  EXPECT_FALSE(rt::validate_params(PolaritySwitchParams{.settle = Duration{0}}).empty());
+  EXPECT_FALSE(rt::validate_params(PolaritySwitchParams{.settle = -1ms}).empty());
 
   start({.settle = 20ms});
   run(20, false, false, {.positive = false, .gen_on = false, .switching = true});

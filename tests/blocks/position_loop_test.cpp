@@ -190,14 +190,14 @@ TEST(PositionLoopTest, non_finite_input_stops_the_axis) {
 }
 
 TEST(PositionLoopTest, validate_refuses_bad_parameters) {
-  EXPECT_TRUE(PositionLoopParams{}.validate().empty());
-  EXPECT_FALSE(PositionLoopParams{.kff = 1.6}.validate().empty());
-  EXPECT_FALSE(PositionLoopParams{.kv = -1.0}.validate().empty());
-  EXPECT_FALSE(PositionLoopParams{.v_max_mm_s = 0.0}.validate().empty());
-  EXPECT_FALSE(PositionLoopParams{.f_err_max_mm = std::numeric_limits<double>::quiet_NaN()}
-                   .validate()
+  EXPECT_TRUE(rt::validate_params(PositionLoopParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(PositionLoopParams{.kff = 1.6}).empty());
+  EXPECT_FALSE(rt::validate_params(PositionLoopParams{.kv = -1.0}).empty());
+  EXPECT_FALSE(rt::validate_params(PositionLoopParams{.v_max_mm_s = 0.0}).empty());
+  EXPECT_FALSE(rt::validate_params(
+                   PositionLoopParams{.f_err_max_mm = std::numeric_limits<double>::quiet_NaN()})
                    .empty());
-  EXPECT_FALSE(PositionLoopParams{.in_pos_cycles = 0}.validate().empty());
+  EXPECT_FALSE(rt::validate_params(PositionLoopParams{.in_pos_cycles = 0}).empty());
   BlockHarness<PositionLoop> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());
 }

@@ -320,12 +320,12 @@ TEST(ShortRetractTest, non_finite_position_is_a_fault_and_not_recorded) {
 }
 
 TEST(ShortRetractTest, validate_and_load_time_only_capacity) {
-  EXPECT_TRUE(ShortRetractParams{}.validate().empty());
-  EXPECT_FALSE(ShortRetractParams{.history_capacity = 1}.validate().empty());
-  EXPECT_FALSE(ShortRetractParams{.short_cycles = 0}.validate().empty());
-  EXPECT_FALSE(ShortRetractParams{.retract_speed_mm_s = 0.0}.validate().empty());
-  EXPECT_FALSE(ShortRetractParams{.resume_ramp_ms = std::numeric_limits<double>::quiet_NaN()}
-                   .validate()
+  EXPECT_TRUE(rt::validate_params(ShortRetractParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(ShortRetractParams{.history_capacity = 1}).empty());
+  EXPECT_FALSE(rt::validate_params(ShortRetractParams{.short_cycles = 0}).empty());
+  EXPECT_FALSE(rt::validate_params(ShortRetractParams{.retract_speed_mm_s = 0.0}).empty());
+  EXPECT_FALSE(rt::validate_params(
+                   ShortRetractParams{.resume_ramp_ms = std::numeric_limits<double>::quiet_NaN()})
                    .empty());
   Rig r(test_params());
   EXPECT_FALSE(r.h.write_param("history_capacity", rt::ParamValue::of_int(16)).empty());

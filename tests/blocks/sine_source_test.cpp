@@ -83,15 +83,16 @@ TEST(SineSourceTest, runtime_write_of_frequency_applies_from_the_next_cycle) {
 }
 
 TEST(SineSourceTest, validate_refuses_bad_parameters) {
-  EXPECT_TRUE(SineSourceParams{}.validate().empty());
-  auto errs = SineSourceParams{.frequency_hz = 0.0}.validate();
+  EXPECT_TRUE(rt::validate_params(SineSourceParams{}).empty());
+  auto errs = rt::validate_params(SineSourceParams{.frequency_hz = 0.0});
   ASSERT_EQ(errs.size(), 1u);
   EXPECT_EQ(errs[0].field, "frequency_hz");
-  errs = SineSourceParams{.amplitude = std::numeric_limits<double>::infinity()}.validate();
+  errs =
+      rt::validate_params(SineSourceParams{.amplitude = std::numeric_limits<double>::infinity()});
   ASSERT_EQ(errs.size(), 1u);
   EXPECT_EQ(errs[0].field, "amplitude");
-  EXPECT_FALSE(SineSourceParams{.frequency_hz = std::numeric_limits<double>::quiet_NaN()}
-                   .validate()
+  EXPECT_FALSE(rt::validate_params(
+                   SineSourceParams{.frequency_hz = std::numeric_limits<double>::quiet_NaN()})
                    .empty());
   BlockHarness<SineSource> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());

@@ -188,6 +188,29 @@ TEST(WearCompensatorTest, wear_ratio_is_clamped_and_non_finite_is_a_fault) {
   EXPECT_EQ(h.out("vd_mm_s"), 1.0);
 }
 
+// An input <= 0 (unwired reads 0) is "no estimate": wear_ratio_default is θ then. With the
+// default 0 that is no compensation, as for an input of 0.
+TEST(WearCompensatorTest, wear_ratio_default_applies_while_the_input_is_not_positive) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kOk);
+  EXPECT_EQ(h.out("vd_mm_s"), 0.0) << "unwired input, default 0: no compensation";
+  ASSERT_TRUE(h.write_param("wear_ratio_default", rt::ParamValue::of_real(0.25)).empty());
+  EXPECT_EQ(step(h, -2.0), BlockStatus::kOk);
+  // Vd = θ·(A_hole/A_e)·|vz| for a steady downward feed.
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.25 * 2.0 * 2.0, 1e-12) << "unwired input: the parameter's θ";
+  h.source<double>("wear_ratio").set(0.5);
+  EXPECT_EQ(step(h, -3.0), BlockStatus::kOk);
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.5 * 2.0 * 3.0, 1e-12) << "a positive input wins";
+  h.source<double>("wear_ratio").set(-0.5);
+  EXPECT_EQ(step(h, -4.0), BlockStatus::kSaturated) << "a negative input is out of range";
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.25 * 2.0 * 4.0, 1e-12);
+  EXPECT_FALSE(h.write_param("wear_ratio_default", rt::ParamValue::of_real(-0.1)).empty());
+  const auto errs = h.write_param("wear_ratio_default", rt::ParamValue::of_real(6.0));
+  ASSERT_EQ(errs.size(), 1u) << describe(errs);
+  EXPECT_EQ(errs[0].field, "wear_ratio_max") << "must be >= wear_ratio_default";
+}
+
 TEST(WearCompensatorTest, runtime_write_of_the_areas) {
   BlockHarness<WearCompensator> h(1ms);
   ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
@@ -200,11 +223,19 @@ TEST(WearCompensatorTest, runtime_write_of_the_areas) {
 }
 
 TEST(WearCompensatorTest, validate_refuses_bad_parameters) {
-  EXPECT_TRUE(WearCompensatorParams{}.validate().empty());
-  EXPECT_FALSE(WearCompensatorParams{.hole_area_mm2 = -1.0}.validate().empty());
-  EXPECT_FALSE(WearCompensatorParams{.electrode_area_mm2 = std::numeric_limits<double>::infinity()}
-                   .validate()
-                   .empty());
+  EXPECT_TRUE(rt::validate_params(WearCompensatorParams{}).empty());
+  EXPECT_FALSE(rt::validate_params(WearCompensatorParams{.hole_area_mm2 = -1.0}).empty());
+  EXPECT_FALSE(
+      rt::validate_params(
+          WearCompensatorParams{.electrode_area_mm2 = std::numeric_limits<double>::infinity()})
+          .empty());
+  EXPECT_FALSE(rt::validate_params(WearCompensatorParams{.wear_ratio_default = -0.1}).empty());
+  EXPECT_FALSE(
+      rt::validate_params(WearCompensatorParams{.wear_ratio_max = 1.0, .wear_ratio_default = 1.5})
+          .empty());
+  EXPECT_TRUE(
+      rt::validate_params(WearCompensatorParams{.wear_ratio_max = 1.0, .wear_ratio_default = 1.0})
+          .empty());
   BlockHarness<WearCompensator> no_task(rt::Duration{0});
   EXPECT_FALSE(no_task.start().empty());
 }

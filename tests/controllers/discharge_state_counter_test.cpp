@@ -235,8 +235,8 @@ TEST(DischargeStateCounter, huge_cycles_cost_two_windows_and_keep_the_sum) {
 }
 
 TEST(DischargeStateCounter, validate_refuses_a_zero_interval) {
-  EXPECT_FALSE(DischargeStateCounterParams{.interval = 0}.validate().empty());
-  EXPECT_TRUE(DischargeStateCounterParams{}.validate().empty());
+  EXPECT_FALSE(rt::validate_params(DischargeStateCounterParams{.interval = 0}).empty());
+  EXPECT_TRUE(rt::validate_params(DischargeStateCounterParams{}).empty());
 }
 
 }  // namespace

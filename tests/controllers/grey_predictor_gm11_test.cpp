@@ -186,13 +186,14 @@ TEST(GreyPredictorGM11, out_is_clamped_to_its_range) {
   }
   EXPECT_TRUE(h.out<bool>("valid"));
   EXPECT_EQ(h.out(), 1.0);
-  EXPECT_FALSE((GreyPredictorGM11Params{.out_min = 1.0, .out_max = 0.0}.validate().empty()));
+  EXPECT_FALSE(
+      (rt::validate_params(GreyPredictorGM11Params{.out_min = 1.0, .out_max = 0.0}).empty()));
 }
 
 TEST(GreyPredictorGM11, window_is_load_time_only_and_validated) {
-  EXPECT_FALSE(GreyPredictorGM11Params{.window = 3}.validate().empty()) << "n >= 4";
-  EXPECT_FALSE(GreyPredictorGM11Params{.horizon = -1}.validate().empty());
-  EXPECT_TRUE(GreyPredictorGM11Params{}.validate().empty());
+  EXPECT_FALSE(rt::validate_params(GreyPredictorGM11Params{.window = 3}).empty()) << "n >= 4";
+  EXPECT_FALSE(rt::validate_params(GreyPredictorGM11Params{.horizon = -1}).empty());
+  EXPECT_TRUE(rt::validate_params(GreyPredictorGM11Params{}).empty());
   BlockHarness<GreyPredictorGM11> h;
   ASSERT_TRUE(h.start(GreyPredictorGM11Params{}).empty());
   EXPECT_FALSE(h.write_param("window", rt::ParamValue::of_int(8)).empty());

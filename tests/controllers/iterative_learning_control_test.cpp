@@ -288,7 +288,7 @@ TEST(IterativeLearningControl, e_max_clamps_the_error_learnt_from) {
   for (const double bad : {-1.0, std::nan("")}) {
     p.e_max = bad;
     bool named = false;
-    for (const auto& e : p.validate()) named = named || e.field == "e_max";
+    for (const auto& e : rt::validate_params(p)) named = named || e.field == "e_max";
     EXPECT_TRUE(named) << bad;
   }
 }
@@ -339,7 +339,7 @@ TEST(IterativeLearningControl, warm_start_needs_track_wired_and_is_load_time_onl
   EXPECT_EQ(h.step(), BlockStatus::kOk);
   EXPECT_FALSE(h.block().stage_param(11, rt::ParamValue::of_int(0)).empty());
   p.warm_cycles = -1;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
 }
 
 TEST(IterativeLearningControl, cycle_handling_and_validation) {
@@ -366,13 +366,13 @@ TEST(IterativeLearningControl, cycle_handling_and_validation) {
   EXPECT_EQ(h.out<std::int64_t>("cycles"), 1);
   EXPECT_EQ(h.out<std::int64_t>("sample"), 0);
   p.p0 = 0.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = {};
   p.lambda3 = 1.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = {};
   p.q_pole = 1.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   EXPECT_FALSE(h.block().stage_param(0, rt::ParamValue::of_int(8)).empty());
 }
 

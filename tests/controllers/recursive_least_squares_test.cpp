@@ -176,13 +176,13 @@ TEST(RecursiveLeastSquares, the_trace_bound_keeps_the_covariance_bounded) {
 TEST(RecursiveLeastSquares, rejects_bad_parameters_and_non_finite_inputs) {
   RecursiveLeastSquaresParams p;
   p.lambda = 0.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = {};
   p.n_params = 5;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   p = {};
   p.trace_max = p.p0 / 2.0;
-  EXPECT_FALSE(p.validate().empty());
+  EXPECT_FALSE(rt::validate_params(p).empty());
   BlockHarness<RecursiveLeastSquares> h;
   ASSERT_TRUE(h.start(RecursiveLeastSquaresParams{}).empty());
   h.source<double>("y").set(std::nan(""));

@@ -195,10 +195,10 @@ TEST(SelfTuningRegulator, clamps_and_faults) {
   EXPECT_EQ(str.step(std::nan("")), BlockStatus::kFault);
   SelfTuningRegulatorParams bad;
   bad.beta00 = 0.0;
-  EXPECT_FALSE(bad.validate().empty());
+  EXPECT_FALSE(rt::validate_params(bad).empty());
   bad = {};
   bad.u_v_initial = 5.0;
-  EXPECT_FALSE(bad.validate().empty());
+  EXPECT_FALSE(rt::validate_params(bad).empty());
 }
 
 }  // namespace

@@ -34,11 +34,15 @@ struct ButterworthLowPassParams {
   bool prime{true};      // the first sample after activate() sets the steady state
 
   void visit(rt::ParamVisitor& v) {
-    v.param("cutoff", cutoff, "1", "cut-off as a fraction of the Nyquist frequency, 0 < Wn < 1");
-    v.param("initial", initial, "", "steady-state value after activation, signal unit");
-    v.param("prime", prime, "", "the first sample after activation sets the steady state");
+    v.param("cutoff", cutoff,
+            {.unit = "1",
+             .description = "cut-off Wn as a fraction of the Nyquist frequency",
+             .range = rt::open(0.0, 1.0)});
+    v.param("initial", initial,
+            {.unit = "", .description = "steady-state value after activation, signal unit"});
+    v.param("prime", prime,
+            {.unit = "", .description = "the first sample after activation sets the steady state"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class ButterworthLowPass final : public rt::BlockWithParams<ButterworthLowPassParams> {

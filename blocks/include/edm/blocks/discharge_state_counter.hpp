@@ -48,12 +48,15 @@ struct DischargeStateCounterParams {
   bool arcs_as_short{true};   // transient and stable arcs count as short (else as normal)
 
   void visit(rt::ParamVisitor& v) {
-    v.param("interval", interval, "pulses",
-            "analysis interval m: latch the counts every m pulses (>= 1; >= 32: all-new pulses)");
-    v.param("arcs_as_short", arcs_as_short, "",
-            "count transient and stable arcs as short pulses (false: as normal)");
+    v.param("interval", interval,
+            {.unit = "pulses",
+             .description = "analysis interval m: latch the counts every m pulses (>= 32: all-new "
+                            "pulses)",
+             .range = rt::closed(1.0, static_cast<double>(kMaxInterval))});
+    v.param("arcs_as_short", arcs_as_short,
+            {.unit = "",
+             .description = "count transient and stable arcs as short pulses (false: as normal)"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class DischargeStateCounter final : public rt::BlockWithParams<DischargeStateCounterParams> {

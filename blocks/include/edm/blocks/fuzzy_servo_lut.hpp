@@ -72,17 +72,27 @@ struct FuzzyServoLUTParams {
   double v_max_mm_s{5.0};     // [mm/s] > 0: |v| at a normalised output of 1 (paper: ±5)
 
   void visit(rt::ParamVisitor& v) {
-    v.param("open_terms", open_terms, "pulses",
-            "terms of the open count, e.g. 'Z=tri(-14,0,14) ...'");
-    v.param("short_terms", short_terms, "pulses", "terms of the short count");
-    v.param("normal_terms", normal_terms, "pulses",
-            "terms of the normal count 32 - open - short (optional)");
-    v.param("velocity_terms", velocity_terms, "1", "output terms in units of v_max_mm_s");
-    v.param("rules", rules, "", "'if open is L and short is Z then v is PB; ...'");
-    v.param("samples", samples, "", "points of the sampled output universe (3..100000)");
-    v.param("v_max_mm_s", v_max_mm_s, "mm/s", "speed at a normalised output of +-1 (> 0)");
+    v.param(
+        "open_terms", open_terms,
+        {.unit = "pulses", .description = "terms of the open count, e.g. 'Z=tri(-14,0,14) ...'"});
+    v.param("short_terms", short_terms,
+            {.unit = "pulses", .description = "terms of the short count"});
+    v.param("normal_terms", normal_terms,
+            {.unit = "pulses",
+             .description = "terms of the normal count 32 - open - short (optional)"});
+    v.param("velocity_terms", velocity_terms,
+            {.unit = "1", .description = "output terms in units of v_max_mm_s"});
+    v.param("rules", rules,
+            {.unit = "", .description = "'if open is L and short is Z then v is PB; ...'"});
+    v.param("samples", samples,
+            {.unit = "",
+             .description = "points of the sampled output universe",
+             .range = rt::closed(3, 100000)});
+    v.param("v_max_mm_s", v_max_mm_s,
+            {.unit = "mm/s",
+             .description = "speed at a normalised output of +-1",
+             .range = rt::kPositive});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class FuzzyServoLUT final : public rt::BlockWithParams<FuzzyServoLUTParams> {

@@ -19,10 +19,10 @@ struct GainParams {
   double offset{0.0};  // [out unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("k", k, "", "gain");
-    v.param("offset", offset, "", "added after the gain, in the output's unit");
+    v.param("k", k, {.unit = "", .description = "gain"});
+    v.param("offset", offset,
+            {.unit = "", .description = "added after the gain, in the output's unit"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class Gain final : public rt::BlockWithParams<GainParams> {

@@ -51,13 +51,24 @@ struct GreyPredictorGM11Params {
   double out_max{1e12};
 
   void visit(rt::ParamVisitor& v) {
-    v.param("window", window, "samples", "samples in the GM(1,1) fit (4..1024), load time only");
-    v.param("horizon", horizon, "samples", "prediction horizon p (0..100000)");
-    v.param("paper_exp", paper_exp, "",
-            "use exp(-c) of the paper's eq. 1 (not exact on exponentials) instead of rho");
-    v.param("out_min", out_min, "", "lower clamp of out (Rab: 0)");
-    v.param("out_max", out_max, "", "upper clamp of out (Rab: 1)");
+    v.param("window", window,
+            {.unit = "samples",
+             .description = "samples in the GM(1,1) fit",
+             .range = rt::closed(4.0, static_cast<double>(kMaxWindow)),
+             .load_time_only = true});
+    v.param("horizon", horizon,
+            {.unit = "samples",
+             .description = "prediction horizon p",
+             .range = rt::closed(0.0, static_cast<double>(kMaxHorizon))});
+    v.param("paper_exp", paper_exp,
+            {.unit = "",
+             .description =
+                 "use exp(-c) of the paper's eq. 1 (not exact on exponentials) instead of rho"});
+    v.param("out_min", out_min, {.unit = "", .description = "lower clamp of out (Rab: 0)"});
+    v.param("out_max", out_max,
+            {.unit = "", .description = "upper clamp of out (Rab: 1), >= out_min"});
   }
+  /// Cross-field rule: out_min <= out_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -79,8 +90,6 @@ class GreyPredictorGM11 final : public rt::BlockWithParams<GreyPredictorGM11Para
   void activate() noexcept override;
   /// RT-safe. kOk, or kFault (nothing stored, outputs held) on a non-finite input.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses `window` (it sized the ring at configure()).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
  private:
   rt::Input<double> in_;

@@ -29,11 +29,14 @@ struct IntegratorParams {
   double initial{0.0};  // [out unit], used clamped to [min, max]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("k", k, "1/s", "integration gain: out changes by k·in per second");
-    v.param("min", min, "", "lower limit of out");
-    v.param("max", max, "", "upper limit of out (>= min)");
-    v.param("initial", initial, "", "out at configure and while reset is true (clamped)");
+    v.param("k", k,
+            {.unit = "1/s", .description = "integration gain: out changes by k·in per second"});
+    v.param("min", min, {.unit = "", .description = "lower limit of out"});
+    v.param("max", max, {.unit = "", .description = "upper limit of out, >= min"});
+    v.param("initial", initial,
+            {.unit = "", .description = "out at configure and while reset is true (clamped)"});
   }
+  /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 

@@ -47,8 +47,9 @@ namespace edm::blocks {
 
 struct IterativeLearningControlParams {
   static constexpr std::int64_t kMaxSamples = 65536;
+  static constexpr double kMaxPole = 1.0 - 1e-9;  // |pole| bound: strictly inside the unit circle
 
-  std::int64_t n_samples{100};  // N, samples per cycle (2..65536), load time only
+  std::int64_t n_samples{100};  // N, samples per cycle, load time only
   double p0{0.5};               // first impulse-response sample of the closed axis loop
   double k_delta{1.0};          // kδ: output per unit of gap (y = kδ·δ + b), != 0
   double q_pole{0.0};           // a of Q's first-order low-pass, [0, 1); q0 = 1 − a
@@ -63,22 +64,52 @@ struct IterativeLearningControlParams {
   double e_max{0.0};            // > 0: each sample's error is clamped to ±e_max (0: off)
 
   void visit(rt::ParamVisitor& v) {
-    v.param("n_samples", n_samples, "samples", "samples per cycle N (2..65536), load time only");
-    v.param("p0", p0, "1", "first impulse-response sample of the axis loop (!= 0)");
-    v.param("k_delta", k_delta, "", "output per unit of gap, y = k_delta*gap + b (!= 0)");
-    v.param("q_pole", q_pole, "1", "pole a of the Q low-pass, 0 <= a < 1 (0: no filter)");
-    v.param("lambda1", lambda1, "1", "forward-motion pole 1, |lambda| < 1");
-    v.param("lambda2", lambda2, "1", "forward-motion pole 2, |lambda| < 1");
-    v.param("lambda3", lambda3, "1", "within-cycle pole, |lambda| < 1");
-    v.param("u_initial", u_initial, "", "output before learning, position unit");
-    v.param("u_min", u_min, "", "lower clamp of u");
-    v.param("u_max", u_max, "", "upper clamp of u");
-    v.param("auto_cycle", auto_cycle, "", "a cycle ends every n_samples without cycle_start");
-    v.param("warm_cycles", warm_cycles, "cycles",
-            "complete cycles recorded from `track` before this block takes over (0: none)");
-    v.param("e_max", e_max, "",
-            "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b holds");
+    v.param("n_samples", n_samples,
+            {.unit = "samples",
+             .description = "samples per cycle N",
+             .range = rt::closed(2.0, static_cast<double>(kMaxSamples)),
+             .load_time_only = true});
+    v.param("p0", p0,
+            {.unit = "1", .description = "first impulse-response sample of the axis loop, != 0"});
+    v.param("k_delta", k_delta,
+            {.unit = "", .description = "output per unit of gap, y = k_delta*gap + b, != 0"});
+    v.param("q_pole", q_pole,
+            {.unit = "1",
+             .description = "pole a of the Q low-pass (0: no filter)",
+             .range = rt::closed(0.0, kMaxPole)});
+    v.param("lambda1", lambda1,
+            {.unit = "1",
+             .description = "forward-motion pole 1",
+             .range = rt::closed(-kMaxPole, kMaxPole)});
+    v.param("lambda2", lambda2,
+            {.unit = "1",
+             .description = "forward-motion pole 2",
+             .range = rt::closed(-kMaxPole, kMaxPole)});
+    v.param("lambda3", lambda3,
+            {.unit = "1",
+             .description = "within-cycle pole",
+             .range = rt::closed(-kMaxPole, kMaxPole)});
+    v.param(
+        "u_initial", u_initial,
+        {.unit = "", .description = "output before learning, position unit, in [u_min, u_max]"});
+    v.param("u_min", u_min, {.unit = "", .description = "lower clamp of u"});
+    v.param("u_max", u_max, {.unit = "", .description = "upper clamp of u, >= u_min"});
+    v.param("auto_cycle", auto_cycle,
+            {.unit = "", .description = "a cycle ends every n_samples without cycle_start"});
+    v.param("warm_cycles", warm_cycles,
+            {.unit = "cycles",
+             .description = "complete cycles recorded from `track` before this block takes over "
+                            "(0: none; the warm-up starts at activation)",
+             .range = rt::closed(0.0, 1e6),
+             .load_time_only = true});
+    v.param("e_max", e_max,
+            {.unit = "",
+             .description =
+                 "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b "
+                 "holds (0: off)",
+             .range = rt::kNonNegative});
   }
+  /// Rules a range cannot say: p0 != 0, k_delta != 0, u_min <= u_initial <= u_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -97,8 +128,6 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   void activate() noexcept override;
   /// RT-safe.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses n_samples at run time.
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
  private:
   void learn() noexcept;

@@ -46,14 +46,24 @@ struct JumpCycleParams {
   rt::Duration settle_time{};  // >= 0; `settling` stays true this long after the jump
 
   void visit(rt::ParamVisitor& v) {
-    v.param("period", period, "s", "time from one jump's start to the next (> up + down time)");
-    v.param("up_time", up_time, "s", "time the electrode rises (> 0)");
-    v.param("down_time", down_time, "s", "time it comes back down (> 0)");
-    v.param("up_speed_mm_s", up_speed_mm_s, "mm/s", "rising speed (> 0)");
-    v.param("down_speed_mm_s", down_speed_mm_s, "mm/s", "lowering speed (> 0)");
-    v.param("settle_time", settle_time, "s",
-            "`settling` stays true this long after the jump (the approach; >= 0)");
+    v.param("period", period,
+            {.unit = "s",
+             .description = "time from one jump's start to the next, > up + down + settle time",
+             .range = rt::kPositive});
+    v.param("up_time", up_time,
+            {.unit = "s", .description = "time the electrode rises", .range = rt::kPositive});
+    v.param("down_time", down_time,
+            {.unit = "s", .description = "time it comes back down", .range = rt::kPositive});
+    v.param("up_speed_mm_s", up_speed_mm_s,
+            {.unit = "mm/s", .description = "rising speed", .range = rt::kPositive});
+    v.param("down_speed_mm_s", down_speed_mm_s,
+            {.unit = "mm/s", .description = "lowering speed", .range = rt::kPositive});
+    v.param("settle_time", settle_time,
+            {.unit = "s",
+             .description = "`settling` stays true this long after the jump (the approach)",
+             .range = rt::kNonNegative});
   }
+  /// Cross-field rule: period > up_time + down_time + settle_time.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 

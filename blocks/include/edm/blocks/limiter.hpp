@@ -29,10 +29,14 @@ struct LimiterParams {
   double rate{0.0};    // [signal unit / s], ≥ 0; 0 = no slew-rate limit
 
   void visit(rt::ParamVisitor& v) {
-    v.param("min", min, "", "lower limit, in the signal's unit");
-    v.param("max", max, "", "upper limit (>= min), in the signal's unit");
-    v.param("rate", rate, "1/s", "slew-rate limit in signal units per second (0 = unlimited)");
+    v.param("min", min, {.unit = "", .description = "lower limit, in the signal's unit"});
+    v.param("max", max, {.unit = "", .description = "upper limit, >= min, in the signal's unit"});
+    v.param("rate", rate,
+            {.unit = "1/s",
+             .description = "slew-rate limit in signal units per second (0 = unlimited)",
+             .range = rt::kNonNegative});
   }
+  /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 

@@ -24,10 +24,10 @@ struct LowPassParams {
   double initial{0.0};                              // y after activate() [signal unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("tau", tau, "s", "time constant (> 0)");
-    v.param("initial", initial, "", "output after activation, in the signal's unit");
+    v.param("tau", tau, {.unit = "s", .description = "time constant", .range = rt::kPositive});
+    v.param("initial", initial,
+            {.unit = "", .description = "output after activation, in the signal's unit"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class LowPass final : public rt::BlockWithParams<LowPassParams> {

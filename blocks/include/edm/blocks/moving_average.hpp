@@ -11,8 +11,8 @@
 // write index wraps, so rounding can never build up over more than one window. Cost: three
 // TwoSum steps per cycle, no O(window) recomputation in any cycle (no jitter spike).
 //
-// `window` sizes the buffer, allocated once in configure(); it cannot change at run time
-// (stage_param refuses it: reload the config instead).
+// `window` sizes the buffer, allocated once in configure(); it is load time only (a runtime
+// write is refused: reload the config instead).
 // A non-finite input is not stored: out and full are held and update() returns kFault; so is a
 // window whose sum overflows.
 // RT-safe: update(). Not thread-safe: the owning task calls every member except the pins (see
@@ -32,9 +32,12 @@ struct MovingAverageParams {
   std::int64_t window{16};  // samples, 1..kMaxWindow
 
   void visit(rt::ParamVisitor& v) {
-    v.param("window", window, "samples", "number of samples averaged (1..65536), load time only");
+    v.param("window", window,
+            {.unit = "samples",
+             .description = "number of samples averaged",
+             .range = rt::closed(1.0, static_cast<double>(kMaxWindow)),
+             .load_time_only = true});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class MovingAverage final : public rt::BlockWithParams<MovingAverageParams> {
@@ -46,8 +49,6 @@ class MovingAverage final : public rt::BlockWithParams<MovingAverageParams> {
   void activate() noexcept override;
   /// RT-safe. kOk, or kFault (out held) on a non-finite input or an overflowing sum.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses `window` (it sized the buffer at configure()).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
  private:
   // hi + lo represents a sum more precisely than one double.

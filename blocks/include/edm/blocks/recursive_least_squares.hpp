@@ -31,15 +31,22 @@ struct RecursiveLeastSquaresParams {
   double theta3_init{0.0};
 
   void visit(rt::ParamVisitor& v) {
-    v.param("n_params", n_params, "1", "number of regressors phi0.. used (1..4)");
-    v.param("lambda", lambda, "1", "forgetting factor in [0.001, 1]");
-    v.param("p0", p0, "1", "initial covariance P = p0*I (> 0)");
-    v.param("trace_max", trace_max, "1", "upper bound of trace(P) (>= p0)");
-    v.param("theta0_init", theta0_init, "", "initial estimate of theta0");
-    v.param("theta1_init", theta1_init, "", "initial estimate of theta1");
-    v.param("theta2_init", theta2_init, "", "initial estimate of theta2");
-    v.param("theta3_init", theta3_init, "", "initial estimate of theta3");
+    v.param("n_params", n_params,
+            {.unit = "1",
+             .description = "number of regressors phi0.. used (the estimate's dimension)",
+             .range = rt::closed(1.0, static_cast<double>(RlsCore::kMaxParams)),
+             .load_time_only = true});
+    v.param("lambda", lambda,
+            {.unit = "1", .description = "forgetting factor", .range = rt::closed(1e-3, 1.0)});
+    v.param("p0", p0,
+            {.unit = "1", .description = "initial covariance P = p0*I", .range = rt::kPositive});
+    v.param("trace_max", trace_max, {.unit = "1", .description = "upper bound of trace(P), >= p0"});
+    v.param("theta0_init", theta0_init, {.unit = "", .description = "initial estimate of theta0"});
+    v.param("theta1_init", theta1_init, {.unit = "", .description = "initial estimate of theta1"});
+    v.param("theta2_init", theta2_init, {.unit = "", .description = "initial estimate of theta2"});
+    v.param("theta3_init", theta3_init, {.unit = "", .description = "initial estimate of theta3"});
   }
+  /// Cross-field rule: trace_max >= p0.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -50,8 +57,6 @@ class RecursiveLeastSquares final : public rt::BlockWithParams<RecursiveLeastSqu
   void activate() noexcept override;
   /// RT-safe. One RLS step with the current y and φ.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses n_params (the estimate's dimension) at run time.
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
   [[nodiscard]] const RlsCore& core() const noexcept { return rls_; }
 

@@ -34,12 +34,16 @@ struct SelectParams {
   rt::Duration ramp_time{rt::Duration::zero()};  // bump decay time after a switch, ≥ 0
 
   void visit(rt::ParamVisitor& v) {
-    v.param("select", select, "",
-            "true selects in1 (OR-ed with the input g); writable at run time");
-    v.param("ramp_time", ramp_time, "s",
-            "after a switch, the output's step decays linearly to 0 over this time (0 = at once)");
+    v.param("select", select,
+            {.unit = "",
+             .description = "true selects in1 (OR-ed with the input g); writable at run time"});
+    v.param(
+        "ramp_time", ramp_time,
+        {.unit = "s",
+         .description =
+             "after a switch, the output's step decays linearly to 0 over this time (0 = at once)",
+         .range = rt::kNonNegative});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class Select final : public rt::BlockWithParams<SelectParams> {

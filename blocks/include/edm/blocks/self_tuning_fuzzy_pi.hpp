@@ -71,25 +71,57 @@ struct SelfTuningFuzzyPIParams {
   std::int64_t settle_samples{0};  // hold u, v for this many samples after activate()
 
   void visit(rt::ParamVisitor& v) {
-    v.param("ge", ge, "1", "error scaling Ge (> 0)");
-    v.param("gce", gce, "1", "change-of-error scaling Gce (> 0)");
-    v.param("alpha", alpha, "1", "overshoot attenuation alpha in (0, 1]");
-    v.param("ol", ol, "1", "overloading parameter ol (> 0)");
-    v.param("ku", ku, "us", "global gain of the arc-off time (>= 0)");
-    v.param("kv", kv, "V", "global gain of the servo reference voltage (>= 0)");
-    v.param("rab_ref_default", rab_ref_default, "1", "Rab set point while rab_ref is 0, (0, 1]");
-    v.param("overload_error", overload_error, "1", "Psi applies when e is below this (<= 0)");
-    v.param("dpf_gain", dpf_gain, "1", "gain on d_pf = Rab_p - Rab_f in Psi (>= 0)");
-    v.param("psi_min", psi_min, "1", "floor of Psi in overload (>= 0)");
-    v.param("u_min_us", u_min_us, "us", "shortest arc-off time");
-    v.param("u_max_us", u_max_us, "us", "longest arc-off time");
-    v.param("u_initial_us", u_initial_us, "us", "arc-off time after activation");
-    v.param("v_min_v", v_min_v, "V", "lowest servo reference voltage");
-    v.param("v_max_v", v_max_v, "V", "highest servo reference voltage");
-    v.param("v_initial_v", v_initial_v, "V", "servo reference voltage after activation");
-    v.param("settle_samples", settle_samples, "samples",
-            "hold u and v this many samples after activation while filter and predictor settle");
+    v.param("ge", ge, {.unit = "1", .description = "error scaling Ge", .range = rt::kPositive});
+    v.param("gce", gce,
+            {.unit = "1", .description = "change-of-error scaling Gce", .range = rt::kPositive});
+    v.param("alpha", alpha,
+            {.unit = "1",
+             .description = "overshoot attenuation alpha",
+             .range = rt::closed(1e-9, 1.0)});
+    v.param("ol", ol,
+            {.unit = "1", .description = "overloading parameter ol", .range = rt::kPositive});
+    v.param("ku", ku,
+            {.unit = "us",
+             .description = "global gain of the arc-off time",
+             .range = rt::kNonNegative});
+    v.param("kv", kv,
+            {.unit = "V",
+             .description = "global gain of the servo reference voltage",
+             .range = rt::kNonNegative});
+    v.param("rab_ref_default", rab_ref_default,
+            {.unit = "1",
+             .description = "Rab set point while rab_ref is 0",
+             .range = rt::closed(1e-9, 1.0)});
+    v.param("overload_error", overload_error,
+            {.unit = "1",
+             .description = "Psi applies when e is below this",
+             .range = rt::closed(-1.0, 0.0)});
+    v.param("dpf_gain", dpf_gain,
+            {.unit = "1",
+             .description = "gain on d_pf = Rab_p - Rab_f in Psi",
+             .range = rt::kNonNegative});
+    v.param("psi_min", psi_min,
+            {.unit = "1", .description = "floor of Psi in overload", .range = rt::kNonNegative});
+    v.param("u_min_us", u_min_us, {.unit = "us", .description = "shortest arc-off time"});
+    v.param("u_max_us", u_max_us,
+            {.unit = "us", .description = "longest arc-off time, >= u_min_us"});
+    v.param(
+        "u_initial_us", u_initial_us,
+        {.unit = "us", .description = "arc-off time after activation, in [u_min_us, u_max_us]"});
+    v.param("v_min_v", v_min_v, {.unit = "V", .description = "lowest servo reference voltage"});
+    v.param("v_max_v", v_max_v,
+            {.unit = "V", .description = "highest servo reference voltage, >= v_min_v"});
+    v.param("v_initial_v", v_initial_v,
+            {.unit = "V",
+             .description = "servo reference voltage after activation, in [v_min_v, v_max_v]"});
+    v.param(
+        "settle_samples", settle_samples,
+        {.unit = "samples",
+         .description =
+             "hold u and v this many samples after activation while filter and predictor settle",
+         .range = rt::closed(0.0, 1e9)});
   }
+  /// Cross-field rules: u_min_us <= u_initial_us <= u_max_us, v_min_v <= v_initial_v <= v_max_v.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 

@@ -73,31 +73,75 @@ struct SelfTuningRegulatorParams {
   double y_rt_min{0.3};
 
   void visit(rt::ParamVisitor& v) {
-    v.param("delay_v", delay_v, "samples", "prediction delay d_v of the main model (0..4)");
-    v.param("beta00", beta00, "1", "fixed beta00 of the main model (!= 0; paper -1)");
-    v.param("us_per_unit_v", us_per_unit_v, "V", "servo reference voltage per unit of u_v");
-    v.param("u_v_min", u_v_min, "1", "lowest u_v");
-    v.param("u_v_max", u_v_max, "1", "highest u_v");
-    v.param("u_v_initial", u_v_initial, "1", "u_v after activation");
-    v.param("beta01_init", beta01_init, "1", "initial estimate of beta01");
-    v.param("beta0c_init", beta0c_init, "1", "initial estimate of beta0c");
-    v.param("ti_us", ti_us, "us", "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti (> 0)");
-    v.param("to_min_us", to_min_us, "us", "shortest pulse-off time (> 0)");
-    v.param("to_max_us", to_max_us, "us", "longest pulse-off time");
-    v.param("to_initial_us", to_initial_us, "us", "pulse-off time after activation");
-    v.param("beta1c_init", beta1c_init, "1", "initial estimate of beta1c");
-    v.param("lambda", lambda, "1", "RLS forgetting factor in [0.5, 1]");
-    v.param("p0", p0, "1", "initial RLS covariance (> 0)");
-    v.param("trace_max", trace_max, "1", "bound of the RLS covariance trace (>= 2*p0)");
-    v.param("y_rv_good", y_rv_good, "1", "y_v reference in a good gap (paper 0.95)");
-    v.param("y_rt_good", y_rt_good, "1", "y_t reference in a good gap (paper 0.9)");
-    v.param("transient_arc_limit", transient_arc_limit, "1", "good gap: transient-arc ratio below");
-    v.param("stable_arc_limit", stable_arc_limit, "1", "stable arc: stable-arc ratio above this");
-    v.param("ref_rise", ref_rise, "1", "approach to the good references per sample, (0, 1]");
-    v.param("ref_step", ref_step, "1", "reference decrease per sample during a stable arc");
-    v.param("y_rv_min", y_rv_min, "1", "floor of the y_v reference");
-    v.param("y_rt_min", y_rt_min, "1", "floor of the y_t reference");
+    v.param("delay_v", delay_v,
+            {.unit = "samples",
+             .description = "prediction delay d_v of the main model (shapes the regressor history)",
+             .range = rt::closed(0.0, static_cast<double>(kMaxDelay)),
+             .load_time_only = true});
+    v.param("beta00", beta00,
+            {.unit = "1", .description = "fixed beta00 of the main model, != 0 (paper -1)"});
+    v.param("us_per_unit_v", us_per_unit_v,
+            {.unit = "V",
+             .description = "servo reference voltage per unit of u_v",
+             .range = rt::kPositive});
+    v.param("u_v_min", u_v_min, {.unit = "1", .description = "lowest u_v"});
+    v.param("u_v_max", u_v_max, {.unit = "1", .description = "highest u_v, >= u_v_min"});
+    v.param("u_v_initial", u_v_initial,
+            {.unit = "1", .description = "u_v after activation, in [u_v_min, u_v_max]"});
+    v.param("beta01_init", beta01_init, {.unit = "1", .description = "initial estimate of beta01"});
+    v.param("beta0c_init", beta0c_init, {.unit = "1", .description = "initial estimate of beta0c"});
+    v.param("ti_us", ti_us,
+            {.unit = "us",
+             .description = "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti",
+             .range = rt::kPositive});
+    v.param("to_min_us", to_min_us,
+            {.unit = "us", .description = "shortest pulse-off time", .range = rt::kPositive});
+    v.param("to_max_us", to_max_us,
+            {.unit = "us", .description = "longest pulse-off time, >= to_min_us"});
+    v.param("to_initial_us", to_initial_us,
+            {.unit = "us",
+             .description = "pulse-off time after activation, in [to_min_us, to_max_us]"});
+    v.param("beta1c_init", beta1c_init, {.unit = "1", .description = "initial estimate of beta1c"});
+    v.param("lambda", lambda,
+            {.unit = "1", .description = "RLS forgetting factor", .range = rt::closed(0.5, 1.0)});
+    v.param("p0", p0,
+            {.unit = "1", .description = "initial RLS covariance", .range = rt::kPositive});
+    v.param("trace_max", trace_max,
+            {.unit = "1", .description = "bound of the RLS covariance trace, >= 2*p0"});
+    v.param("y_rv_good", y_rv_good,
+            {.unit = "1",
+             .description = "y_v reference in a good gap (paper 0.95)",
+             .range = rt::closed(0.0, 2.0)});
+    v.param("y_rt_good", y_rt_good,
+            {.unit = "1",
+             .description = "y_t reference in a good gap (paper 0.9)",
+             .range = rt::closed(0.0, 2.0)});
+    v.param("transient_arc_limit", transient_arc_limit,
+            {.unit = "1",
+             .description = "good gap: transient-arc ratio below",
+             .range = rt::closed(0.0, 1.0)});
+    v.param("stable_arc_limit", stable_arc_limit,
+            {.unit = "1",
+             .description = "stable arc: stable-arc ratio above this",
+             .range = rt::closed(0.0, 1.0)});
+    v.param("ref_rise", ref_rise,
+            {.unit = "1",
+             .description = "approach to the good references per sample",
+             .range = rt::closed(1e-9, 1.0)});
+    v.param("ref_step", ref_step,
+            {.unit = "1",
+             .description = "reference decrease per sample during a stable arc",
+             .range = rt::kNonNegative});
+    v.param("y_rv_min", y_rv_min,
+            {.unit = "1",
+             .description = "floor of the y_v reference, <= y_rv_good",
+             .range = rt::closed(0.0, 2.0)});
+    v.param("y_rt_min", y_rt_min,
+            {.unit = "1",
+             .description = "floor of the y_t reference, <= y_rt_good",
+             .range = rt::closed(0.0, 2.0)});
   }
+  /// Rules a range cannot say: beta00 != 0, the min/initial/max orders, trace_max >= 2*p0.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
@@ -108,8 +152,6 @@ class SelfTuningRegulator final : public rt::BlockWithParams<SelfTuningRegulator
   void activate() noexcept override;
   /// RT-safe. One sample of both loops.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses delay_v at run time (it shapes the regressor history).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
 
  private:
   void publish() noexcept;

@@ -57,19 +57,44 @@ struct ShortRetractParams {
   double progress_mm{0.05};             // [mm] ≥ 0, path advance that resets tries
 
   void visit(rt::ParamVisitor& v) {
-    v.param("history_capacity", history_capacity, "points",
-            "path points kept (2..1048576), load time only");
-    v.param("min_spacing_mm", min_spacing_mm, "mm", "least distance between recorded points");
-    v.param("short_cycles", short_cycles, "cycles",
-            "consecutive short cycles that start a retract");
-    v.param("retract_distance_mm", retract_distance_mm, "mm", "retract length along the path");
-    v.param("retract_speed_mm_s", retract_speed_mm_s, "mm/s", "path speed while retracting");
-    v.param("resume_speed_mm_s", resume_speed_mm_s, "mm/s", "path speed walking forward again");
-    v.param("resume_ramp_ms", resume_ramp_ms, "ms", "time to ramp v_scale 0 -> 1 after hand-back");
-    v.param("max_tries", max_tries, "", "retracts without progress before alarm + hold");
-    v.param("progress_mm", progress_mm, "mm", "path advance past the last short that resets tries");
+    v.param("history_capacity", history_capacity,
+            {.unit = "points",
+             .description = "path points kept (it sizes the path ring)",
+             .range = rt::closed(2.0, static_cast<double>(kMaxHistory)),
+             .load_time_only = true});
+    v.param("min_spacing_mm", min_spacing_mm,
+            {.unit = "mm",
+             .description = "least distance between recorded points",
+             .range = rt::closed(0.0, 1.0e3)});
+    v.param("short_cycles", short_cycles,
+            {.unit = "cycles",
+             .description = "consecutive short cycles that start a retract",
+             .range = rt::closed(1.0, 1.0e9)});
+    v.param("retract_distance_mm", retract_distance_mm,
+            {.unit = "mm",
+             .description = "retract length along the path",
+             .range = rt::closed(1.0e-9, 1.0e4)});
+    v.param("retract_speed_mm_s", retract_speed_mm_s,
+            {.unit = "mm/s",
+             .description = "path speed while retracting",
+             .range = rt::closed(1.0e-9, 1.0e4)});
+    v.param("resume_speed_mm_s", resume_speed_mm_s,
+            {.unit = "mm/s",
+             .description = "path speed walking forward again",
+             .range = rt::closed(1.0e-9, 1.0e4)});
+    v.param("resume_ramp_ms", resume_ramp_ms,
+            {.unit = "ms",
+             .description = "time to ramp v_scale 0 -> 1 after hand-back",
+             .range = rt::closed(0.0, 60000.0)});
+    v.param("max_tries", max_tries,
+            {.unit = "",
+             .description = "retracts without progress before alarm + hold",
+             .range = rt::closed(0.0, 1.0e6)});
+    v.param("progress_mm", progress_mm,
+            {.unit = "mm",
+             .description = "path advance past the last short that resets tries",
+             .range = rt::closed(0.0, 1.0e4)});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
@@ -83,8 +108,6 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   void activate() noexcept override;
   /// RT-safe. kOk, or kFault while alarm is set or on a non-finite position input.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// Non-RT. Refuses history_capacity (it sized the ring at configure()).
-  std::vector<rt::ParamError> stage_param(std::size_t index, const rt::ParamValue& v) override;
   /// The current state. For tests and diagnostics; not synchronised.
   [[nodiscard]] State state() const noexcept { return state_; }
   /// Points in the history. For tests and diagnostics; not synchronised.

@@ -27,12 +27,14 @@ struct SineSourceParams {
   double offset{0.0};        // [signal unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("amplitude", amplitude, "", "peak amplitude, in the signal's unit");
-    v.param("frequency_hz", frequency_hz, "Hz", "frequency (> 0)");
-    v.param("phase_rad", phase_rad, "rad", "phase at cycle 0");
-    v.param("offset", offset, "", "added to the sine, in the signal's unit");
+    v.param("amplitude", amplitude,
+            {.unit = "", .description = "peak amplitude, in the signal's unit"});
+    v.param("frequency_hz", frequency_hz,
+            {.unit = "Hz", .description = "frequency", .range = rt::kPositive});
+    v.param("phase_rad", phase_rad, {.unit = "rad", .description = "phase at cycle 0"});
+    v.param("offset", offset,
+            {.unit = "", .description = "added to the sine, in the signal's unit"});
   }
-  [[nodiscard]] std::vector<rt::ParamError> validate() const;
 };
 
 class SineSource final : public rt::BlockWithParams<SineSourceParams> {
