@@ -7,34 +7,33 @@ namespace edm::sim {
 namespace rt = edm::rt;
 
 void SimDriverParams::visit(rt::ParamVisitor& v) {
-  v.param("preset", preset, "", "drill | sink | wire: the defaults of every other parameter");
+  v.param("preset", preset,
+          {.unit = "",
+           .description = "drill | sink | wire: the defaults of every other parameter",
+           .load_time_only = true});
   if (preset != loaded_preset) {
     if (auto p = SimParams::preset(preset)) {
       plant = *p;
     }
     loaded_preset = preset;
   }
-  v.param("seed", seed, "", "random seed (every variate is keyed by seed, stream, pulse)");
+  v.param("seed", seed,
+          {.unit = "",
+           .description = "random seed (every variate is keyed by seed, stream, pulse)",
+           .range = rt::kNonNegative,
+           .load_time_only = true});
   plant.visit(v);
 }
 
 std::vector<rt::ParamError> SimDriverParams::validate() const {
-  std::vector<rt::ParamError> errs;
   if (!SimParams::preset(preset)) {
     std::string names;
     for (const auto& n : preset_names()) {
       names += (names.empty() ? "" : ", ") + n;
     }
-    errs.push_back({"preset", "unknown preset '" + preset + "' (presets: " + names + ")"});
-    return errs;
+    return {{"preset", "unknown preset '" + preset + "' (presets: " + names + ")"}};
   }
-  if (seed < 0) {
-    errs.push_back({"seed", "must be >= 0"});
-  }
-  for (auto& e : plant.validate()) {
-    errs.push_back(std::move(e));
-  }
-  return errs;
+  return plant.cross_field_errors();  // the plant's fields were checked against their ranges
 }
 
 std::vector<rt::ParamError> SimDriver::configure(const rt::BlockSetup& setup) {
@@ -47,11 +46,6 @@ std::vector<rt::ParamError> SimDriver::configure(const rt::BlockSetup& setup) {
 }
 
 void SimDriver::activate() noexcept { started_ = false; }
-
-std::vector<rt::ParamError> SimDriver::stage_param(std::size_t /*index*/,
-                                                   const rt::ParamValue& /*v*/) {
-  return {{"", "simulator parameters are set in the config (load time only)"}};
-}
 
 bool SimDriver::set_seed(std::uint64_t seed) {
   params_.seed = static_cast<std::int64_t>(seed & 0x7fffffffffffffffULL);

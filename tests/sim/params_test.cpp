@@ -57,6 +57,7 @@ TEST(SimParams, visit_names_every_field_once) {
   EXPECT_TRUE(unique.count("max_pulses_per_advance"));
 }
 
+// Each field against its range first; the rules between fields once every field is in range.
 TEST(SimParams, validate_names_the_bad_fields) {
   SimParams p;
   p.peak_current_a = -1.0;
@@ -64,13 +65,35 @@ TEST(SimParams, validate_names_the_bad_fields) {
   p.flush_factor = 1.5;
   p.hole_d_mm = 0.9;  // smaller than the tube
   p.td_len_um = std::nan("");
-  const auto errs = p.validate();
+  auto errs = p.validate();
   EXPECT_TRUE(has_error(errs, "peak_current_a"));
-  EXPECT_TRUE(has_error(errs, "td_law"));
   EXPECT_TRUE(has_error(errs, "flush_factor"));
-  EXPECT_TRUE(has_error(errs, "hole_d_mm"));
   EXPECT_TRUE(has_error(errs, "td_len_um"));
   EXPECT_FALSE(has_error(errs, "default_on_time_us"));
+  ASSERT_EQ(errs.size(), 3U);
+  EXPECT_EQ(errs[0].message, "must be > 0 (got -1)");
+  EXPECT_EQ(errs[1].message, "must be a finite number (got nan)");
+  EXPECT_EQ(errs[2].message, "must be in [0, 1] (got 1.5)");
+  p.peak_current_a = 15.0;
+  p.flush_factor = 1.0;
+  p.td_len_um = 7.0;
+  errs = p.validate();
+  EXPECT_TRUE(has_error(errs, "td_law"));
+  EXPECT_TRUE(has_error(errs, "hole_d_mm"));
+  EXPECT_EQ(errs.size(), 2U);
+}
+
+// The plant resolves its parameters once: every one is load time only.
+TEST(SimParams, every_field_is_load_time_only) {
+  struct Check final : edm::rt::ParamVisitor {
+    int runtime_writable = 0;
+    void on_param(std::string_view, edm::rt::ParamRef, edm::rt::ParamSpec spec) override {
+      runtime_writable += spec.load_time_only ? 0 : 1;
+    }
+  } check;
+  SimParams p;
+  p.visit(check);
+  EXPECT_EQ(check.runtime_writable, 0);
 }
 
 TEST(SimParams, wire_break_shape_must_be_a_whole_number_in_range) {

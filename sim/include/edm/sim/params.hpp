@@ -163,10 +163,15 @@ struct SimParams {
   // --- Cost bound ---
   std::int64_t max_pulses_per_advance{100000};  // per advance_to(); beyond it pulses pause
 
-  /// Names every field (with unit) in declaration order. Non-RT.
+  /// Declares every field (unit, description, range) in declaration order; all are load time
+  /// only (the Plant resolves them once). Non-RT.
   void visit(edm::rt::ParamVisitor& v);
-  /// Every problem with the values; empty means valid. Non-RT.
+  /// Every problem with the values: each field against its range, then (only if all are in
+  /// range) cross_field_errors(). Empty means valid. Non-RT.
   [[nodiscard]] std::vector<edm::rt::ParamError> validate() const;
+  /// The rules a range cannot say: the td_law and tool_kind names, the tool's own dimensions,
+  /// the WEDM profile, hole and cavity, a whole-number wire_break_rab_shape. Non-RT.
+  [[nodiscard]] std::vector<edm::rt::ParamError> cross_field_errors() const;
   /// "drill", "sink" or "wire" (PLANT-MODEL.md §6.5); nullopt for another name.
   static std::optional<SimParams> preset(std::string_view name);
 };

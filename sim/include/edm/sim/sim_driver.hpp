@@ -47,7 +47,9 @@ struct SimDriverParams {
 
   /// `preset` first: once the loader has set it, the plant fields are reset to that preset and
   /// the loader then applies the overrides written in the config.
+  /// Every field is load time only (a runtime write is refused).
   void visit(edm::rt::ParamVisitor& v);
+  /// Rules a range cannot say: a known preset, then the plant's cross-field rules.
   [[nodiscard]] std::vector<edm::rt::ParamError> validate() const;
 };
 
@@ -61,9 +63,6 @@ class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt
   void enter_safe_state(const edm::rt::SafeStateRequest& request) noexcept override;
   [[nodiscard]] edm::rt::IoFault fault() const noexcept override;
   bool set_seed(std::uint64_t seed) override;
-  /// Simulator parameters are load-time only: a runtime write is refused with a message.
-  std::vector<edm::rt::ParamError> stage_param(std::size_t index,
-                                               const edm::rt::ParamValue& v) override;
 
   /// The plant (tests and benchmarks). Valid after configure().
   [[nodiscard]] Plant& plant() noexcept { return *plant_; }
