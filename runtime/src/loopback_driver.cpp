@@ -2,12 +2,6 @@
 
 namespace edm::rt {
 
-std::vector<ParamError> LoopbackParams::validate() const {
-  std::vector<ParamError> errs;
-  require_range(errs, "channels", static_cast<double>(channels), 1, 64);
-  return errs;
-}
-
 std::vector<ParamError> LoopbackDriver::configure(const BlockSetup& /*setup*/) {
   channels_.clear();
   for (std::int64_t k = 0; k < params_.channels; ++k) {

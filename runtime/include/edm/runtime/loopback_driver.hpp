@@ -17,10 +17,13 @@
 namespace edm::rt {
 
 struct LoopbackParams {
-  std::int64_t channels{4};  // analog and digital channel pairs, 1..64
+  std::int64_t channels{4};  // analog and digital channel pairs
 
-  void visit(ParamVisitor& v) { v.param("channels", channels, "", "channel pairs, 1..64"); }
-  [[nodiscard]] std::vector<ParamError> validate() const;
+  void visit(ParamVisitor& v) {
+    v.param(
+        "channels", channels,
+        {.unit = "", .description = "analog and digital channel pairs", .range = closed(1, 64)});
+  }
 };
 
 class LoopbackDriver final : public BlockWithParams<LoopbackParams, IoDriver> {
