@@ -21,6 +21,9 @@
 
 namespace edm::blocks::test {
 
+inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
 /// Formats validate()/configure() errors for assertion messages.
 inline std::string describe(const std::vector<rt::ParamError>& errs) {
   std::string out;
@@ -55,6 +58,11 @@ class BlockHarness {
   std::vector<rt::ParamError> start(const Params& p) {
     block_.set_params(p);
     return start();
+  }
+  /// start(p) for a test that expects the parameters to be accepted (a refusal fails the test).
+  void start_ok(const Params& p) {
+    const auto errs = start(p);
+    EXPECT_TRUE(errs.empty()) << describe(errs);
   }
   std::vector<rt::ParamError> start() {
     if (auto errs = block_.validate(); !errs.empty()) {
@@ -119,6 +127,17 @@ class BlockHarness {
     ++cycle_;
     return block_.update(ctx);
   }
+  /// Latches a command on the bool input `name`: drops it for one cycle if it was high, then
+  /// raises it. Returns the status of the edge cycle.
+  rt::BlockStatus rising_edge(std::string_view name = "start") {
+    auto& s = source<bool>(name);
+    if (s.get()) {
+      s.set(false);
+      step();
+    }
+    s.set(true);
+    return step();
+  }
   /// Sets input "in" to x, then step().
   rt::BlockStatus step(double x) {
     if (in_ == nullptr) {
@@ -165,3 +184,13 @@ class BlockHarness {
 };
 
 }  // namespace edm::blocks::test
+
+// The names every block test uses unqualified, declared once for the suite instead of in each file.
+namespace edm::blocks {
+using namespace std::chrono_literals;
+using rt::BlockStatus;
+using test::BlockHarness;
+using test::describe;
+using test::kInf;
+using test::kNaN;
+}  // namespace edm::blocks

@@ -15,18 +15,11 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = std::numbers::pi;
 
 struct Rig {
   explicit Rig(rt::Duration period = 1ms, CircularInterpolatorParams p = {}) : h(period) {
-    const auto errs = h.start(p);
-    EXPECT_TRUE(errs.empty()) << describe(errs);
+    h.start_ok(p);
     ov.set(1.0);
     turns.set(1);
   }
@@ -51,14 +44,7 @@ struct Rig {
     feed.set(feed_mm_min);
     return edge();
   }
-  BlockStatus edge() {
-    if (start.get()) {
-      start.set(false);
-      h.step();
-    }
-    start.set(true);
-    return h.step();
-  }
+  BlockStatus edge() { return h.rising_edge("start"); }
   [[nodiscard]] double x() const { return h.out("rx_mm"); }
   [[nodiscard]] double y() const { return h.out("ry_mm"); }
   [[nodiscard]] bool busy() const { return h.out<bool>("busy"); }

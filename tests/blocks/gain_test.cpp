@@ -10,12 +10,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 TEST(GainTest, out_is_k_times_in_plus_offset) {
   BlockHarness<Gain> h;
   ASSERT_TRUE(h.start({.k = 2.5, .offset = -1.0}).empty());

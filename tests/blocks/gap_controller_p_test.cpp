@@ -9,13 +9,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
 // kg 0.1 mm/s per µs, Tdr 10 µs, feed ≤ 0.5 mm/s down, ≤ 2 mm/s up, retract
 // at 1.5 mm/s.
 constexpr GapControllerPParams kParams{.kg = 0.1,

@@ -11,11 +11,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 TEST(IntegratorTest, integrates_a_constant_exactly) {
   // dt = 0.125 s and k·in·dt = 0.5·4·0.125 = 0.25: every partial sum is exact in binary.
   BlockHarness<Integrator> h(125ms);

@@ -15,10 +15,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-
 JumpCycleParams small() {
   JumpCycleParams p;
   p.period = 100ms;

@@ -11,11 +11,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 TEST(LimiterTest, clamps_to_min_and_max) {
   BlockHarness<Limiter> h;
   ASSERT_TRUE(h.start({.min = -1.0, .max = 2.0, .rate = 0.0}).empty());

@@ -15,19 +15,13 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
 using Vec3 = std::array<double, 3>;
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The block with every input wired to a test-owned output.
 struct Rig {
   explicit Rig(rt::Duration period = 1ms, LinearInterpolatorParams p = {}) : h(period) {
-    const auto errs = h.start(p);
-    EXPECT_TRUE(errs.empty()) << describe(errs);
+    h.start_ok(p);
     ov.set(1.0);
   }
   /// Latches a move: start low for one cycle (if it was high), then a rising edge. Returns the
@@ -37,12 +31,7 @@ struct Rig {
     ly.set(l[1]);
     lz.set(l[2]);
     feed.set(feed_mm_min);
-    if (start.get()) {
-      start.set(false);
-      h.step();
-    }
-    start.set(true);
-    return h.step();
+    return h.rising_edge("start");
   }
   [[nodiscard]] Vec3 pos() const { return {h.out("rx_mm"), h.out("ry_mm"), h.out("rz_mm")}; }
   [[nodiscard]] Vec3 vel() const { return {h.out("vx_mm_s"), h.out("vy_mm_s"), h.out("vz_mm_s")}; }

@@ -11,11 +11,7 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
 using rt::Duration;
-using test::BlockHarness;
-using test::describe;
 
 // dt/τ from the integer nanosecond counts, independently of the block's code path.
 double ratio(Duration dt, Duration tau) {

@@ -13,9 +13,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 constexpr double kSpike = 1e12;
 
 // Brute force: the mean of the samples in the window, summed afresh. The ±kSpike samples are

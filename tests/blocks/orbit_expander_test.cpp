@@ -14,28 +14,15 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 struct Rig {
   explicit Rig(OrbitExpanderParams p = {}) {
-    const auto errs = h.start(p);
-    EXPECT_TRUE(errs.empty()) << describe(errs);
+    h.start_ok(p);
     enable.set(true);
   }
   BlockStatus start_orbit(double r0_mm, double final_mm) {
     r0.set(r0_mm);
     fin.set(final_mm);
-    if (start.get()) {
-      start.set(false);
-      h.step();
-    }
-    start.set(true);
-    return h.step();
+    return h.rising_edge("start");
   }
   /// One sample of a revolution; the last one with the rev_pulse edge.
   BlockStatus sample(double td, bool ok = true, bool last = false) {

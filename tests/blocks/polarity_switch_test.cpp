@@ -13,11 +13,7 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
 using rt::Duration;
-using test::BlockHarness;
-using test::describe;
 
 struct Out {
   bool positive;

@@ -11,14 +11,10 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-
 // A position loop closed over a simulated axis that integrates the velocity command:
 // x ← x + v_cmd·dt (+ an optional velocity disturbance).
 struct Loop {
-  explicit Loop(const PositionLoopParams& p) { EXPECT_TRUE(h.start(p).empty()); }
+  explicit Loop(const PositionLoopParams& p) { h.start_ok(p); }
   BlockStatus step(double disturbance_mm_s = 0.0) {
     x_mm.set(x);
     const BlockStatus s = h.step();

@@ -15,10 +15,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-
 TEST(SelectTest, selects_in1_when_g_or_the_select_parameter_is_true) {
   BlockHarness<Select> h(1ms);
   ASSERT_TRUE(h.start({}).empty());

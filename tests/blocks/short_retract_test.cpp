@@ -14,9 +14,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
 using State = ShortRetract::State;
 
 ShortRetractParams test_params() {

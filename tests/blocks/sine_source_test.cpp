@@ -13,11 +13,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 TEST(SineSourceTest, matches_std_sin_over_the_first_cycles) {

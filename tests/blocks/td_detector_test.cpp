@@ -12,10 +12,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 // One cycle of the FPGA counters.
 struct Pulses {
   std::int64_t td_sum_ns{0};

@@ -13,11 +13,6 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 // Sets the gap controller's command vz_in_mm_s, then runs one cycle.
 BlockStatus step(BlockHarness<WearCompensator>& h, double vz_in_mm_s) {
   h.source<double>("vz_in_mm_s").set(vz_in_mm_s);
