@@ -14,9 +14,7 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
 using std::numbers::pi;
-using test::BlockHarness;
 
 BlockHarness<ButterworthLowPass>* started(BlockHarness<ButterworthLowPass>& h, double wn,
                                           bool prime = false) {

@@ -15,8 +15,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
 using PulseClass = DischargeStateCounter::PulseClass;
 
 struct Counts {

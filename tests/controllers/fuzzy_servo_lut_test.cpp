@@ -14,10 +14,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-using test::describe;
-
 constexpr double kCornerTol = 1e-9;
 
 fuzzy::Variable variable(const std::string& name, const std::string& text) {

@@ -14,9 +14,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 struct ExpCase {
   double c;      // amplitude
   double alpha;  // growth per sample

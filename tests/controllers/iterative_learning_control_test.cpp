@@ -15,9 +15,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 // The paper's process: z_j = P·u_j with P first-sample anchored (row i: 1 − Σ_{m<i} p_m on the
 // first column, p_{i−c} on column c ≥ 1), p_m = (1 − b)·b^m (a first-order closed axis loop,
 // p0 = 1 − b); y = kδ·(z − z_p) + b_y + n; the surface is constant over a cycle and recedes by
@@ -31,6 +28,15 @@ struct Plant {
   double recede{0.0};
   std::vector<double> shape;  // repeating within-cycle disturbance n(k) (empty: none)
 };
+
+// One period of 0.1·sin(2πk/n) over a cycle of n samples: a repeating within-cycle disturbance.
+std::vector<double> sine_disturbance(int n) {
+  std::vector<double> shape(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) {
+    shape[static_cast<std::size_t>(k)] = 0.1 * std::sin(2.0 * 3.14159265358979 * k / n);
+  }
+  return shape;
+}
 
 struct CycleLog {
   std::vector<double> mean_error;           // ē_j per cycle (as the block measured it)
@@ -149,10 +155,7 @@ TEST(IterativeLearningControl, a_repeating_error_shape_contracts_by_lambda3_per_
   // w_j+1 = (1 − kδ·l1)·w_j = λ3·w_j exactly, a repeating disturbance is learnt away.
   Plant plant;
   plant.b = 0.0;
-  plant.shape.resize(static_cast<std::size_t>(plant.n));
-  for (int k = 0; k < plant.n; ++k) {
-    plant.shape[static_cast<std::size_t>(k)] = 0.1 * std::sin(2.0 * 3.14159265358979 * k / plant.n);
-  }
+  plant.shape = sine_disturbance(plant.n);
   const double lambda3 = 0.35;
   const auto p = params(plant.n, 1.0, plant.k_delta, 0.0, 0.5, 0.5, lambda3);
   const double y_ref = plant.k_delta * 0.05 + plant.b_y;
@@ -182,10 +185,7 @@ TEST(IterativeLearningControl, with_a_real_axis_and_q_filter_the_learning_conver
   // part of the learning (the usual ILC trade-off between robustness and residual error).
   Plant plant;
   plant.b = 0.5;
-  plant.shape.resize(static_cast<std::size_t>(plant.n));
-  for (int k = 0; k < plant.n; ++k) {
-    plant.shape[static_cast<std::size_t>(k)] = 0.1 * std::sin(2.0 * 3.14159265358979 * k / plant.n);
-  }
+  plant.shape = sine_disturbance(plant.n);
   const auto p = params(plant.n, 0.5, plant.k_delta, 0.2, 0.5, 0.5, 0.3);
   const double y_ref = plant.k_delta * 0.05 + plant.b_y;
   const CycleLog r = run(p, plant, -0.05, y_ref, 80);

@@ -13,9 +13,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 // y = θ0·φ0 + θ1·φ1 + θ2 (φ2 = 1), φ0, φ1 ~ N(0, 1), noise ~ N(0, σ²); seeded.
 class Rls {
  public:
@@ -128,18 +125,27 @@ TEST(RecursiveLeastSquares, forgetting_factor_tracks_a_parameter_step) {
       << "no forgetting: the old data still dominates";
 }
 
-TEST(RecursiveLeastSquares, covariance_grows_as_lambda_to_the_minus_k_without_excitation) {
-  // φ = [1, 0]: the second direction is never excited, so P11 = p0·λ^(−k) exactly (wind-up).
+// n = 2, λ = 0.97, p0 = 10 under the given trace bound, driven with φ = [1, 0] and y = 2: the
+// second direction is never excited.
+RecursiveLeastSquaresParams start_with_one_direction_excited(
+    BlockHarness<RecursiveLeastSquares>& h, double trace_max) {
   RecursiveLeastSquaresParams p;
   p.n_params = 2;
   p.lambda = 0.97;
   p.p0 = 10.0;
-  p.trace_max = 1e300;
-  BlockHarness<RecursiveLeastSquares> h;
-  ASSERT_TRUE(h.start(p).empty());
+  p.trace_max = trace_max;
+  EXPECT_TRUE(h.start(p).empty());
   h.source<double>("phi0").set(1.0);
   h.source<double>("phi1").set(0.0);
   h.source<double>("y").set(2.0);
+  return p;
+}
+
+TEST(RecursiveLeastSquares, covariance_grows_as_lambda_to_the_minus_k_without_excitation) {
+  // φ = [1, 0]: the second direction is never excited, so P11 = p0·λ^(−k) exactly (wind-up).
+  BlockHarness<RecursiveLeastSquares> h;
+  const RecursiveLeastSquaresParams p = start_with_one_direction_excited(h, 1e300);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const int k = 200;
   for (int i = 0; i < k; ++i) {
     h.step();
@@ -153,16 +159,9 @@ TEST(RecursiveLeastSquares, covariance_grows_as_lambda_to_the_minus_k_without_ex
 }
 
 TEST(RecursiveLeastSquares, the_trace_bound_keeps_the_covariance_bounded) {
-  RecursiveLeastSquaresParams p;
-  p.n_params = 2;
-  p.lambda = 0.97;
-  p.p0 = 10.0;
-  p.trace_max = 100.0;
   BlockHarness<RecursiveLeastSquares> h;
-  ASSERT_TRUE(h.start(p).empty());
-  h.source<double>("phi0").set(1.0);
-  h.source<double>("phi1").set(0.0);
-  h.source<double>("y").set(2.0);
+  const RecursiveLeastSquaresParams p = start_with_one_direction_excited(h, 100.0);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   bool saw_bound = false;
   for (int i = 0; i < 2000; ++i) {
     const BlockStatus s = h.step();

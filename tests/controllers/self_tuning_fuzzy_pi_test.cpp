@@ -15,9 +15,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 // Table 3 of the paper, rows CE = PB…NB, columns E = NB…PB, as printed (the extracted text lost
 // one cell of column PS; it is restored from the neighbouring cells' pattern: NM).
 constexpr int kTable3[7][7] = {

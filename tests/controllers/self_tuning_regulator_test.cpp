@@ -13,9 +13,6 @@
 namespace edm::blocks {
 namespace {
 
-using rt::BlockStatus;
-using test::BlockHarness;
-
 class Str {
  public:
   explicit Str(const SelfTuningRegulatorParams& p = {}) {
