@@ -1,32 +1,21 @@
 // Acceptance: a third-party client written with a socket and a JSON library only (Python 3
 // standard library) runs the scripted session of docs/protocol.md against a real edmplc.
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <fstream>
 #include <string>
 
 #include "bridge_fixture.hpp"
+#include "support/free_port.hpp"
 #include "support/subprocess.hpp"
 
 namespace edm::bridge::test {
 namespace {
 
-// A free loopback port: bind port 0, read it back, release it (edmplc binds it right after).
-int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
+using edm::test::free_port;
 
+// A free loopback port: bind port 0, read it back, release it (edmplc binds it right after).
 TEST(ThirdPartyClient, python_session_against_a_real_edmplc) {
   if (::access("/usr/bin/python3", X_OK) != 0) {
     GTEST_SKIP() << "python3 not installed";

@@ -12,9 +12,12 @@
 #include <vector>
 
 #include "edm/runtime/config.hpp"
+#include "support/files.hpp"
 
 namespace edm::rt {
 namespace {
+
+using edm::test::read_file;
 
 // EDM_CONFIG_FUZZ_CASES=50000 for a longer local run.
 int case_count(int fallback) {
@@ -23,13 +26,6 @@ int case_count(int fallback) {
 }
 constexpr std::uint64_t kSeed = 0x5eed'ed3f'00c0'ffeeULL;
 const std::string kPath = "fuzz.yaml";
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::vector<std::string> split_lines(const std::string& text) {
   std::vector<std::string> lines;

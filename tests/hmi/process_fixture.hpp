@@ -5,8 +5,6 @@
 // and a fixture that kills every child it started in its teardown.
 
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -22,17 +20,16 @@
 
 #include "edm/apps/subprocess.hpp"
 #include "edm/bridge/client.hpp"
+#include "support/files.hpp"
+#include "support/free_port.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::hmi::test {
 
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
-
-inline std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using edm::test::free_port;
+using edm::test::read_file;
 
 /// Calls `done` every `every` until it returns true or `timeout` has passed. True if it did.
 template <class F>
@@ -43,19 +40,6 @@ bool poll_until(F done, std::chrono::milliseconds timeout, std::chrono::millisec
     if (Clock::now() >= deadline) return false;
     std::this_thread::sleep_for(every);  // the polling interval, not a wait for a thread
   }
-}
-
-/// A free loopback port: bind port 0, read it back, release it (edmplc binds it right after).
-inline int free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
 }
 
 using Env = std::vector<std::pair<std::string, std::string>>;

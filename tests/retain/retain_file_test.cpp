@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "edm/runtime/retain.hpp"
+#include "support/files.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::rt {
@@ -21,20 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 
 using TempDir = edm::test::TempDir;
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  // Remove first: ext4 flushes a file truncated over old data on close (auto_da_alloc), which
-  // makes the byte-by-byte sweeps below slow.
-  std::error_code ec;
-  fs::remove(path, ec);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << bytes;
-}
+using edm::test::read_file;
+using edm::test::write_file;
 
 // A body followed by its correct end line: isolates the check under test from the checksum.
 std::string with_end(const std::string& body) {
@@ -61,7 +50,7 @@ TEST(RetainCrc, matches_the_ieee_check_value) {
 TEST(RetainCrc, a_file_written_by_the_hand_written_crc_still_loads) {
   const TempDir dir;
   const std::string path = dir.file("old.retain");
-  write_bytes(path,
+  write_file(path,
               "edmplc-retain 1\n"
               "drill.counter.holes LINT 17\n"
               "drill.electrode.length_left LREAL 123.456\n"
@@ -127,10 +116,10 @@ TEST(RetainFile, round_trips_every_type_and_extreme_reals_exactly) {
   EXPECT_TRUE(std::signbit(out.values.at("r.neg_zero").r));
   EXPECT_TRUE(std::isnan(out.values.at("r.nan").r));
   // Deterministic: the same map gives the same bytes, and rewriting what was read changes nothing.
-  const std::string bytes = read_bytes(path);
+  const std::string bytes = read_file(path);
   EXPECT_EQ(bytes, format_retain_file(in));
   write_retain_file_atomic(path, out.values);
-  EXPECT_EQ(read_bytes(path), bytes);
+  EXPECT_EQ(read_file(path), bytes);
   // No temp file is left after a successful write.
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir.path())) {
@@ -163,7 +152,7 @@ TEST(RetainFile, directory_and_empty_file_give_warnings) {
   EXPECT_TRUE(out.values.empty());
   EXPECT_NE(out.warning.find("not a regular file"), std::string::npos) << out.warning;
   const std::string path = dir.file("empty");
-  write_bytes(path, "");
+  write_file(path, "");
   out = load_retain_file(path);
   EXPECT_NE(out.warning.find("empty file"), std::string::npos) << out.warning;
 }
@@ -173,7 +162,7 @@ TEST(RetainFile, every_truncation_is_detected) {
   const std::string path = dir.file("retain.txt");
   const std::string good = format_retain_file(sample_map());
   for (std::size_t len = 0; len < good.size(); ++len) {
-    write_bytes(path, good.substr(0, len));
+    write_file(path, good.substr(0, len));
     RetainLoadResult out;
     ASSERT_NO_THROW(out = load_retain_file(path));
     EXPECT_TRUE(out.values.empty()) << "len " << len;
@@ -189,7 +178,7 @@ TEST(RetainFile, every_single_byte_corruption_is_detected) {
     for (const unsigned mask : {0x01U, 0x20U, 0x80U, 0xFFU}) {
       std::string bad = good;
       bad[at] = static_cast<char>(static_cast<unsigned char>(bad[at]) ^ mask);
-      write_bytes(path, bad);
+      write_file(path, bad);
       RetainLoadResult out;
       ASSERT_NO_THROW(out = load_retain_file(path));
       EXPECT_TRUE(out.values.empty()) << "offset " << at << " mask " << mask;
@@ -259,7 +248,7 @@ TEST(RetainFile, invalid_names_are_refused_before_touching_the_disk) {
 TEST(RetainFile, write_into_missing_or_non_directory_parent_throws_system_error_with_path) {
   TempDir dir;
   const std::string not_a_dir = dir.file("plain");
-  write_bytes(not_a_dir, "x");
+  write_file(not_a_dir, "x");
   for (const std::string& path : {dir.file("missing/retain.txt"), not_a_dir + "/retain.txt"}) {
     try {
       write_retain_file_atomic(path, sample_map());
@@ -302,11 +291,11 @@ TEST(RetainFile, remove_stale_temps_removes_only_other_writers_temp_files) {
   TempDir dir;
   const std::string path = dir.file("retain.txt");
   write_retain_file_atomic(path, sample_map());
-  write_bytes(path + ".tmp.12345", "partial");
-  write_bytes(path + ".tmp.999999", "partial");
-  write_bytes(path + ".tmp." + std::to_string(::getpid()), "ours");
-  write_bytes(path + ".tmp.notapid", "unrelated");
-  write_bytes(dir.file("other.txt.tmp.1"), "unrelated");
+  write_file(path + ".tmp.12345", "partial");
+  write_file(path + ".tmp.999999", "partial");
+  write_file(path + ".tmp." + std::to_string(::getpid()), "ours");
+  write_file(path + ".tmp.notapid", "unrelated");
+  write_file(dir.file("other.txt.tmp.1"), "unrelated");
   EXPECT_EQ(remove_stale_retain_temps(path), 2U);
   EXPECT_FALSE(fs::exists(path + ".tmp.12345"));
   EXPECT_FALSE(fs::exists(path + ".tmp.999999"));

@@ -15,6 +15,7 @@
 #include <system_error>
 
 #include "edm/runtime/retain.hpp"
+#include "support/files.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::rt {
@@ -22,17 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using TempDir = edm::test::TempDir;
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
-}
+using edm::test::read_file;
+using edm::test::write_file;
 
 const RetainMap kValues = {{"p.counter.holes", RetainValue::make_int(17)},
                            {"p.electrode.left_mm", RetainValue::make_real(123.5)}};
@@ -41,12 +33,12 @@ TEST(RetainHostile, planted_link_at_the_old_predictable_temp_name_is_not_followe
   TempDir dir;
   const std::string path = dir.file("retain.txt");
   const std::string victim = dir.file("victim.txt");
-  write_bytes(victim, "precious\n");
+  write_file(victim, "precious\n");
   // The name older builds wrote to: path.tmp.<pid>. A link there must not be written through.
   const std::string old_tmp = path + ".tmp." + std::to_string(::getpid());
   ASSERT_EQ(::symlink(victim.c_str(), old_tmp.c_str()), 0);
   write_retain_file_atomic(path, kValues);
-  EXPECT_EQ(read_bytes(victim), "precious\n");
+  EXPECT_EQ(read_file(victim), "precious\n");
   EXPECT_TRUE(fs::is_symlink(old_tmp));
   const RetainLoadResult r = load_retain_file(path);
   EXPECT_EQ(r.status, RetainLoadStatus::kLoaded) << r.warning;
@@ -63,9 +55,9 @@ TEST(RetainHostile, temp_names_are_unpredictable_and_the_file_is_private) {
   // Two writers in one process never share a temp name: a stale temp left under our own pid
   // (as a crashed thread would) neither blocks nor is reused by the next write.
   const std::string ours = path + ".tmp." + std::to_string(::getpid()) + ".0123456789abcdef";
-  write_bytes(ours, "left over");
+  write_file(ours, "left over");
   write_retain_file_atomic(path, kValues);
-  EXPECT_EQ(read_bytes(ours), "left over");
+  EXPECT_EQ(read_file(ours), "left over");
 }
 
 TEST(RetainHostile, writer_refuses_anything_but_a_regular_file) {
@@ -75,7 +67,7 @@ TEST(RetainHostile, writer_refuses_anything_but_a_regular_file) {
   const std::string subdir = dir.file("adir");
   fs::create_directory(subdir);
   const std::string target = dir.file("target.txt");
-  write_bytes(target, "target\n");
+  write_file(target, "target\n");
   const std::string link = dir.file("link");
   ASSERT_EQ(::symlink(target.c_str(), link.c_str()), 0);
   for (const std::string& p : {fifo, subdir, link}) {
@@ -91,7 +83,7 @@ TEST(RetainHostile, writer_refuses_anything_but_a_regular_file) {
   EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
   EXPECT_TRUE(fs::is_directory(subdir));
   EXPECT_TRUE(fs::is_symlink(link));
-  EXPECT_EQ(read_bytes(target), "target\n");
+  EXPECT_EQ(read_file(target), "target\n");
   // No temp file was left behind by the refusals.
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir.path())) {
@@ -150,20 +142,20 @@ TEST(RetainHostile, huge_file_is_refused_unread) {
 TEST(RetainHostile, missing_and_corrupt_are_told_apart) {
   TempDir dir;
   EXPECT_EQ(load_retain_file(dir.file("none")).status, RetainLoadStatus::kMissing);
-  write_bytes(dir.file("bad"), "edmplc-retain 1\ngarbage\n");
+  write_file(dir.file("bad"), "edmplc-retain 1\ngarbage\n");
   EXPECT_EQ(load_retain_file(dir.file("bad")).status, RetainLoadStatus::kCorrupt);
 }
 
 TEST(RetainHostile, set_aside_keeps_every_corrupt_copy) {
   TempDir dir;
   const std::string path = dir.file("retain.txt");
-  write_bytes(path, "first bad\n");
+  write_file(path, "first bad\n");
   EXPECT_EQ(set_aside_retain_file(path), path + ".corrupt");
-  write_bytes(path, "second bad\n");
+  write_file(path, "second bad\n");
   EXPECT_EQ(set_aside_retain_file(path), path + ".corrupt.1");
   EXPECT_FALSE(fs::exists(path));
-  EXPECT_EQ(read_bytes(path + ".corrupt"), "first bad\n");
-  EXPECT_EQ(read_bytes(path + ".corrupt.1"), "second bad\n");
+  EXPECT_EQ(read_file(path + ".corrupt"), "first bad\n");
+  EXPECT_EQ(read_file(path + ".corrupt.1"), "second bad\n");
 }
 
 // Seeded random mutations of a good file and random bytes: the pure parser never crashes and

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "support/files.hpp"
 #include "support/subprocess.hpp"
 #include "support/temp_dir.hpp"
 
@@ -14,13 +15,6 @@ namespace edm::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 const std::string kDrill = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim-program.yaml";
 
@@ -30,7 +24,7 @@ TEST(SimDriver, SameSeedGivesByteIdenticalTracesAndAnotherSeedDoesNot) {
     Child c({EDM_EDMPLC_PATH, "--config", kDrill, "--clock", "virtual", "--run-for", "30s",
              "--seed", seed, "--trace-out", dir.file(out)});
     EXPECT_EQ(c.wait(), 0) << c.output();
-    return slurp(dir.file(out));
+    return read_file(dir.file(out));
   };
   const std::string a = run("7", "a.csv");
   const std::string b = run("7", "b.csv");
@@ -44,14 +38,14 @@ TEST(SimDriver, RealClockLatchAdvancesThePlantFromTheFirstLatchOnly) {
   // The plant starts at the first latch: a first cycle that tried to simulate CLOCK_MONOTONIC's
   // whole history would take seconds. (No watchdog here: a loaded CI machine must not fault it.)
   TempDir dir("edm-sim");
-  std::string cfg = slurp(kDrill);
+  std::string cfg = read_file(kDrill);
   cfg.erase(cfg.find("    watchdog:"),
             cfg.find("\n", cfg.find("    watchdog:")) + 1 - cfg.find("    watchdog:"));
   std::ofstream(dir.file("m.yaml")) << cfg;
   Child c({EDM_EDMPLC_PATH, "--config", dir.file("m.yaml"), "--clock", "real", "--run-for", "300ms",
            "--stats-out", dir.file("s.json")});
   ASSERT_EQ(c.wait(), 0) << c.output();
-  const std::string stats = slurp(dir.file("s.json"));
+  const std::string stats = read_file(dir.file("s.json"));
   const auto exec = stats.find("\"exec_us\"");
   const auto max_at = stats.find("\"max\": ", exec);
   EXPECT_LT(std::stod(stats.substr(max_at + 7)), 100000.0) << stats;

@@ -14,6 +14,7 @@
 
 #include "edm/runtime/pin.hpp"
 #include "edm/runtime/pin_sampler.hpp"
+#include "support/files.hpp"
 
 namespace edm::rt {
 namespace {
@@ -21,6 +22,7 @@ namespace {
 using namespace std::chrono_literals;
 
 using Row = std::vector<std::string>;
+using edm::test::read_file;
 
 // Field split without quoting: the names used in these tests contain no commas or quotes.
 Row split_fields(const std::string& line) {
@@ -56,13 +58,6 @@ Csv parse_csv(const std::string& text) {
     }
   }
   return csv;
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 std::string temp_path(const std::string& name) {
