@@ -185,6 +185,12 @@ class BridgeFixture : public ::testing::Test {
       server_->stop();
     }
   }
+  /// Routes `c`'s events to `sink`, then connects. Declare the sink before the client: it must
+  /// outlive the client's I/O thread.
+  Role connect_with_events(Client& c, EventSink& sink) {
+    c.set_event_handler(sink.handler());
+    return c.connect(client_opts());
+  }
   ClientOptions client_opts(const std::string& token = "") const {
     ClientOptions o;
     o.port = server_->port();
@@ -199,6 +205,16 @@ class BridgeFixture : public ::testing::Test {
   std::atomic<bool> stop_{false};
   std::thread runner_;
 };
+
+/// A watchdog warning from `source` (static strings, as the RT side raises alarms).
+inline rt::Alarm warning_alarm(const char* source, const char* text) {
+  rt::Alarm a;
+  a.code = rt::AlarmCode::kWatchdogWarning;
+  a.severity = rt::AlarmSeverity::kWarning;
+  a.source = source;
+  a.text = text;
+  return a;
+}
 
 inline void expect_error(const Reply& r, ErrorCode code) {
   EXPECT_FALSE(r.ok) << r.body;

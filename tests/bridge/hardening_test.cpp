@@ -416,14 +416,9 @@ TEST_F(Hardening, a_persisting_alarm_is_one_event_and_its_repeats_are_counted_in
   start();
   EventSink sink;
   Client c;
-  c.set_event_handler(sink.handler());
-  ASSERT_EQ(c.connect(client_opts()), Role::kOperator);
+  ASSERT_EQ(connect_with_events(c, sink), Role::kOperator);
   ASSERT_TRUE(c.subscribe({"alarm"}));
-  rt::Alarm a;
-  a.code = rt::AlarmCode::kWatchdogWarning;
-  a.severity = rt::AlarmSeverity::kWarning;
-  a.source = "test.raiser";
-  a.text = "persisting";
+  const rt::Alarm a = warning_alarm("test.raiser", "persisting");
   for (int i = 0; i < 500; ++i) {
     rt_->machine().raise(a);
   }

@@ -161,8 +161,7 @@ TEST_F(Bridge, status_subscription_has_the_rate_and_no_seq_gaps) {
   start();
   EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  c.set_event_handler(sink.handler());
-  c.connect(client_opts());
+  connect_with_events(c, sink);
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_TRUE(c.subscribe({"status"}, 50));
   const auto ev = sink.wait_for("status", 50);
@@ -189,8 +188,7 @@ TEST_F(Bridge, a_stalled_100hz_subscriber_delays_neither_others_nor_the_tasks) {
       "{\"id\":2,\"op\":\"subscribe\",\"topics\":[\"status\"],\"rate_hz\":100}\n");
   EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client good;
-  good.set_event_handler(sink.handler());
-  good.connect(client_opts());
+  connect_with_events(good, sink);
   const std::uint64_t cycles0 = rt_->tasks().front()->cycles();
   ASSERT_TRUE(good.subscribe({"status"}, 50));
   const auto ev = sink.wait_for("status", 100);
@@ -215,14 +213,9 @@ TEST_F(Bridge, alarms_reach_subscribers_and_the_log_alike) {
   start();
   EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  c.set_event_handler(sink.handler());
-  c.connect(client_opts());
+  connect_with_events(c, sink);
   ASSERT_TRUE(c.subscribe({"alarm"}));
-  rt::Alarm a;
-  a.code = rt::AlarmCode::kWatchdogWarning;
-  a.severity = rt::AlarmSeverity::kWarning;
-  a.source = "test";
-  a.text = "a test alarm";
+  rt::Alarm a = warning_alarm("test", "a test alarm");
   a.value = 1.5;
   rt_->machine().raise(a);
   const auto ev = sink.wait_for("alarm", 1);
@@ -287,8 +280,7 @@ TEST_F(Bridge, trace_streams_samples_from_its_own_tap) {
   start();
   EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  c.set_event_handler(sink.handler());
-  c.connect(client_opts());
+  connect_with_events(c, sink);
   expect_error(c.trace_start({"nope.x"}), ErrorCode::kNotFound);
   ASSERT_TRUE(c.trace_start({"chain.g.out", "io.ai0"}));
   const auto ev = sink.wait_for("trace", 3);
@@ -309,8 +301,7 @@ TEST_F(Bridge, reconnect_replays_the_subscription) {
   start();
   EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client c;
-  c.set_event_handler(sink.handler());
-  c.connect(client_opts());
+  connect_with_events(c, sink);
   ASSERT_TRUE(c.subscribe({"status"}, 20));
   ASSERT_EQ(sink.wait_for("status", 2).size(), 2u);
   c.reconnect();
