@@ -105,6 +105,56 @@ void SimParams::visit(rt::ParamVisitor& outer) {
   v.param(
       "debris_short_us", debris_short_us,
       {.unit = "us", .description = "t_bs: duration of a debris short", .range = rt::kPositive});
+  v.param("short_events", short_events,
+          {.unit = "",
+           .description = "debris bridges and tube vibration contacts (false: the model before "
+                          "edm-sim-params/7)"});
+  v.param("bridge_rate_hz", bridge_rate_hz,
+          {.unit = "1/s",
+           .description = "lambda_b0: bridges per second at c = c_b at the surface",
+           .range = rt::kNonNegative});
+  v.param("bridge_debris_ref", bridge_debris_ref,
+          {.unit = "1", .description = "c_b: reference debris of the bridge hazard",
+           .range = rt::open_closed(0.0, 1.0)});
+  v.param("bridge_debris_exp", bridge_debris_exp,
+          {.unit = "1", .description = "n_b: bridge hazard grows as (c/c_b)^n_b",
+           .range = rt::kNonNegative});
+  v.param("bridge_depth_mm", bridge_depth_mm,
+          {.unit = "mm", .description = "h_b: bridge hazard grows as 1 + h/h_b",
+           .range = rt::kPositive});
+  v.param("bridge_mean_ms", bridge_mean_ms,
+          {.unit = "ms", .description = "t_b: mean life of a debris bridge",
+           .range = rt::kPositive});
+  v.param("bridge_clear_um", bridge_clear_um,
+          {.unit = "um", .description = "a back-off of the tip this large breaks a bridge",
+           .range = rt::kPositive});
+  v.param("tube_guide_mm", tube_guide_mm,
+          {.unit = "mm", .description = "tube: free length between the guide and the surface",
+           .range = rt::kNonNegative});
+  v.param("vib_amp_ref_um", vib_amp_ref_um,
+          {.unit = "um",
+           .description = "tube: RMS lateral tip deflection at the free length L_ref (0: none)",
+           .range = rt::kNonNegative});
+  v.param("vib_len_ref_mm", vib_len_ref_mm,
+          {.unit = "mm", .description = "tube: reference free length L_ref",
+           .range = rt::kPositive});
+  v.param("vib_amp_exp", vib_amp_exp,
+          {.unit = "1", .description = "tube: deflection grows as (L/L_ref)^this",
+           .range = rt::kNonNegative});
+  v.param("vib_freq_ref_hz", vib_freq_ref_hz,
+          {.unit = "Hz",
+           .description = "tube: first bending frequency at L_ref (scales as (L_ref/L)^2)",
+           .range = rt::kPositive});
+  v.param("contact_at_depth_mm", contact_at_depth_mm,
+          {.unit = "mm",
+           .description = "injection: a hard contact meets the tip at this hole depth (<= 0: off)"});
+  v.param("contact_clear_um", contact_clear_um,
+          {.unit = "um",
+           .description = "injection: the tip backed off this far from the contact is clear of it",
+           .range = rt::kPositive});
+  v.param("contact_persistent", contact_persistent,
+          {.unit = "",
+           .description = "injection: the contact stays (every re-approach meets it again)"});
   v.param(
       "arc_p0", arc_p0,
       {.unit = "1", .description = "arc probability floor p_a0", .range = rt::closed(0.0, 1.0)});
@@ -158,8 +208,11 @@ void SimParams::visit(rt::ParamVisitor& outer) {
   v.param("tool_width_mm", tool_width_mm, {.unit = "mm", .description = "block width"});
   v.param("tool_length_mm", tool_length_mm, {.unit = "mm", .description = "block length"});
   v.param("wire_d_mm", wire_d_mm, {.unit = "mm", .description = "wire diameter D"});
-  v.param("electrode_length_mm", electrode_length_mm,
-          {.unit = "mm", .description = "electrode length at start", .range = rt::kPositive});
+  // Outside LoadTimeOnly: the retained electrode length is restored through this (§5a).
+  outer.param("electrode_length_mm", electrode_length_mm,
+              {.unit = "mm",
+               .description = "electrode length; reads the length left, a runtime write sets it",
+               .range = rt::kNonNegative});
   v.param(
       "work_thickness_mm", work_thickness_mm,
       {.unit = "mm", .description = "through at this depth (0: blind)", .range = rt::kNonNegative});

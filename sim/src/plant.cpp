@@ -76,6 +76,8 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   axes_[2].reset(p.start_gap_um * 1e-3 + hole_bottom_mm_);
   jump_low_z_mm_ = axes_[2].position_mm();
   axis_step_ns_ = std::max<std::int64_t>(1, to_ns(p.axis_step_us));
+  working_gap_um_ = model_.no_ignition_gap_um(p.wait_time_us, 0.0);
+  contact_ = p.contact_at_depth_mm > 0.0 ? Contact::kArmed : Contact::kOff;
   rab_ = RabWindow(to_ns(p.rab_window_ms * 1e3));
   wire_monitor_ = WireBreakMonitor(
       to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab, to_ns(p.wire_break_rab_ms * 1e3),
@@ -122,6 +124,7 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
     }
     axes_[2].step(vz, dt);
   }
+  track_short_events();
   const double z = axes_[2].position_mm();
   const double gap = front_gap_um(z);
   const double h_flush = tool_ == Tool::kWire ? 0.0 : depth_mm();
@@ -248,7 +251,11 @@ void Plant::start_pulse(std::int64_t t_ns) noexcept {
                       is_arc(state_.last_class)};
   const PulseDraw draw{uniform(seed_, Stream::kDebrisShort, k), uniform(seed_, Stream::kArc, k),
                        uniform(seed_, Stream::kTd, k), uniform(seed_, Stream::kArcTd, k)};
-  const PulseOutcome out = model_.classify(in, draw);
+  const ShortCause forced = short_event(t_ns, k, gap_front, c);
+  const PulseOutcome out =
+      forced == ShortCause::kNone
+          ? model_.classify(in, draw)
+          : PulseOutcome{PulseClass::kShort, 0.0, forced == ShortCause::kBridge};
 
   const double on_us = cmd_.on_time_us > 0.0 ? cmd_.on_time_us : p.default_on_time_us;
   const std::int64_t off_ns = std::max<std::int64_t>(
@@ -372,6 +379,12 @@ void Plant::set_debris(double c) noexcept {
   publish();
 }
 
+void Plant::set_electrode_length_mm(double mm) noexcept {
+  wear_length_mm_ = params_.electrode_length_mm - mm;
+  if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
+  publish();
+}
+
 void Plant::publish() noexcept {
   const double q = params_.encoder_um * 1e-3;
   auto quantise = [q](double x) { return q > 0.0 ? std::round(x / q) * q : x; };
@@ -388,6 +401,8 @@ void Plant::publish() noexcept {
   state_.mean_current_a = current_sum_a_;
   state_.flush_effective = flush_effective();
   state_.rab = rab_.rab(state_.now.count());
+  state_.contact = contact_ == Contact::kMet &&
+                   (tip_z_mm() - contact_tip_mm_) * 1e3 < params_.contact_clear_um;
 }
 
 }  // namespace edm::sim

@@ -42,7 +42,32 @@ std::vector<rt::ParamError> SimDriver::configure(const rt::BlockSetup& setup) {
   }
   plant_ = std::make_unique<Plant>(params_.plant, static_cast<std::uint64_t>(params_.seed));
   started_ = false;
+  electrode_left_mm_.store(plant_->state().electrode_length_mm, std::memory_order_relaxed);
+  // The index the registry uses for io.electrode_length_mm (visit order of SimDriverParams).
+  struct Find final : rt::ParamVisitor {
+    std::size_t n = 0, at = 0;
+    void on_param(std::string_view name, rt::ParamRef, rt::ParamSpec) override {
+      if (name == "electrode_length_mm") at = n;
+      ++n;
+    }
+  } find;
+  SimDriverParams copy = params_;
+  copy.visit(find);
+  electrode_param_index_ = find.at;
   return {};
+}
+
+void SimDriver::params_changed() noexcept {
+  if (!plant_) return;
+  plant_->set_electrode_length_mm(params_.plant.electrode_length_mm);
+  electrode_left_mm_.store(plant_->state().electrode_length_mm, std::memory_order_relaxed);
+}
+
+rt::ParamValue SimDriver::read_param(std::size_t index) const {
+  if (plant_ && index == electrode_param_index_) {
+    return rt::ParamValue::of_real(electrode_left_mm_.load(std::memory_order_relaxed));
+  }
+  return BlockWithParams::read_param(index);
 }
 
 void SimDriver::activate() noexcept { started_ = false; }
@@ -129,6 +154,7 @@ void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
   y_mm_.set(st.y_mm);
   z_mm_.set(st.z_mm);
   electrode_mm_.set(st.electrode_length_mm);
+  electrode_left_mm_.store(st.electrode_length_mm, std::memory_order_relaxed);
   depth_mm_.set(st.depth_mm);
   wall_radius_mm_.set(st.wall_radius_mm);
   wire_broken_.set(st.wire_broken);

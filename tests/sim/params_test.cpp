@@ -83,17 +83,18 @@ TEST(SimParams, validate_names_the_bad_fields) {
   EXPECT_EQ(errs.size(), 2U);
 }
 
-// The plant resolves its parameters once: every one is load time only.
-TEST(SimParams, every_field_is_load_time_only) {
+// The plant resolves its parameters once: every one is load time only, but the electrode length
+// a retain store restores at start (docs/simulator.md §5a).
+TEST(SimParams, every_field_but_the_electrode_length_is_load_time_only) {
   struct Check final : edm::rt::ParamVisitor {
-    int runtime_writable = 0;
-    void on_param(std::string_view, edm::rt::ParamRef, edm::rt::ParamSpec spec) override {
-      runtime_writable += spec.load_time_only ? 0 : 1;
+    std::vector<std::string> runtime_writable;
+    void on_param(std::string_view name, edm::rt::ParamRef, edm::rt::ParamSpec spec) override {
+      if (!spec.load_time_only) runtime_writable.emplace_back(name);
     }
   } check;
   SimParams p;
   p.visit(check);
-  EXPECT_EQ(check.runtime_writable, 0);
+  EXPECT_EQ(check.runtime_writable, std::vector<std::string>{"electrode_length_mm"});
 }
 
 TEST(SimParams, wire_break_shape_must_be_a_whole_number_in_range) {

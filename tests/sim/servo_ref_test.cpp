@@ -8,13 +8,13 @@
 #include <chrono>
 #include <string>
 
-#include "edm/blocks/register.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/task.hpp"
 #include "edm/sim/params.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "sim_registries.hpp"
 
 namespace edm::sim {
 namespace {
@@ -22,12 +22,7 @@ namespace {
 using namespace std::chrono_literals;
 
 std::unique_ptr<rt::Runtime> build(const std::string& preset, double servo_ref_v) {
-  static const auto regs = [] {
-    std::pair<rt::BlockRegistry, rt::DriverRegistry> r;
-    blocks::register_builtin_blocks(r.first);
-    register_sim_driver(r.second);
-    return r;
-  }();
+  const auto& regs = test::sim_registries();
   const std::string yaml = R"(version: 1
 machine:
   name: servo

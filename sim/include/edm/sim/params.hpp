@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/6";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/7";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
@@ -54,6 +54,36 @@ struct SimParams {
   double debris_k_s{500.0};      // sigmoid steepness
   double debris_short_us{50.0};  // t_bs, duration of a debris short
 
+  // --- Short events at the servo's gap (docs/simulator.md §4a; edm-sim-params/7) ---
+  // Debris bridges: a bridge forms at the hazard λ_b = bridge_rate_hz (c/c_b)^n_b (1 + h/h_b)
+  // while the electrode is in the working gap; every pulse of it is a debris short until it
+  // breaks after Exp(bridge_mean_ms) or the tip backs off bridge_clear_um from where it formed.
+  // Tube vibration: the tip's lateral deflection δ ~ N(0, σ(L)²), σ = vib_amp_ref_um
+  // (L/vib_len_ref_mm)^vib_amp_exp, L = tube_guide_mm + the tip's depth below the surface,
+  // touches the wall when |δ| > the side gap: contacts arrive at Rice's up-crossing rate
+  // 2 f1 e^(−u²/2), u = side gap/σ, f1 = vib_freq_ref_hz (L_ref/L)², each a hard short.
+  bool short_events{true};  // false: neither (the model before edm-sim-params/7, exactly)
+  double bridge_rate_hz{12.0};      // λ_b0, bridges/s at c = c_b at the surface [bk, cal]
+  double bridge_debris_ref{0.4};    // c_b
+  double bridge_debris_exp{2.0};    // n_b: two-body (particle meets particle)
+  double bridge_depth_mm{10.0};     // h_b: the side gap adds a front's worth per h_b of depth
+  double bridge_mean_ms{1.0};       // t_b, mean life of a bridge
+  double bridge_clear_um{10.0};     // a back-off this large shears a bridge
+  double tube_guide_mm{5.0};        // free tube between the guide and the work surface [bk]
+  double vib_amp_ref_um{20.0};      // σ at vib_len_ref_mm [bk, cal]
+  double vib_len_ref_mm{50.0};      // L_ref
+  double vib_amp_exp{1.5};          // σ ∝ L^this
+  double vib_freq_ref_hz{200.0};    // f1 of the free length at L_ref (brass Ø1.0/0.3 tube)
+
+  // --- Injected contact (scenarios, tests; off by default) ---
+  // When the hole reaches contact_at_depth_mm (> 0), a hard contact (a chip) meets the tip:
+  // every pulse is a short while the tip is less than contact_clear_um above where it met it.
+  // Not persistent: the first back-off by contact_clear_um clears it for good. Persistent: the
+  // chip stays there; every re-approach within contact_clear_um meets it again.
+  double contact_at_depth_mm{0.0};  // <= 0: off
+  double contact_clear_um{50.0};
+  bool contact_persistent{false};
+
   // --- Arcs (§6.2 step 3) ---
   double arc_p0{0.01};
   double arc_k_t{0.3};     // weight of the not-yet-deionised channel
@@ -83,7 +113,10 @@ struct SimParams {
   double tool_width_mm{10.0};         // block
   double tool_length_mm{10.0};        // block
   double wire_d_mm{0.25};             // wire diameter D
-  double electrode_length_mm{300.0};  // tube/block length sticking out; consumed by wear
+  // Tube/block length sticking out, consumed by wear. The one parameter writable at run time:
+  // a write says "the electrode now measures this" (a retained length restored at start, an
+  // electrode change); the driver reads the length left back through it (docs/simulator.md §5a).
+  double electrode_length_mm{300.0};
   double work_thickness_mm{0.0};      // tube/block: through at this depth; 0 = blind (no limit)
   double start_gap_um{100.0};         // tip above the work surface at start
   double initial_depth_mm{0.0};       // a hole already there (tip start_gap_um above its bottom)

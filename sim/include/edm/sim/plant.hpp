@@ -74,6 +74,10 @@ struct PlantState {
   double gap_voltage_filtered_v{0.0};        // U_av: 1st-order filter of the gap voltage
   double flush_effective{0.0};               // F_eff = F x strength x drop (0 = off)
   std::uint64_t budget_overruns{0};          // advances that hit max_pulses_per_advance
+  // Short events (docs/simulator.md §4a):
+  bool contact{false};                   // the injected contact holds the gap short now
+  std::uint64_t bridges{0};              // debris bridges formed so far
+  std::uint64_t vibration_contacts{0};   // lateral tube contacts so far
 };
 
 class Plant {
@@ -100,6 +104,10 @@ class Plant {
   void release_gap() noexcept;
   void set_depth_mm(double h) noexcept;
   void set_debris(double c) noexcept;
+  /// The electrode now measures `mm` (a retained length restored at start, an electrode
+  /// change): the wear becomes electrode_length_mm − mm, so the tip sits that much above where a
+  /// new electrode's would. RT-safe.
+  void set_electrode_length_mm(double mm) noexcept;
 
   /// Tube hole wall: radius of bin j (angle 2πj/kWallBins from +x) at the tip, mm.
   static constexpr std::size_t kWallBins = 64;
@@ -127,6 +135,15 @@ class Plant {
   /// simulator models one hole at a time, so a row of holes can be drilled).
   void track_hole() noexcept;
   void start_pulse(std::int64_t t_ns) noexcept;
+  /// What forces pulse k to be a short before the gap physics is asked (plant_short_events.cpp):
+  /// the injected contact, a debris bridge or a tube contact in progress or starting now.
+  enum class ShortCause : std::uint8_t { kNone, kContact, kBridge, kVibration };
+  [[nodiscard]] ShortCause short_event(std::int64_t t_ns, std::uint64_t k, double gap_um,
+                                       double debris) noexcept;
+  /// Between pulses: a back-off clears the injected contact (unless persistent) and breaks a
+  /// bridge, even while the generator is off.
+  void track_short_events() noexcept;
+  [[nodiscard]] double tip_z_mm() const noexcept;  // at the last axis step
   void enter_phase(Phase ph, std::int64_t t_ns, std::int64_t dur_ns) noexcept;
   void on_phase_end(std::int64_t t_ns) noexcept;
   void remove(double volume_mm3, double wear_mm3, double gap_um, int site) noexcept;
@@ -174,6 +191,16 @@ class Plant {
   std::int64_t last_discharge_end_ns_{-1'000'000'000};
   std::int64_t pulses_this_advance_{0};
   bool paused_{false};
+
+  // Short events: at most one bridge or tube contact at a time, and the injected contact.
+  ShortCause episode_{ShortCause::kNone};
+  std::int64_t episode_end_ns_{0};
+  double episode_tip_mm_{0.0};  // tip z where the bridge formed
+  std::int64_t last_pulse_ns_{0};
+  double working_gap_um_{0.0};  // beyond it a clean gap never ignites: nothing forms there
+  enum class Contact : std::uint8_t { kArmed, kMet, kCleared, kOff };
+  Contact contact_{Contact::kOff};
+  double contact_tip_mm_{0.0};  // tip z where the injected contact was met
 
   // Sensors and WEDM.
   RabWindow rab_{};

@@ -22,6 +22,9 @@ enum class Stream : std::uint64_t {
   kRemovalScatter = 5,  // crater volume scatter (normal, two uniforms per pulse)
   kSite = 6,            // discharge site when the wall bins compete (orbit)
   kWireBreak = 7,       // WEDM: the tolerated damage of the abnormal-discharge rupture hazard
+  kShortEvent = 8,      // a short event (debris bridge, tube contact) starts at this pulse
+  kShortEventKind = 9,  // which of the competing events it is
+  kShortEventLife = 10, // how long it lasts
 };
 
 inline constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ULL;

@@ -25,9 +25,14 @@
 // Safe state: in FAULT and ESTOP the generator is off whatever the pins say; in ESTOP the axes
 // are also held at zero velocity (in FAULT the programs back Z off through vz_cmd).
 //
+// Retain: `io.electrode_length_mm` is the one runtime-writable parameter. It reads the length
+// left; a write (the retain store's restore at start, after activate()) sets it, so listing it
+// under `retain.variables` carries the electrode's length across a restart.
+//
 // RT-safety: read_inputs/write_outputs/enter_safe_state/fault are RT-safe. Thread-safety: the
 // I/O task's thread only.
 
+#include <atomic>
 #include <memory>
 #include <optional>
 #include <string>
@@ -63,12 +68,22 @@ class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt
   void enter_safe_state(const edm::rt::SafeStateRequest& request) noexcept override;
   [[nodiscard]] edm::rt::IoFault fault() const noexcept override;
   bool set_seed(std::uint64_t seed) override;
+  /// `electrode_length_mm` reads the plant's length left (what a retain store saves); every
+  /// other parameter reads its accepted value. Non-RT (any thread: the length is atomic).
+  [[nodiscard]] edm::rt::ParamValue read_param(std::size_t index) const override;
 
   /// The plant (tests and benchmarks). Valid after configure().
   [[nodiscard]] Plant& plant() noexcept { return *plant_; }
 
+ protected:
+  /// A write of `electrode_length_mm` (the only runtime-writable one) sets the plant's length
+  /// left. RT-safe.
+  void params_changed() noexcept override;
+
  private:
   std::unique_ptr<Plant> plant_;
+  std::size_t electrode_param_index_{0};
+  std::atomic<double> electrode_left_mm_{0.0};  // published for read_param on other threads
   bool started_{false};
   edm::rt::TimePoint origin_{};  // clock time of the first latch = plant time 0
 
