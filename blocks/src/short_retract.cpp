@@ -18,20 +18,21 @@ double distance(double ax, double ay, double az, double bx, double by, double bz
 }  // namespace
 
 void ShortRetract::visit_pins(rt::PinVisitor& v) {
-  v.input("x_mm", x_mm_, "mm");
-  v.input("y_mm", y_mm_, "mm");
-  v.input("z_mm", z_mm_, "mm");
-  v.input("short_detected", short_detected_);
-  v.input("enable", enable_);
-  v.input("reset", reset_);
-  v.output("active", active_);
-  v.output("x_sp_mm", x_sp_mm_, "mm");
-  v.output("y_sp_mm", y_sp_mm_, "mm");
-  v.output("z_sp_mm", z_sp_mm_, "mm");
-  v.output("v_scale", v_scale_);
-  v.output("tries", tries_out_);
-  v.output("alarm", alarm_out_);
-  v.output("hold", hold_out_);
+  v.input("x_mm", x_mm, "mm");
+  v.input("y_mm", y_mm, "mm");
+  v.input("z_mm", z_mm, "mm");
+  v.input("short_detected", short_detected);
+  v.input("enable", enable);
+  v.input("reset", reset);
+  v.output("active", active);
+  v.output("x_sp_mm", x_sp_mm, "mm");
+  v.output("y_sp_mm", y_sp_mm, "mm");
+  v.output("z_sp_mm", z_sp_mm, "mm");
+  v.output("v_scale", v_scale);
+  v.output("tries", tries);
+  v.output("retracts", retracts);
+  v.output("alarm", alarm);
+  v.output("hold", hold);
 }
 
 std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup) {
@@ -59,11 +60,12 @@ void ShortRetract::activate() noexcept {
   alarm_ = false;
   final_ = false;
   ramp_k_ = 0;
-  active_.set(false);
-  v_scale_.set(1.0);
-  tries_out_.set(0);
-  alarm_out_.set(false);
-  hold_out_.set(false);
+  retracts.set(0);
+  active.set(false);
+  v_scale.set(1.0);
+  tries.set(0);
+  alarm.set(false);
+  hold.set(false);
 }
 
 void ShortRetract::params_changed() noexcept { compute_ramp(); }
@@ -136,7 +138,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
   if (history_.capacity() == 0) {  // not configured
     return rt::BlockStatus::kFault;
   }
-  if (reset_.get()) {
+  if (reset.get()) {
     alarm_ = false;
     final_ = false;
     tries_ = 0;
@@ -145,15 +147,15 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
     }
   }
   bool input_fault = false;
-  double v_scale = 1.0;
-  if (!enable_.get()) {
+  double v_scale_now = 1.0;
+  if (!enable.get()) {
     state_ = State::kIdle;
     history_.forget();  // O(1): record() never reads a slot it has not written
     short_count_ = 0;
     final_ = false;
-    const double x = x_mm_.get();
-    const double y = y_mm_.get();
-    const double z = z_mm_.get();
+    const double x = x_mm.get();
+    const double y = y_mm.get();
+    const double z = z_mm.get();
     if (std::isfinite(x) && std::isfinite(y) && std::isfinite(z)) {
       sp_[0] = x;
       sp_[1] = y;
@@ -167,14 +169,14 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
     if (state_ == State::kRetract || state_ == State::kHold) {
       short_count_ = 0;
     } else {
-      short_count_ = short_detected_.get() ? std::min(short_count_ + 1, p.short_cycles) : 0;
+      short_count_ = short_detected.get() ? std::min(short_count_ + 1, p.short_cycles) : 0;
       sustained = short_count_ >= p.short_cycles;
     }
     const bool recording = state_ == State::kIdle || state_ == State::kRamp;
     if (recording) {
-      const double x = x_mm_.get();
-      const double y = y_mm_.get();
-      const double z = z_mm_.get();
+      const double x = x_mm.get();
+      const double y = y_mm.get();
+      const double z = z_mm.get();
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
         input_fault = true;
         sustained = false;  // no valid head to retract from this cycle
@@ -196,6 +198,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
         ++tries_;
       }
       start_retract(/*from_head=*/recording);
+      retracts.set(retracts.get() + 1);
     }
 
     switch (state_) {
@@ -207,7 +210,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
           --seg_;
         }
         set_point_at(pos_s_);
-        v_scale = 0.0;
+        v_scale_now = 0.0;
         if (pos_s_ <= target_s_) {
           state_ = final_ ? State::kHold : State::kResume;
         }
@@ -219,7 +222,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
         while (seg_ + 2 < history_.size() && at(seg_ + 1).s < pos_s_) {
           ++seg_;
         }
-        v_scale = 0.0;
+        v_scale_now = 0.0;
         if (pos_s_ >= s_head) {
           const PathPoint& h = head();
           sp_[0] = h.x;
@@ -227,7 +230,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
           sp_[2] = h.z;
           ramp_k_ = 0;
           state_ = ramp_cycles_ > 0 ? State::kRamp : State::kIdle;
-          v_scale = ramp_cycles_ > 0 ? 0.0 : 1.0;
+          v_scale_now = ramp_cycles_ > 0 ? 0.0 : 1.0;
         } else {
           set_point_at(pos_s_);
         }
@@ -238,26 +241,26 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
         if (ramp_k_ >= ramp_cycles_) {
           state_ = State::kIdle;
         } else {
-          v_scale = static_cast<double>(ramp_k_) / static_cast<double>(ramp_cycles_);
+          v_scale_now = static_cast<double>(ramp_k_) / static_cast<double>(ramp_cycles_);
         }
         break;
       case State::kHold:
-        v_scale = 0.0;
+        v_scale_now = 0.0;
         break;
     }
   }
-  const bool active =
+  const bool active_now =
       state_ == State::kRetract || state_ == State::kResume || state_ == State::kHold;
-  if (!input_fault || active) {
-    active_.set(active);
-    x_sp_mm_.set(sp_[0]);
-    y_sp_mm_.set(sp_[1]);
-    z_sp_mm_.set(sp_[2]);
-    v_scale_.set(v_scale);
+  if (!input_fault || active_now) {
+    active.set(active_now);
+    x_sp_mm.set(sp_[0]);
+    y_sp_mm.set(sp_[1]);
+    z_sp_mm.set(sp_[2]);
+    v_scale.set(v_scale_now);
   }
-  tries_out_.set(tries_);
-  alarm_out_.set(alarm_);
-  hold_out_.set(alarm_);
+  tries.set(tries_);
+  alarm.set(alarm_);
+  hold.set(alarm_);
   return alarm_ || input_fault ? rt::BlockStatus::kFault : rt::BlockStatus::kOk;
 }
 

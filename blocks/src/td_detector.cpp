@@ -66,14 +66,19 @@ rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
   sum_.n_total += c.n_total - old.n_total;
 
   const bool hold = params_.hold_when_empty;
-  if (c.td_count > 0) {
-    td_raw_us.set(static_cast<double>(c.td_sum_ns) / static_cast<double>(c.td_count) / kNsPerUs);
+  const double short_ns = params_.short_td_us * kNsPerUs;
+  const auto mean_us = [short_ns](std::int64_t sum_ns, std::int64_t ignited, std::int64_t shorts) {
+    return (static_cast<double>(sum_ns) + static_cast<double>(shorts) * short_ns) /
+           static_cast<double>(ignited + shorts) / kNsPerUs;
+  };
+  if (c.td_count + c.n_short > 0) {
+    td_raw_us.set(mean_us(c.td_sum_ns, c.td_count, c.n_short));
   } else if (!hold) {
     td_raw_us.set(params_.empty_td_us);
   }
-  const bool valid_now = sum_.td_count > 0;
+  const bool valid_now = sum_.td_count + sum_.n_short > 0;
   if (valid_now) {
-    td_us.set(static_cast<double>(sum_.td_sum_ns) / static_cast<double>(sum_.td_count) / kNsPerUs);
+    td_us.set(mean_us(sum_.td_sum_ns, sum_.td_count, sum_.n_short));
   } else if (!hold) {
     td_us.set(params_.empty_td_us);
   }

@@ -46,12 +46,30 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
            .range = rt::kNonNegative});
   v.param("overtravel_mm", overtravel_mm,
           {.unit = "mm", .description = "feed on after breakthrough", .range = rt::kNonNegative});
+  v.param("short_ratio_limit", short_ratio_limit,
+          {.unit = "",
+           .description = "the Td window reads short at this fraction of shorted pulses",
+           .range = rt::open_closed(0.0, 1.0)});
+  v.param("short_retracts_max", short_retracts_max,
+          {.unit = "",
+           .description = "retracts allowed within short_retracts_window; one more: alarm 150",
+           .range = rt::closed(1, kMaxShortRetracts)});
+  v.param("short_retracts_window", short_retracts_window,
+          {.unit = "s",
+           .description = "the time over which short retracts are counted",
+           .range = rt::kPositive});
+  v.param("short_backoff_mm", short_backoff_mm,
+          {.unit = "mm",
+           .description = "Z backs off this far on alarm 150, generator off, then holds",
+           .range = rt::kNonNegative});
 }
 
 DeepHoleDrill::DeepHoleDrill()
     : td_(add_child<blocks::TdDetector>("td")),
       gap_(add_child<blocks::GapControllerP>("gap")),
-      wear_(add_child<blocks::WearCompensator>("wear")) {
+      wear_(add_child<blocks::WearCompensator>("wear")),
+      retract_(add_child<blocks::ShortRetract>("retract")),
+      zloop_(add_child<blocks::PositionLoop>("zloop")) {
   // This program's defaults for its children (variables of their own, set in YAML).
   blocks::GapControllerPParams gp;
   gp.idle_feed_mm_s = -DeepHoleDrillParams{}.approach_speed_mm_s;
@@ -59,6 +77,14 @@ DeepHoleDrill::DeepHoleDrill()
   blocks::WearCompensatorParams wp;
   wp.wear_ratio_default = 0.6;
   wear_.set_params(wp);
+  blocks::ShortRetractParams rp;
+  rp.short_cycles = 1;   // the detection window is td's
+  rp.max_tries = 1000;   // the retract budget is this program's (short_retracts_max in a window)
+  retract_.set_params(rp);
+  blocks::PositionLoopParams zp;
+  zp.kv = 50.0;
+  zp.v_max_mm_s = 10.0;
+  zloop_.set_params(zp);
 }
 
 void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
@@ -85,6 +111,18 @@ void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
   v.output("breakthrough", breakthrough);
   v.output("reset_wear", reset_wear);
   v.output("vz_servo_cmd_mm_s", vz_servo_cmd_mm_s, "mm/s");
+  v.output("gap_short", gap_short);
+  v.output("retract_enable", retract_enable);
+  v.output("retract_vff_mm_s", retract_vff_mm_s, "mm/s");
+  v.output("short_retracts", short_retracts);
+  v.output("short_time_s", short_time_s, "s");
+}
+
+std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& setup) {
+  machine_ = setup.machine;
+  source_name_ = std::string(setup.instance);
+  source_ = source_name_.c_str();
+  return {};
 }
 
 void DeepHoleDrill::bind_self() {
@@ -100,6 +138,13 @@ void DeepHoleDrill::bind_self() {
   wear_.wear_ratio.follow(wear_ratio);
   wear_.enable.follow(enable_wear_comp);
   wear_.reset_wear.connect(reset_wear);
+  retract_.z_mm.follow(z_mm);
+  retract_.short_detected.connect(gap_short);
+  retract_.enable.connect(retract_enable);
+  zloop_.x_ref_mm.connect(retract_.z_sp_mm);
+  zloop_.v_ff_mm_s.connect(retract_vff_mm_s);
+  zloop_.x_mm.follow(z_mm);
+  zloop_.enable.connect(retract_.active);
 }
 
 void DeepHoleDrill::activate_self() noexcept {
@@ -118,6 +163,13 @@ void DeepHoleDrill::activate_self() noexcept {
   touch_z_mm.set(0.0);
   wear_mm.set(0.0);
   done.set(false);
+  gap_short.set(false);
+  retract_enable.set(false);
+  retract_vff_mm_s.set(0.0);
+  short_retracts.set(0);
+  short_time_s.set(0.0);
+  last_retracts_ = 0;
+  n_retract_starts_ = 0;
   set_state(State::kIdle);
 }
 
@@ -136,6 +188,9 @@ void DeepHoleDrill::begin_cycle() noexcept {
   breakthrough.set(false);
   depth_reached_mm.set(0.0);
   wear_mm.set(0.0);
+  short_retracts.set(0);
+  short_time_s.set(0.0);
+  n_retract_starts_ = 0;
   set_state(State::kApproach);
 }
 
@@ -144,9 +199,13 @@ void DeepHoleDrill::begin_retract(double target_z) noexcept {
   set_state(State::kRetract);
 }
 
-void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
+void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcept {
   gen_on.set(false);
-  if (state_value_ == State::kDrill || state_value_ == State::kBreakthrough) {
+  retract_enable.set(false);
+  if (state_value_ == State::kDrill && request.cause == rt::AlarmCode::kShortCircuit) {
+    begin_retract(z_mm.get() + params_.short_backoff_mm);  // back off, then hold
+    safe_retract_ = true;
+  } else if (state_value_ == State::kDrill || state_value_ == State::kBreakthrough) {
     begin_retract(touch_z_mm.get() + params_.clearance_mm);
     safe_retract_ = true;
   } else if (state_value_ == State::kApproach) {
@@ -158,6 +217,54 @@ void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& /*request*/) noe
   } else {
     vz_cmd_mm_s.set(0.0);
   }
+}
+
+bool DeepHoleDrill::too_many_retracts(rt::TimePoint now) noexcept {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < n_retract_starts_; ++k) {
+    if (now - retract_starts_[k] <= params_.short_retracts_window) {
+      retract_starts_[kept++] = retract_starts_[k];
+    }
+  }
+  retract_starts_[kept++] = now;  // fits: more than short_retracts_max (≤ 16) raises the alarm
+  n_retract_starts_ = kept;
+  return static_cast<std::int64_t>(kept) > params_.short_retracts_max;
+}
+
+bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
+                                 rt::BlockStatus& status) noexcept {
+  retract_enable.set(true);
+  gap_short.set(td_.valid.get() && td_.short_ratio.get() >= params_.short_ratio_limit);
+  status = rt::worst(status, step(retract_, ctx));
+  const bool active = retract_.active.get();
+  const std::int64_t started = retract_.retracts.get();
+  if (started != last_retracts_) {  // a retract began this cycle (also from RESUME)
+    last_retracts_ = started;
+    if (too_many_retracts(ctx.release)) {
+      // Alarm 150: the machine goes to FAULT; the safe state backs Z off and holds.
+      if (machine_ != nullptr) {
+        machine_->raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, ctx.release,
+                         source_, "short circuit: too many retracts within the window",
+                         static_cast<double>(n_retract_starts_)});
+      } else {
+        safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
+      }
+    } else {
+      short_retracts.set(short_retracts.get() + 1);
+    }
+  }
+  if (active || retract_.v_scale.get() < 1.0) {
+    short_time_s.set(short_time_s.get() + ctx.dt_s);
+  }
+  if (!active) {
+    last_z_sp_mm_ = z;
+    return false;
+  }
+  const double sp = retract_.z_sp_mm.get();
+  retract_vff_mm_s.set(ctx.dt_s > 0.0 ? (sp - last_z_sp_mm_) / ctx.dt_s : 0.0);
+  last_z_sp_mm_ = sp;
+  status = rt::worst(status, step(zloop_, ctx));
+  return true;
 }
 
 rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept {
@@ -209,19 +316,22 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       status = rt::worst(status, step(td_, ctx));
     }
     status = rt::worst(status, step(gap_, ctx));
-    if (vz_servo_mm_s.connected()) {
-      const double v = vz_servo_mm_s.get();
-      const double limit_down = -gap_.params().v_feed_max_mm_s;
-      const double limit_up = gap_.params().v_retract_max_mm_s;
-      if (std::isfinite(v)) {
-        vz_servo_cmd_mm_s.set(std::clamp(v, limit_down, limit_up));
-      } else {
-        vz_servo_cmd_mm_s.set(0.0);
-        status = rt::worst(status, rt::BlockStatus::kFault);
+    const bool retracting = handle_short(ctx, z, status);
+    if (!retracting) {
+      if (vz_servo_mm_s.connected()) {
+        const double v = vz_servo_mm_s.get();
+        const double limit_down = -gap_.params().v_feed_max_mm_s;
+        const double limit_up = gap_.params().v_retract_max_mm_s;
+        if (std::isfinite(v)) {
+          vz_servo_cmd_mm_s.set(std::clamp(v, limit_down, limit_up));
+        } else {
+          vz_servo_cmd_mm_s.set(0.0);
+          status = rt::worst(status, rt::BlockStatus::kFault);
+        }
       }
+      status = rt::worst(status, step(wear_, ctx));
+      reset_wear.set(false);
     }
-    status = rt::worst(status, step(wear_, ctx));
-    reset_wear.set(false);
     // The electrode front is z − accumulated wear: the compensated axis travels further than the
     // front by the length the compensator has added for the wear, so the front (≈ the hole
     // bottom, one working gap away) has gone (touch_z − z) − wear_mm below the touch point.
@@ -237,10 +347,19 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       breakthrough.set(true);
       breakthrough_z_mm_ = z;
       set_state(State::kBreakthrough);
-    } else {
+    } else if (state_value_ == State::kDrill) {
       gen_on.set(true);
-      vz_cmd_mm_s.set(wear_.vz_out_mm_s.get());
+      // Retracting: zloop follows the retract's setpoint. Else the servo's command, which ramps
+      // back in after a retract (v_scale 0 → 1). While the window reads short, never toward the
+      // work.
+      const double v = retracting ? zloop_.v_cmd_mm_s.get()
+                                  : wear_.vz_out_mm_s.get() * retract_.v_scale.get();
+      vz_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
     }
+  }
+  if (state_value_ != State::kDrill && retract_enable.get()) {
+    retract_enable.set(false);  // the history is the path of this hole's DRILL only
+    status = rt::worst(status, step(retract_, ctx));
   }
 
   if (state_value_ == State::kBreakthrough) {

@@ -116,9 +116,10 @@ TEST_F(TdDetectorTest, window_matches_brute_force_over_random_cycles) {
       sh += history[i].n_short;
       t += history[i].td_count + history[i].n_open + history[i].n_short;
     }
-    ASSERT_EQ(valid(), n > 0) << "k = " << k;
-    if (n > 0) {
-      last_td = static_cast<double>(s) / static_cast<double>(n) / 1000.0;
+    // Gap truth: a short is a pulse with Td = short_td_us = 0, pooled with the ignited ones.
+    ASSERT_EQ(valid(), n + sh > 0) << "k = " << k;
+    if (n + sh > 0) {
+      last_td = static_cast<double>(s) / static_cast<double>(n + sh) / 1000.0;
     }
     ASSERT_DOUBLE_EQ(td(), last_td) << "k = " << k;
     if (t > 0) {
@@ -139,20 +140,20 @@ TEST_F(TdDetectorTest, ratios_use_n_total_or_the_sum_of_the_classes) {
   step({.td_sum_ns = 10'000, .td_count = 2, .n_open = 3, .n_short = 1, .n_total = 40});
   EXPECT_DOUBLE_EQ(open_ratio(), 6.0 / 50.0);
   EXPECT_DOUBLE_EQ(short_ratio(), 2.0 / 50.0);
-  EXPECT_DOUBLE_EQ(td(), 70.0 / 8.0);
+  EXPECT_DOUBLE_EQ(td(), 70.0 / 10.0) << "8 ignited and 2 shorts (Td 0)";
   // Only open pulses: no ignition this cycle, but the window still has ignited
   // pulses.
   step({.n_open = 10});
   EXPECT_DOUBLE_EQ(open_ratio(), 13.0 / 50.0);
   EXPECT_DOUBLE_EQ(short_ratio(), 1.0 / 50.0);
-  EXPECT_DOUBLE_EQ(td(), 10.0 / 2.0);
+  EXPECT_DOUBLE_EQ(td(), 10.0 / 3.0);
   EXPECT_TRUE(valid());
   // All open for the whole window: not valid, Td held, open ratio 1.
   step({.n_open = 10});
   EXPECT_DOUBLE_EQ(open_ratio(), 1.0);
   EXPECT_DOUBLE_EQ(short_ratio(), 0.0);
   EXPECT_FALSE(valid());
-  EXPECT_DOUBLE_EQ(td(), 5.0) << "hold_when_empty keeps the last td_us";
+  EXPECT_DOUBLE_EQ(td(), 10.0 / 3.0) << "hold_when_empty keeps the last td_us";
 }
 
 TEST_F(TdDetectorTest, empty_window_holds_by_default_and_never_divides) {
@@ -165,15 +166,15 @@ TEST_F(TdDetectorTest, empty_window_holds_by_default_and_never_divides) {
   EXPECT_DOUBLE_EQ(open_ratio(), 0.0);
   EXPECT_FALSE(valid());
   step({.td_sum_ns = 8'000, .td_count = 2, .n_open = 2, .n_short = 4});
-  EXPECT_DOUBLE_EQ(td(), 4.0);
+  EXPECT_DOUBLE_EQ(td(), 8.0 / 6.0) << "2 ignited (4 us) and 4 shorts (0 us)";
   EXPECT_TRUE(valid());
   EXPECT_EQ(step({}), BlockStatus::kOk);
   EXPECT_TRUE(valid()) << "the ignited cycle is still in the window";
   EXPECT_EQ(step({}),
             BlockStatus::kOk);  // generator off: no pulses in the window
   EXPECT_FALSE(valid());
-  EXPECT_DOUBLE_EQ(td(), 4.0);
-  EXPECT_DOUBLE_EQ(td_raw(), 4.0);
+  EXPECT_DOUBLE_EQ(td(), 8.0 / 6.0);
+  EXPECT_DOUBLE_EQ(td_raw(), 8.0 / 6.0);
   EXPECT_DOUBLE_EQ(open_ratio(), 0.25) << "ratios held too";
   EXPECT_DOUBLE_EQ(short_ratio(), 0.5);
 }
@@ -181,7 +182,7 @@ TEST_F(TdDetectorTest, empty_window_holds_by_default_and_never_divides) {
 TEST_F(TdDetectorTest, empty_window_outputs_empty_td_us_when_not_holding) {
   ASSERT_TRUE(start({.window = 1, .hold_when_empty = false, .empty_td_us = 60.0}).empty());
   step({.td_sum_ns = 8'000, .td_count = 2, .n_open = 2, .n_short = 4});
-  EXPECT_DOUBLE_EQ(td(), 4.0);
+  EXPECT_DOUBLE_EQ(td(), 8.0 / 6.0);
   EXPECT_EQ(step({.n_open = 5}), BlockStatus::kOk);
   EXPECT_FALSE(valid());
   EXPECT_DOUBLE_EQ(td(), 60.0);
@@ -218,7 +219,7 @@ TEST_F(TdDetectorTest, broken_counters_fault_and_are_not_stored) {
   }
   // The bad cycles never entered the sums.
   EXPECT_EQ(step({.td_sum_ns = 20'000, .td_count = 4}), BlockStatus::kOk);
-  EXPECT_DOUBLE_EQ(td(), 60.0 / 8.0);
+  EXPECT_DOUBLE_EQ(td(), 60.0 / 9.0) << "8 ignited and the first cycle's short";
   EXPECT_DOUBLE_EQ(open_ratio(), 1.0 / 10.0);
 }
 
@@ -259,6 +260,26 @@ TEST_F(TdDetectorTest, validate_and_runtime_writes) {
   EXPECT_DOUBLE_EQ(td(), 3.0);
   step({});
   EXPECT_DOUBLE_EQ(td(), 0.0) << "hold switched off at run time: empty_td_us";
+}
+
+// Gap truth (seed 004): a contact reads feedback ≈ 0. A window of nothing but shorts is a valid
+// measurement of Td = short_td_us, far below any reference, so a P law backs off.
+TEST_F(TdDetectorTest, a_window_of_shorts_reads_short_td_and_is_valid) {
+  ASSERT_TRUE(start({.window = 4}).empty());
+  for (int k = 0; k < 4; ++k) {
+    step({.td_sum_ns = 120'000, .td_count = 10});
+  }
+  EXPECT_DOUBLE_EQ(td(), 12.0);
+  for (int k = 0; k < 4; ++k) {
+    step({.n_short = 10});
+  }
+  EXPECT_TRUE(valid());
+  EXPECT_DOUBLE_EQ(td(), 0.0);
+  EXPECT_DOUBLE_EQ(td_raw(), 0.0);
+  EXPECT_DOUBLE_EQ(short_ratio(), 1.0);
+  ASSERT_TRUE(start({.window = 2, .short_td_us = 0.5}).empty());
+  step({.td_sum_ns = 30'000, .td_count = 3, .n_short = 1});
+  EXPECT_DOUBLE_EQ(td(), (30.0 + 0.5) / 4.0) << "a short counts with short_td_us";
 }
 
 }  // namespace

@@ -129,7 +129,11 @@ TEST(NestedParams, BadChildParametersAreRefusedAtTheirLine) {
     ADD_FAILURE() << "accepted";
     return rt::Diagnostic{};
   };
-  const int line = 31;  // the drill block's line in drill-sim-program.yaml
+  // The drill block's line in drill-sim-program.yaml.
+  const std::string text = slurp(kDrillProgram);
+  const auto at = text.find("{name: drill, type: DeepHoleDrill");
+  ASSERT_NE(at, std::string::npos);
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
   rt::Diagnostic d = first_error(with_gap_params("gap: {kg: -1}"));
   EXPECT_EQ(d.loc.line, line) << d.str();
   EXPECT_NE(d.message.find("gap.kg must be > 0 (got -1)"), std::string::npos) << d.str();

@@ -25,6 +25,8 @@
 // Tries: reset to 0 once the head has advanced progress_mm along the path beyond the head at the
 // last retract. A sustained short while tries == max_tries raises alarm and hold instead: the
 // block retracts once more and then stays in HOLD; update() returns kFault while alarm is set.
+// retracts counts every retract started since activate() (tries is reset by progress; this is
+// not), so a consumer can count retracts over a time window.
 // reset = true clears alarm, hold and tries (HOLD → RESUME: walk back to the head).
 // enable = false: IDLE, history and short count cleared (alarm stays latched until reset).
 // The controller must hold its commanded position while active is true (the inputs are not read
@@ -130,20 +132,25 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   void set_point_at(double s) noexcept;
   void compute_ramp() noexcept;
 
-  rt::Input<double> x_mm_;
-  rt::Input<double> y_mm_;
-  rt::Input<double> z_mm_;
-  rt::Input<bool> short_detected_;
-  rt::Input<bool> enable_{true};
-  rt::Input<bool> reset_;
-  rt::Output<bool> active_;
-  rt::Output<double> x_sp_mm_;
-  rt::Output<double> y_sp_mm_;
-  rt::Output<double> z_sp_mm_;
-  rt::Output<double> v_scale_{1.0};
-  rt::Output<std::int64_t> tries_out_;
-  rt::Output<bool> alarm_out_;
-  rt::Output<bool> hold_out_;
+ public:
+  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
+  rt::Input<double> x_mm;
+  rt::Input<double> y_mm;
+  rt::Input<double> z_mm;
+  rt::Input<bool> short_detected;
+  rt::Input<bool> enable{true};
+  rt::Input<bool> reset;
+  rt::Output<bool> active;
+  rt::Output<double> x_sp_mm;
+  rt::Output<double> y_sp_mm;
+  rt::Output<double> z_sp_mm;
+  rt::Output<double> v_scale{1.0};
+  rt::Output<std::int64_t> tries;
+  rt::Output<std::int64_t> retracts;  // retracts started since activate() (progress never resets)
+  rt::Output<bool> alarm;
+  rt::Output<bool> hold;
+
+ private:
 
   WindowRing<PathPoint> history_;  // allocated in configure(); at(0) is the oldest point
   double dt_s_{0.0};

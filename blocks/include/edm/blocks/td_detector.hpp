@@ -3,10 +3,18 @@
 // counters of the generator's FPGA (or the simulator's io.td_sum_ns, io.td_count, io.n_*).
 //
 //   total(k)    = n_total(k) if n_total(k) > 0, else td_count(k) + n_open(k) + n_short(k)
-//   td_raw_us   = td_sum_ns(k) / td_count(k) / 1000                 this cycle
-//   td_us       = Σ td_sum_ns / Σ td_count / 1000                   over the last `window` cycles
+//   td_raw_us   = (td_sum_ns(k) + n_short(k)·Ts) / (td_count(k) + n_short(k)) / 1000   this cycle
+//   td_us       = (Σ td_sum_ns + Σ n_short·Ts) / (Σ td_count + Σ n_short) / 1000
+//                                                                   over the last `window` cycles
 //   open_ratio  = Σ n_open / Σ total,  short_ratio = Σ n_short / Σ total   (same window)
-//   valid       = Σ td_count > 0       (at least one ignited pulse in the window)
+//   valid       = Σ td_count + Σ n_short > 0   (an ignited or a shorted pulse in the window)
+// Gap truth (seed 004): the gap feedback reads the full applied voltage on an open gap and about
+// zero on a contact. A short is therefore a pulse whose ignition delay is Ts = short_td_us (0 by
+// default: breakdown at once), pooled with the ignited pulses: a window of shorts reads Td ≈ 0,
+// far below any Tdr, and the P law backs the electrode off at Kg·Tdr. (Counting only ignited
+// pulses, as before, made a short-only window "not valid", and the drill then crept DOWN into the
+// short.) Open pulses carry no delay measurement: a window of only opens is not valid (the gap is
+// open; the consumer feeds at its idle speed).
 //
 // Pooling the sums (not averaging the per-cycle means) weighs every pulse equally, so a cycle
 // with 3 pulses does not count as much as one with 300. The sums are exact 64-bit integers kept
@@ -35,6 +43,7 @@ struct TdDetectorParams {
   std::int64_t window{8};      // cycles pooled, 1..kMaxWindow (load time only)
   bool hold_when_empty{true};  // empty window: hold the last td_us (else output empty_td_us)
   double empty_td_us{0.0};  // [µs] ≥ 0: td_us after activate(), and when empty and not holding
+  double short_td_us{0.0};  // [µs] ≥ 0: the ignition delay a shorted pulse counts with
 
   void visit(rt::ParamVisitor& v) {
     v.param("window", window,
@@ -50,6 +59,10 @@ struct TdDetectorParams {
     v.param("empty_td_us", empty_td_us,
             {.unit = "us",
              .description = "td_us after activation, and with an empty window when not holding",
+             .range = rt::kNonNegative});
+    v.param("short_td_us", short_td_us,
+            {.unit = "us",
+             .description = "ignition delay a shorted pulse counts with (gap feedback ~ 0)",
              .range = rt::kNonNegative});
   }
 };

@@ -43,6 +43,18 @@
 // Input hold (feed hold): in APPROACH or DRILL the generator goes off and vz = 0 at once; the
 // children are not stepped, so the cycle resumes where it was when hold drops.
 //
+// Short circuits (DRILL). td pools a short as a pulse with Td ≈ 0 (gap truth, seed 004), so a
+// short-dominated window makes the P law back off by itself. Besides that:
+//   gap_short = td.short_ratio ≥ short_ratio_limit (the detection window is td.window cycles);
+//   while gap_short the Z command never points down (vz ≥ 0);
+//   retract (ShortRetract, retract.short_cycles consecutive gap_short cycles, 1 by default) backs
+//   Z off along the path already drilled (retract.retract_distance_mm at retract_speed_mm_s),
+//   walks forward again and hands back with a ramp (v_scale); zloop (PositionLoop) follows its
+//   setpoint; the generator stays on. short_retracts counts them, short_time_s is the time
+//   they took.
+//   More than short_retracts_max retracts within short_retracts_window: alarm 150
+//   (kShortCircuit, a fault) instead of another retract; the safe state then backs Z off by
+//   short_backoff_mm with the generator off and holds (IDLE, done = false).
 // Children and their parameters are variables of their own (`<instance>.gap.kg`, …), set in
 // YAML under this block's params (`gap: {kg: 0.147}`). This program gives its children these
 // defaults: gap.idle_feed_mm_s = −0.5 mm/s (the creep while the Td window holds no ignited
@@ -62,10 +74,14 @@
 // RT-safety: update() and enter_safe_state() are RT-safe (noexcept, no allocation, no locks).
 // Not thread-safe: the owning task calls every member except the pins (see pin.hpp).
 
+#include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "edm/blocks/gap_controller_p.hpp"
+#include "edm/blocks/position_loop.hpp"
+#include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
 #include "edm/blocks/wear_compensator.hpp"
 #include "edm/runtime/block.hpp"
@@ -82,6 +98,12 @@ struct DeepHoleDrillParams {
   std::int64_t breakthrough_cycles{300};  // cycles without ignition = breakthrough (through)
   double breakthrough_min_mm{0.5};        // [mm] no breakthrough before this depth
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
+  // Short circuits (seed 004: a short reads as feedback ≈ 0, so it must back the electrode off).
+  static constexpr std::int64_t kMaxShortRetracts = 16;
+  double short_ratio_limit{0.5};           // the Td window reads short at this fraction of shorts
+  std::int64_t short_retracts_max{3};      // N: retracts allowed within short_retracts_window
+  rt::Duration short_retracts_window{std::chrono::seconds(10)};  // T
+  double short_backoff_mm{1.0};  // [mm] Z backs off this far on alarm 150, then holds
 
   void visit(rt::ParamVisitor& v);
 };
@@ -118,9 +140,15 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<bool> breakthrough;
   rt::Output<bool> reset_wear;
   rt::Output<double> vz_servo_cmd_mm_s;
+  rt::Output<bool> gap_short;           // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable;      // the short retract records and acts (DRILL only)
+  rt::Output<double> retract_vff_mm_s;  // feed-forward of the retract setpoint into zloop
+  rt::Output<std::int64_t> short_retracts;  // retracts in this hole
+  rt::Output<double> short_time_s;          // time spent retracting and resuming in this hole
 
  protected:
   void visit_own_pins(rt::PinVisitor& v) override;
+  std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
   void bind_self() override;
   void activate_self() noexcept override;
   void safe_state_self(const rt::SafeStateRequest& request) noexcept override;
@@ -131,10 +159,19 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   void set_state(State s) noexcept;
   void begin_cycle() noexcept;
   void begin_retract(double target_z) noexcept;
+  /// One DRILL cycle of the short handling; true while the retract owns the Z command.
+  bool handle_short(const rt::CycleContext& ctx, double z, rt::BlockStatus& status) noexcept;
+  /// A retract began at `now`: true when it is more than short_retracts_max within the window.
+  bool too_many_retracts(rt::TimePoint now) noexcept;
 
   blocks::TdDetector& td_;
   blocks::GapControllerP& gap_;
   blocks::WearCompensator& wear_;
+  blocks::ShortRetract& retract_;
+  blocks::PositionLoop& zloop_;
+  rt::Machine* machine_{nullptr};
+  const char* source_{""};  // this block's instance name, for alarm 150
+  std::string source_name_;
 
   State state_value_{State::kIdle};
   bool prev_start_{false};
@@ -144,6 +181,10 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   double target_depth_mm_{0.0};
   double retract_to_z_mm_{0.0};
   bool safe_retract_{false};  // the running retract was started by the safe state
+  std::int64_t last_retracts_{0};  // retract.retracts seen last cycle
+  double last_z_sp_mm_{0.0};
+  std::array<rt::TimePoint, DeepHoleDrillParams::kMaxShortRetracts + 1> retract_starts_{};
+  std::size_t n_retract_starts_{0};  // entries of retract_starts_ in use (oldest first)
 };
 
 }  // namespace edm::programs
