@@ -1,10 +1,7 @@
 #include "edm/blocks/circular_interpolator.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
-
-#include "edm/blocks/validation.hpp"
 
 namespace edm::blocks {
 
@@ -37,14 +34,6 @@ void CircularInterpolator::visit_pins(rt::PinVisitor& v) {
   v.output("done", done);
 }
 
-std::vector<rt::ParamError> CircularInterpolator::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
-  dt_s_ = rt::to_seconds(setup.period);
-  activate();
-  return errs;
-}
-
 void CircularInterpolator::activate() noexcept {
   x_ = params_.x0_mm;
   y_ = params_.y0_mm;
@@ -58,17 +47,19 @@ void CircularInterpolator::activate() noexcept {
   sigma_ = 1.0;
   sweep_ = 0.0;
   phi_ = 0.0;
-  feed_mm_s_ = 0.0;
-  busy_state_ = false;
-  done_state_ = false;
-  prev_start_ = false;
+  reset_move();
   publish(0.0, 0.0);
 }
 
-void CircularInterpolator::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
-  busy_state_ = false;
-  done_state_ = false;
-  publish(0.0, 0.0);
+bool CircularInterpolator::load_position() noexcept {
+  const double lx = load_x_mm.get();
+  const double ly = load_y_mm.get();
+  if (!std::isfinite(lx) || !std::isfinite(ly)) {
+    return false;
+  }
+  x_ = lx;
+  y_ = ly;
+  return true;
 }
 
 bool CircularInterpolator::latch_move() noexcept {
@@ -133,56 +124,12 @@ bool CircularInterpolator::latch_move() noexcept {
   sigma_ = sigma;
   sweep_ = sweep;
   phi_ = 0.0;
-  feed_mm_s_ = feed_mm_min_now / 60.0;
-  busy_state_ = true;
-  done_state_ = false;
+  begin_move(feed_mm_min_now);
   return true;
 }
 
-rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start_now = start.get();
-  const bool edge = start_now && !prev_start_;
-  prev_start_ = start_now;
-
-  if (load.get()) {
-    const double lx = load_x_mm.get();
-    const double ly = load_y_mm.get();
-    if (!std::isfinite(lx) || !std::isfinite(ly)) {
-      publish(0.0, 0.0);
-      return rt::BlockStatus::kFault;
-    }
-    x_ = lx;
-    y_ = ly;
-    busy_state_ = false;
-    done_state_ = false;
-    publish(0.0, 0.0);
-    return rt::BlockStatus::kOk;
-  }
-
-  if (edge && !busy_state_ && !latch_move()) {
-    busy_state_ = false;
-    done_state_ = false;
-    publish(0.0, 0.0);
-    return rt::BlockStatus::kFault;
-  }
-  if (!busy_state_) {
-    publish(0.0, 0.0);
-    return rt::BlockStatus::kOk;
-  }
-
-  const double ov_in = feed_override.get();
-  if (!std::isfinite(ov_in)) {
-    publish(0.0, 0.0);
-    return rt::BlockStatus::kFault;
-  }
-  const double ov = std::clamp(ov_in, 0.0, kMaxOverride);
-  const rt::BlockStatus status = ov != ov_in ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-  if (hold.get()) {
-    publish(0.0, 0.0);
-    return status;
-  }
-
-  const double phi_next = phi_ + feed_mm_s_ * ov * dt_s_ / radius_;  // Δθ = fr/R
+void CircularInterpolator::advance(double ds_mm) noexcept {
+  const double phi_next = phi_ + ds_mm / radius_;  // Δθ = fr/R
   double nx = 0.0;
   double ny = 0.0;
   if (phi_next >= sweep_) {
@@ -190,8 +137,7 @@ rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) no
     theta_ = theta0_ + sigma_ * sweep_;
     nx = ex_abs_;
     ny = ey_abs_;
-    busy_state_ = false;
-    done_state_ = true;
+    finish_move();
   } else {
     phi_ = phi_next;
     theta_ = theta0_ + sigma_ * phi_next;
@@ -204,7 +150,6 @@ rt::BlockStatus CircularInterpolator::update(const rt::CycleContext& /*ctx*/) no
   x_ = nx;
   y_ = ny;
   publish(vx, vy);
-  return status;
 }
 
 void CircularInterpolator::publish(double vx_mm_s_now, double vy_mm_s_now) noexcept {

@@ -20,12 +20,10 @@ void Integrator::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> Integrator::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   dt_s_ = rt::to_seconds(setup.period);
   compute_gain();
   out_.set(reset_value());
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 rt::BlockStatus Integrator::update(const rt::CycleContext& /*ctx*/) noexcept {

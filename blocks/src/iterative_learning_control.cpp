@@ -60,7 +60,7 @@ void IterativeLearningControl::activate() noexcept {
   std::fill(u_.begin(), u_.end(), params_.u_initial);
   std::fill(e_.begin(), e_.end(), 0.0);
   idx_ = -1;
-  prev_edge_ = false;
+  cycle_start_edge_.reset();
   overrun_ = false;
   x_ = 0.0;
   last_e_ = 0.0;
@@ -134,9 +134,7 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   const auto& p = params_;
   const double y = y_.get();
   const double ref = y_ref_.get();
-  const bool edge_in = cycle_start_.get();
-  const bool rising = edge_in && !prev_edge_;
-  prev_edge_ = edge_in;
+  const bool rising = cycle_start_edge_(cycle_start_.get());
   const auto n = static_cast<std::int64_t>(u_.size());
   if (!std::isfinite(y) || !std::isfinite(ref) || n == 0) {
     return rt::BlockStatus::kFault;

@@ -43,11 +43,9 @@ void JumpCycle::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> JumpCycle::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   task_period_ = setup.period;
   params_changed();
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 void JumpCycle::params_changed() noexcept {

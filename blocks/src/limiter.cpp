@@ -20,11 +20,9 @@ void Limiter::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> Limiter::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   dt_s_ = rt::to_seconds(setup.period);
   compute_step();
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 void Limiter::activate() noexcept { has_prev_ = false; }

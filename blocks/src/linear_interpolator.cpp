@@ -1,9 +1,6 @@
 #include "edm/blocks/linear_interpolator.hpp"
 
-#include <algorithm>
 #include <cmath>
-
-#include "edm/blocks/validation.hpp"
 
 namespace edm::blocks {
 
@@ -29,14 +26,6 @@ void LinearInterpolator::visit_pins(rt::PinVisitor& v) {
   v.output("done", done);
 }
 
-std::vector<rt::ParamError> LinearInterpolator::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
-  dt_s_ = rt::to_seconds(setup.period);
-  activate();
-  return errs;
-}
-
 void LinearInterpolator::activate() noexcept {
   pos_ = {params_.x0_mm, params_.y0_mm, params_.z0_mm};
   p0_ = pos_;
@@ -44,17 +33,17 @@ void LinearInterpolator::activate() noexcept {
   l_ = {};
   len_ = 0.0;
   s_ = 0.0;
-  feed_mm_s_ = 0.0;
-  busy_state_ = false;
-  done_state_ = false;
-  prev_start_ = false;
+  reset_move();
   publish({});
 }
 
-void LinearInterpolator::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
-  busy_state_ = false;
-  done_state_ = false;
-  publish({});
+bool LinearInterpolator::load_position() noexcept {
+  const Vec3 p{load_x_mm.get(), load_y_mm.get(), load_z_mm.get()};
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+    return false;
+  }
+  pos_ = p;
+  return true;
 }
 
 bool LinearInterpolator::latch_move() noexcept {
@@ -79,67 +68,23 @@ bool LinearInterpolator::latch_move() noexcept {
   len_ = len;
   s_ = 0.0;
   if (len == 0.0) {  // zero-length move: complete at once, the feed is not needed
-    busy_state_ = false;
-    done_state_ = true;
+    finish_move();
     return true;
   }
   if (!(feed_mm_min_now > 0.0)) {
     return false;
   }
-  feed_mm_s_ = feed_mm_min_now / 60.0;
-  busy_state_ = true;
-  done_state_ = false;
+  begin_move(feed_mm_min_now);
   return true;
 }
 
-rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start_now = start.get();
-  const bool edge = start_now && !prev_start_;
-  prev_start_ = start_now;
-
-  if (load.get()) {
-    const Vec3 p{load_x_mm.get(), load_y_mm.get(), load_z_mm.get()};
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      publish({});
-      return rt::BlockStatus::kFault;
-    }
-    pos_ = p;
-    busy_state_ = false;
-    done_state_ = false;
-    publish({});
-    return rt::BlockStatus::kOk;
-  }
-
-  if (edge && !busy_state_ && !latch_move()) {
-    busy_state_ = false;
-    done_state_ = false;
-    publish({});
-    return rt::BlockStatus::kFault;
-  }
-  if (!busy_state_) {
-    publish({});
-    return rt::BlockStatus::kOk;
-  }
-
-  const double ov_in = feed_override.get();
-  if (!std::isfinite(ov_in)) {
-    publish({});
-    return rt::BlockStatus::kFault;
-  }
-  const double ov = std::clamp(ov_in, 0.0, kMaxOverride);
-  const rt::BlockStatus status = ov != ov_in ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;
-  if (hold.get()) {
-    publish({});
-    return status;
-  }
-
-  const double s_next = s_ + feed_mm_s_ * ov * dt_s_;
+void LinearInterpolator::advance(double ds_mm) noexcept {
+  const double s_next = s_ + ds_mm;
   Vec3 next{};
   if (s_next >= len_) {
     next = end_;
     s_ = len_;
-    busy_state_ = false;
-    done_state_ = true;
+    finish_move();
   } else {
     const double u = s_next / len_;
     for (std::size_t a = 0; a < 3; ++a) {
@@ -153,7 +98,6 @@ rt::BlockStatus LinearInterpolator::update(const rt::CycleContext& /*ctx*/) noex
   }
   pos_ = next;
   publish(v);
-  return status;
 }
 
 void LinearInterpolator::publish(const Vec3& v_mm_s) noexcept {

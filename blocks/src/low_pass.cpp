@@ -12,11 +12,9 @@ void LowPass::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> LowPass::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   period_ = setup.period;
   compute_alpha();
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 void LowPass::activate() noexcept {

@@ -24,28 +24,19 @@ void OrbitExpander::visit_pins(rt::PinVisitor& v) {
 void OrbitExpander::activate() noexcept {
   radius_mm_ = 0.0;
   final_mm_ = 0.0;
-  dr_mm_ = 0.0;
-  tdm_us_ = 0.0;
-  sum_us_ = 0.0;
-  n_valid_ = 0;
-  n_samples_ = 0;
-  revs_ = 0;
+  clear_progress();
   busy_state_ = false;
   done_state_ = false;
-  prev_start_ = false;
-  prev_rev_ = false;
+  start_edge_.reset();
+  rev_edge_.reset();
   publish();
 }
 
 rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept {
-  const bool start_now = start.get();
-  const bool start_edge = start_now && !prev_start_;
-  prev_start_ = start_now;
+  const bool start_edge = start_edge_(start.get());
   // rev_pulse edges are tracked in every cycle so that a pulse held high across a pause or a
   // start does not count twice.
-  const bool rev = rev_pulse.get();
-  const bool rev_edge = rev && !prev_rev_;
-  prev_rev_ = rev;
+  const bool rev_edge = rev_edge_(rev_pulse.get());
 
   if (start_edge && !busy_state_) {
     const double r0 = r0_mm.get();
@@ -56,12 +47,7 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
     }
     radius_mm_ = r0;
     final_mm_ = fin;
-    dr_mm_ = 0.0;
-    tdm_us_ = 0.0;
-    sum_us_ = 0.0;
-    n_valid_ = 0;
-    n_samples_ = 0;
-    revs_ = 0;
+    clear_progress();
     busy_state_ = r0 < fin;
     done_state_ = !busy_state_;
     publish();
@@ -120,6 +106,15 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
   n_samples_ = 0;
   publish();
   return status;
+}
+
+void OrbitExpander::clear_progress() noexcept {
+  dr_mm_ = 0.0;
+  tdm_us_ = 0.0;
+  sum_us_ = 0.0;
+  n_valid_ = 0;
+  n_samples_ = 0;
+  revs_ = 0;
 }
 
 void OrbitExpander::publish() noexcept {

@@ -21,11 +21,9 @@ void PositionLoop::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> PositionLoop::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   dt_s_ = rt::to_seconds(setup.period);
   activate();
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 void PositionLoop::activate() noexcept {

@@ -18,10 +18,8 @@ void Select::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> Select::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   dt_s_ = rt::to_seconds(setup.period);
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 void Select::activate() noexcept {

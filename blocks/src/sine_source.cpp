@@ -10,11 +10,9 @@ namespace edm::blocks {
 void SineSource::visit_pins(rt::PinVisitor& v) { v.output("out", out_); }
 
 std::vector<rt::ParamError> SineSource::configure(const rt::BlockSetup& setup) {
-  std::vector<rt::ParamError> errs;
-  require_task_period(errs, setup.period);
   period_ = setup.period;
   compute_step();
-  return errs;
+  return task_period_errors(setup.period);
 }
 
 rt::BlockStatus SineSource::update(const rt::CycleContext& ctx) noexcept {

@@ -10,4 +10,10 @@ void require_task_period(std::vector<rt::ParamError>& errs, rt::Duration period)
   }
 }
 
+std::vector<rt::ParamError> task_period_errors(rt::Duration period) {
+  std::vector<rt::ParamError> errs;
+  require_task_period(errs, period);
+  return errs;
+}
+
 }  // namespace edm::blocks

@@ -31,6 +31,8 @@ void add_arc(Json& out, const Vec3& from, const Vec3& c, double sweep_rad, doubl
   }
 }
 
+Json no_machine_info() { return {{"ok", false}, {"message", "no machine.info yet"}}; }
+
 std::string reply_error(const bridge::Reply& r) {
   return (r.code ? std::string(bridge::to_string(*r.code)) + ": " : std::string()) + r.message;
 }
@@ -124,16 +126,23 @@ std::optional<Vec3> WebJob::position_locked() const {
   return Vec3{f.x_mm.value_or(0.0), f.y_mm.value_or(0.0), f.z_mm.value_or(0.0)};
 }
 
-Json WebJob::check(const std::string& text, const std::string& name) {
+std::optional<GcodeResult> WebJob::interpret(const std::string& text, const std::string& name,
+                                             GcodeOptions& options) const {
   machining::MachineTables tables;
-  GcodeOptions options;
   {
     std::lock_guard lock(mutex_);
-    if (!have_tables_) return {{"ok", false}, {"message", "no machine.info yet"}};
+    if (!have_tables_) return std::nullopt;
     tables = tables_;
     options.start_mm = position_locked().value_or(Vec3{});
   }
-  const GcodeResult g = interpret_gcode(text, name, tables, options);
+  return interpret_gcode(text, name, tables, options);
+}
+
+Json WebJob::check(const std::string& text, const std::string& name) {
+  GcodeOptions options;
+  const std::optional<GcodeResult> result = interpret(text, name, options);
+  if (!result) return no_machine_info();
+  const GcodeResult& g = *result;
   return {{"ok", g.ok()},
           {"errors", errors_json(g.errors)},
           {"blocks", g.blocks.size()},
@@ -143,15 +152,10 @@ Json WebJob::check(const std::string& text, const std::string& name) {
 }
 
 Json WebJob::upload(const std::string& text, const std::string& name) {
-  machining::MachineTables tables;
   GcodeOptions options;
-  {
-    std::lock_guard lock(mutex_);
-    if (!have_tables_) return {{"ok", false}, {"message", "no machine.info yet"}};
-    tables = tables_;
-    options.start_mm = position_locked().value_or(Vec3{});
-  }
-  GcodeResult g = interpret_gcode(text, name, tables, options);
+  std::optional<GcodeResult> result = interpret(text, name, options);
+  if (!result) return no_machine_info();
+  GcodeResult& g = *result;
   if (!g.ok()) {
     return {{"ok", false},
             {"code", "bad_program"},

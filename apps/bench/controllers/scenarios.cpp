@@ -79,24 +79,33 @@ std::vector<Scenario> make_scenarios(bool quick) {
   const double depth = quick ? 10.0 : 30.0;
   const std::string depth_s = quick ? "10" : "30";
   const double drill_limit = quick ? 60.0 : 200.0;
-
-  // B1: Ø1.0/0.3 tube, 30 mm hole; time to depth (true depth ≥ target − 50 µm).
-  {
-    Scenario s;
-    s.id = "B1";
-    s.title = "drilling Ø1.0/0.3 mm tube to " + depth_s + " mm (drill preset, F = 1)";
+  // The hole of B1-B3 drilled by the P gap controller (drill-p.yaml) to `depth`, until DONE.
+  const auto drill_p = [&] {
     RunSpec p;
     p.config = "config/bench/controllers/drill-p.yaml";
     p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
     p.limit_s = drill_limit;
     p.target_depth_mm = depth;
     p.done_var = "cycle.drill.state";
-    p.td_ref_us = 8.0;
-    RunSpec lut = p;
+    return p;
+  };
+  // The same hole under the fuzzy LUT servo (drill-fuzzy-lut.yaml), stopped at the depth.
+  const auto fuzzy_lut = [](RunSpec lut) {
     lut.config = "config/bench/controllers/drill-fuzzy-lut.yaml";
     lut.edits.clear();
     lut.done_var.clear();
     lut.stop_at_depth = true;
+    return lut;
+  };
+
+  // B1: Ø1.0/0.3 tube, 30 mm hole; time to depth (true depth ≥ target − 50 µm).
+  {
+    Scenario s;
+    s.id = "B1";
+    s.title = "drilling Ø1.0/0.3 mm tube to " + depth_s + " mm (drill preset, F = 1)";
+    RunSpec p = drill_p();
+    p.td_ref_us = 8.0;
+    const RunSpec lut = fuzzy_lut(p);
     RunSpec constant = lut;
     constant.config = "config/bench/controllers/drill-constant-feed.yaml";
     s.variants = {{"P gap controller on Td (seed 004)", p},
@@ -118,12 +127,7 @@ std::vector<Scenario> make_scenarios(bool quick) {
     Scenario s;
     s.id = "B2";
     s.title = "blind " + depth_s + " mm hole, depth error (DeepHoleDrill's own depth estimate)";
-    RunSpec p;
-    p.config = "config/bench/controllers/drill-p.yaml";
-    p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
-    p.limit_s = drill_limit;
-    p.target_depth_mm = depth;
-    p.done_var = "cycle.drill.state";
+    RunSpec p = drill_p();
     RunSpec off = p;
     off.edits.push_back({"drill.enable_wear_comp: true", "drill.enable_wear_comp: false"});
     RunSpec fuzzy = p;  // seed 003's servo inside DeepHoleDrill (its vz_servo_mm_s input)
@@ -146,20 +150,11 @@ std::vector<Scenario> make_scenarios(bool quick) {
     s.title = "B1 with flushing × 0.3 from " + drop_s + " mm (flush_drop_depth_mm " + drop_s +
               ", flush_drop_factor 0.3), " + depth_s + " mm";
     const std::string extra = "flush_drop_depth_mm: " + drop_s + ", flush_drop_factor: 0.3";
-    RunSpec p;
-    p.config = "config/bench/controllers/drill-p.yaml";
-    p.edits = {{"depth_default_mm: 30", "depth_default_mm: " + depth_s}};
+    RunSpec p = drill_p();
     p.io_extra = extra;
-    p.limit_s = drill_limit;
-    p.target_depth_mm = depth;
-    p.done_var = "cycle.drill.state";
     p.flush_drop_mm = drop;
     p.window_end_state = 3.0;  // DeepHoleDrill's RETRACT: the drilling is over
-    RunSpec lut = p;
-    lut.config = "config/bench/controllers/drill-fuzzy-lut.yaml";
-    lut.edits.clear();
-    lut.done_var.clear();
-    lut.stop_at_depth = true;
+    const RunSpec lut = fuzzy_lut(p);
     s.variants = {{"P gap controller on Td (seed 004)", p},
                   {"fuzzy LUT servo on open/short counts (seed 003)", lut}};
     s.columns = {col("done / reached", &Outcome::reached),

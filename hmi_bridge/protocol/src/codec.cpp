@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <unordered_set>
 
@@ -17,6 +18,14 @@ using machining::Vec3;
 namespace {
 
 Json vec_to_json(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
+
+// The sparse form of a block: a field is written only where it differs from MotionBlock{}.
+template <class T, class ToJson = std::identity>
+void put_unless_default(Json& j, const char* key, const T& v, const T& dflt, ToJson to_json = {}) {
+  if (v != dflt) {
+    j[key] = to_json(v);
+  }
+}
 
 bool finite_number(const Json& j, double& out) {
   if (!j.is_number()) {
@@ -73,33 +82,15 @@ Json to_json(const MotionBlock& b) {
   j["kind"] = std::string(machining::to_string(b.kind));
   j["line"] = b.line;
   j["col"] = b.col;
-  if (b.target != d.target) {
-    j["target"] = vec_to_json(b.target);
-  }
-  if (b.centre != d.centre) {
-    j["centre"] = vec_to_json(b.centre);
-  }
-  if (b.turns != d.turns) {
-    j["turns"] = b.turns;
-  }
-  if (b.feed_mm_s != d.feed_mm_s) {
-    j["feed_mm_s"] = b.feed_mm_s;
-  }
-  if (b.condition != d.condition) {
-    j["condition"] = b.condition;
-  }
-  if (b.z_travel_mm != d.z_travel_mm) {
-    j["z_travel_mm"] = b.z_travel_mm;
-  }
-  if (b.final_radius_mm != d.final_radius_mm) {
-    j["final_radius_mm"] = b.final_radius_mm;
-  }
-  if (b.dwell_s != d.dwell_s) {
-    j["dwell_s"] = b.dwell_s;
-  }
-  if (b.on != d.on) {
-    j["on"] = b.on;
-  }
+  put_unless_default(j, "target", b.target, d.target, vec_to_json);
+  put_unless_default(j, "centre", b.centre, d.centre, vec_to_json);
+  put_unless_default(j, "turns", b.turns, d.turns);
+  put_unless_default(j, "feed_mm_s", b.feed_mm_s, d.feed_mm_s);
+  put_unless_default(j, "condition", b.condition, d.condition);
+  put_unless_default(j, "z_travel_mm", b.z_travel_mm, d.z_travel_mm);
+  put_unless_default(j, "final_radius_mm", b.final_radius_mm, d.final_radius_mm);
+  put_unless_default(j, "dwell_s", b.dwell_s, d.dwell_s);
+  put_unless_default(j, "on", b.on, d.on);
   return j;
 }
 

@@ -20,7 +20,8 @@
 //
 // Outputs: position, v = step/dt, angle_rad = θ wrapped to [−π, π] (polar angle of the point seen
 // from the centre: the radial direction), swept_rad = φ. `done` is a level (see
-// LinearInterpolator); `load` sets the position and cancels a move.
+// LinearInterpolator); `load` sets the position and cancels a move (the commands are
+// MoveInterpolator's).
 //
 // Status: kSaturated when override was clamped; kFault (no advance, v = 0) on a non-finite
 // override or load position, or a rejected move (non-finite inputs, R = 0, feed ≤ 0, turns
@@ -29,8 +30,8 @@
 // calls every member except the pins (see pin.hpp).
 
 #include <cstdint>
-#include <vector>
 
+#include "edm/blocks/move_interpolator.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -51,28 +52,16 @@ struct CircularInterpolatorParams {
   }
 };
 
-class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolatorParams> {
+class CircularInterpolator final : public MoveInterpolator<CircularInterpolatorParams> {
  public:
-  static constexpr double kMaxOverride = 2.0;
   static constexpr std::int64_t kMaxTurns = 1'000'000;
 
   void visit_pins(rt::PinVisitor& v) override;
-  /// Non-RT. Needs a task period > 0.
-  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Position = (x0, y0), idle.
   void activate() noexcept override;
-  /// RT-safe. kOk, kSaturated (override clamped) or kFault (see the file comment).
-  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// RT-safe. Cancels a move in progress (busy = false, v = 0); the position is kept.
-  void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
 
- private:
-  [[nodiscard]] bool latch_move() noexcept;
-  void publish(double vx_mm_s, double vy_mm_s) noexcept;
-
- public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<bool> start;
+  // Pins (named as in visit_pins; start, feed_mm_min, override, hold, load, busy and done are
+  // MoveInterpolator's): a C++ PROGRAM connects them by member.
   rt::Input<bool> cw;
   rt::Input<double> i_mm;
   rt::Input<double> j_mm;
@@ -80,10 +69,6 @@ class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolat
   rt::Input<std::int64_t> turns{1};
   rt::Input<double> ex_mm;
   rt::Input<double> ey_mm;
-  rt::Input<double> feed_mm_min;
-  rt::Input<double> feed_override{1.0};
-  rt::Input<bool> hold;
-  rt::Input<bool> load;
   rt::Input<double> load_x_mm;
   rt::Input<double> load_y_mm;
   rt::Output<double> rx_mm;
@@ -92,11 +77,14 @@ class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolat
   rt::Output<double> vy_mm_s;
   rt::Output<double> angle_rad;
   rt::Output<double> swept_rad;
-  rt::Output<bool> busy;
-  rt::Output<bool> done;
 
  private:
-  double dt_s_{0.0};
+  [[nodiscard]] bool load_position() noexcept override;
+  [[nodiscard]] bool latch_move() noexcept override;
+  void advance(double ds_mm) noexcept override;
+  void publish_at_rest() noexcept override { publish(0.0, 0.0); }
+  void publish(double vx_mm_s, double vy_mm_s) noexcept;
+
   double x_{0.0};  // [mm] current position
   double y_{0.0};
   double cx_{0.0};  // [mm] centre
@@ -109,10 +97,6 @@ class CircularInterpolator final : public rt::BlockWithParams<CircularInterpolat
   double sigma_{1.0};   // +1 G03 (ccw), −1 G02 (cw)
   double sweep_{0.0};   // [rad] total angle of the move, > 0
   double phi_{0.0};     // [rad] swept so far
-  double feed_mm_s_{0.0};
-  bool busy_state_{false};
-  bool done_state_{false};
-  bool prev_start_{false};
 };
 
 }  // namespace edm::blocks

@@ -41,6 +41,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/rising_edge.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -143,7 +144,7 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   std::vector<double> u_;
   std::vector<double> e_;
   std::int64_t idx_{-1};  // sample output last update; −1 before the first cycle
-  bool prev_edge_{false};
+  RisingEdge cycle_start_edge_;
   bool overrun_{false};
   double x_{0.0};
   double last_e_{0.0};

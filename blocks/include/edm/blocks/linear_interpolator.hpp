@@ -14,7 +14,8 @@
 // no rounding growth along the move and the end point is bit-exact P0 + L. `load` (level) sets
 // the position to (load_x, load_y, load_z) and cancels a move in progress. A rising start edge
 // while busy is ignored. `done` is a level: true from the cycle the end point is reached until
-// the next move is latched or a load. A zero-length move completes on its start edge.
+// the next move is latched or a load. A zero-length move completes on its start edge. The
+// commands (start, load, hold, override) are MoveInterpolator's.
 //
 // Status: kSaturated when override was outside [0, 2] (clamped); kFault (no advance, v = 0) on
 // a non-finite override or load position, or a rejected move (non-finite increments or feed,
@@ -23,8 +24,8 @@
 // calls every member except the pins (see pin.hpp).
 
 #include <array>
-#include <vector>
 
+#include "edm/blocks/move_interpolator.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -41,36 +42,17 @@ struct LinearInterpolatorParams {
   }
 };
 
-class LinearInterpolator final : public rt::BlockWithParams<LinearInterpolatorParams> {
+class LinearInterpolator final : public MoveInterpolator<LinearInterpolatorParams> {
  public:
-  static constexpr double kMaxOverride = 2.0;
-
   void visit_pins(rt::PinVisitor& v) override;
-  /// Non-RT. Needs a task period > 0.
-  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Position = (x0, y0, z0), idle.
   void activate() noexcept override;
-  /// RT-safe. kOk, kSaturated (override clamped) or kFault (see the file comment).
-  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-  /// RT-safe. Cancels a move in progress (busy = false, v = 0); the position is kept.
-  void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
 
- private:
-  using Vec3 = std::array<double, 3>;
-
-  [[nodiscard]] bool latch_move() noexcept;
-  void publish(const Vec3& v_mm_s) noexcept;
-
- public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<bool> start;
+  // Pins (named as in visit_pins; start, feed_mm_min, override, hold, load, busy and done are
+  // MoveInterpolator's): a C++ PROGRAM connects them by member.
   rt::Input<double> lx_mm;
   rt::Input<double> ly_mm;
   rt::Input<double> lz_mm;
-  rt::Input<double> feed_mm_min;
-  rt::Input<double> feed_override{1.0};
-  rt::Input<bool> hold;
-  rt::Input<bool> load;
   rt::Input<double> load_x_mm;
   rt::Input<double> load_y_mm;
   rt::Input<double> load_z_mm;
@@ -80,21 +62,22 @@ class LinearInterpolator final : public rt::BlockWithParams<LinearInterpolatorPa
   rt::Output<double> vx_mm_s;
   rt::Output<double> vy_mm_s;
   rt::Output<double> vz_mm_s;
-  rt::Output<bool> busy;
-  rt::Output<bool> done;
 
  private:
-  double dt_s_{0.0};
+  using Vec3 = std::array<double, 3>;
+
+  [[nodiscard]] bool load_position() noexcept override;
+  [[nodiscard]] bool latch_move() noexcept override;
+  void advance(double ds_mm) noexcept override;
+  void publish_at_rest() noexcept override { publish({}); }
+  void publish(const Vec3& v_mm_s) noexcept;
+
   Vec3 pos_{};       // [mm] current position
   Vec3 p0_{};        // [mm] position when the move was latched
   Vec3 l_{};         // [mm] latched increments
   Vec3 end_{};       // [mm] p0_ + l_
   double len_{0.0};  // [mm] |l_|
   double s_{0.0};    // [mm] path length travelled
-  double feed_mm_s_{0.0};
-  bool busy_state_{false};
-  bool done_state_{false};
-  bool prev_start_{false};
 };
 
 }  // namespace edm::blocks

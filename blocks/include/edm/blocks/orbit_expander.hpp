@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/rising_edge.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -66,6 +67,8 @@ class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
 
  private:
   void publish() noexcept;
+  /// Zero increment, mean Td, sums and revolution count: the state of a move not yet begun.
+  void clear_progress() noexcept;
 
  public:
   // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
@@ -94,8 +97,8 @@ class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
   std::int64_t revs_{0};
   bool busy_state_{false};
   bool done_state_{false};
-  bool prev_start_{false};
-  bool prev_rev_{false};
+  RisingEdge start_edge_;
+  RisingEdge rev_edge_;
 };
 
 }  // namespace edm::blocks

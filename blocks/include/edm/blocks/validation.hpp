@@ -15,5 +15,7 @@ namespace edm::blocks {
 /// Adds an error unless the task period handed to configure() is > 0: blocks that discretise
 /// continuous-time behaviour need a sampling interval.
 void require_task_period(std::vector<rt::ParamError>& errs, rt::Duration period);
+/// The same as a list of its own: for a configure() whose only check is the period.
+[[nodiscard]] std::vector<rt::ParamError> task_period_errors(rt::Duration period);
 
 }  // namespace edm::blocks

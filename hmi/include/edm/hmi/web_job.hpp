@@ -59,6 +59,10 @@ class WebJob {
 
  private:
   std::optional<machining::Vec3> position_locked() const;
+  /// The G-code interpreted against a copy of the tables from the current position (returned in
+  /// options.start_mm), outside the lock; nullopt before refresh_machine().
+  std::optional<GcodeResult> interpret(const std::string& text, const std::string& name,
+                                       GcodeOptions& options) const;
 
   bridge::Client& client_;
   mutable std::mutex mutex_;
