@@ -51,6 +51,9 @@ class Parser {
  private:
   void parse_machine(const Value& v, MachineSpec& out);
   void parse_io(const Value& v, IoSpec& out);
+  void parse_safety(const Value& v, MachineSpec& machine);  // config_safety.cpp
+  void parse_safety_axis(const Value& v, const MachineSpec& machine, SafetyAxisSpec& out);
+  std::optional<NameRef> io_pin_name(const Value& v);
   void parse_task(const Value& v, TaskSpec& out);
   void parse_watchdog(const Value& v, WatchdogSpec& out);
   void parse_program(const Value& v, ProgramSpec& out);

@@ -20,7 +20,7 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "io", "axes"});
+  auto m = r_.map(v, {"name", "io", "axes", "safety"});
   if (!m) {
     return;
   }
@@ -34,6 +34,9 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
   }
   if (const Field* f = m->find("axes")) {
     out.axes = machining::read_axes(r_, f->value);
+  }
+  if (const Field* f = m->find("safety")) {
+    parse_safety(f->value, out);  // after the axes: it names them
   }
 }
 

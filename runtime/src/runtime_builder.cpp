@@ -10,6 +10,7 @@
 
 #include "edm/runtime/runtime.hpp"
 #include "param_reader.hpp"
+#include "supervisor_builder.hpp"
 
 namespace edm::rt {
 
@@ -89,6 +90,7 @@ class RuntimeBuilder {
     make_driver();
     make_programs();
     wire();
+    make_supervisor();
     register_variables();
     make_trace();
     check_bridge_vars();
@@ -158,6 +160,27 @@ class RuntimeBuilder {
       io_task_->attach_driver(*rt_->driver_);
     }
     block_pin_names_["io"] = names;
+  }
+
+  // The safety supervisor watches and drives the driver's pins on the I/O task.
+  void make_supervisor() {
+    const SafetySpec& spec = cfg_.machine.safety;
+    if (!spec.present || !rt_->driver_) {
+      return;  // an unknown driver was reported; its pins would only add noise
+    }
+    if (io_task_ == nullptr) {
+      diag_.error(spec.loc, "machine.safety: there is no I/O task to supervise (no tasks)");
+      return;
+    }
+    auto pin_of = [this](const NameRef& n) {
+      const PinEntry* e = resolve("", n.name, n.loc, false);
+      return e != nullptr ? e->ref : PinRef{};
+    };
+    rt_->supervisor_ = build_supervisor(spec, rt_->tables_, rt_->machine_,
+                                        io_task_->spec().interval, pin_of, diag_);
+    if (rt_->supervisor_) {
+      io_task_->attach_supervisor(*rt_->supervisor_);
+    }
   }
 
   BlockSetup setup(std::string_view instance, Duration period) {

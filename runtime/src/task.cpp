@@ -1,5 +1,6 @@
 #include "edm/runtime/task.hpp"
 
+#include "edm/runtime/supervisor.hpp"
 #include "edm/runtime/trace.hpp"
 #include "edm/runtime/variables.hpp"
 
@@ -92,6 +93,9 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   }
   for (Program* p : programs_) {
     p->run(ctx);
+  }
+  if (supervisor_ != nullptr) {
+    supervisor_->supervise(ctx);
   }
   if (driver_ != nullptr) {
     driver_->write_outputs(ctx);

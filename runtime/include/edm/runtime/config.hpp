@@ -93,10 +93,37 @@ struct IoSpec {
 /// An axis (soft limits, dynamics) as read by machining's shared section reader.
 using AxisSpec = machining::LocatedAxis;
 
+/// Which way an axis may still move in FAULT (DESIGN §11: "Z backed off"); ESTOP stops all.
+enum class RetractDirection : std::int8_t { kMinus = -1, kNone = 0, kPlus = 1 };
+
+/// `machine.safety.axes[i]`: an axis of `machine.axes` whose process-image command the
+/// supervisor checks (docs/config.md, docs/safety.md).
+struct SafetyAxisSpec {
+  char name{'\0'};  // 'X', 'Y' or 'Z'; '\0' until read
+  NameRef velocity;                     // io.<LREAL input>, mm/s
+  NameRef position;                     // io.<LREAL output>, mm
+  std::optional<double> ferror_mm;      // following-error limit at v_max; absent: not checked
+  std::optional<double> min_ferror_mm;  // at standstill; default ferror_mm
+  RetractDirection retract{RetractDirection::kNone};
+  SourceLoc loc;
+};
+
+/// `machine.safety`: the runtime's safety supervisor. Absent (present == false): none.
+struct SafetySpec {
+  bool present{false};
+  std::vector<SafetyAxisSpec> axes;
+  std::optional<NameRef> electrode_length;  // io.<LREAL output>, mm of electrode left
+  double electrode_margin_mm{0.0};          // alarm 160 at or below this length
+  std::optional<NameRef> wire_break;        // io.<BOOL output>, true = broken
+  std::vector<NameRef> generator;           // io.<BOOL input>s held false in FAULT/ESTOP
+  SourceLoc loc;
+};
+
 struct MachineSpec {
   std::string name;
   IoSpec io;
   std::vector<AxisSpec> axes;
+  SafetySpec safety;
   SourceLoc loc;
 };
 

@@ -56,11 +56,11 @@ enum class AlarmCode : std::uint16_t {
   kBlockFault = 110,       // a block's update() returned kFault
   kIoFault = 120,          // the I/O driver reported a fault
   kEstop = 130,            // emergency stop requested
-  kFollowingError = 140,   // axis following error (EdmJob)
-  kSoftLimit = 141,        // soft-limit violation (EdmJob)
+  kFollowingError = 140,   // axis following error (safety supervisor)
+  kSoftLimit = 141,        // soft limit: command refused or axis outside (safety supervisor)
   kShortCircuit = 150,     // reserved: sustained short circuit after N retracts
-  kElectrodeUsedUp = 160,  // reserved: electrode length exhausted
-  kWireBreak = 170,        // reserved: wire EDM wire break
+  kElectrodeUsedUp = 160,  // electrode length at its margin (safety supervisor)
+  kWireBreak = 170,        // wire EDM wire break (safety supervisor)
   kRetainCorrupt = 180,    // the retain file could not be read: set aside, defaults in use
   kForcesReleased = 181,   // a safe state released forced pins (value: how many)
 };

@@ -15,6 +15,11 @@
 // The runtime releases every force when the machine enters FAULT or ESTOP (the safe state
 // wins over forces; docs/runtime.md "Forcing").
 //
+// Supervision (inputs only): the safety supervisor (supervisor.hpp) may replace what an Input
+// of the process image reads — a refused velocity, a generator pin held off in FAULT. It ranks
+// above a force: get() returns the supervised value, then the forced one, then the wire.
+// requested() is what the input would read without the supervisor.
+//
 // RT-safe: get(), set(). Non-RT: connect(), follow(), set_constant(). force()/unforce() may be called from
 // any thread. Pins are neither copyable nor movable (wires point at them).
 
@@ -99,15 +104,24 @@ class Input {
   Input(const Input&) = delete;
   Input& operator=(const Input&) = delete;
 
-  /// The wired source's current value, the constant if unwired, or the forced value. RT-safe.
+  /// The supervised value while supervised, else requested(). RT-safe.
   [[nodiscard]] T get() const noexcept {
-    if (forced_.load(std::memory_order_acquire)) {
+    const std::uint8_t m = mode_.load(std::memory_order_acquire);
+    if (m == 0) {
+      return wired();
+    }
+    if ((m & kSupervised) != 0) {
+      return supervised_value_.load(std::memory_order_relaxed);
+    }
+    return force_value_.load(std::memory_order_relaxed);
+  }
+  /// The forced value, or the wired source's current value, or the constant if unwired: what
+  /// the input reads when the supervisor does not intervene. RT-safe.
+  [[nodiscard]] T requested() const noexcept {
+    if ((mode_.load(std::memory_order_acquire) & kForced) != 0) {
       return force_value_.load(std::memory_order_relaxed);
     }
-    if (via_ != nullptr) {
-      return via_->get();
-    }
-    return src_->load(std::memory_order_relaxed);
+    return wired();
   }
 
   /// Wires this input to an output. Non-RT (load time only).
@@ -133,17 +147,45 @@ class Input {
 
   void force(T v) noexcept {
     force_value_.store(v, std::memory_order_relaxed);
-    forced_.store(true, std::memory_order_release);
+    mode_.fetch_or(kForced, std::memory_order_release);
   }
-  void unforce() noexcept { forced_.store(false, std::memory_order_release); }
-  [[nodiscard]] bool forced() const noexcept { return forced_.load(std::memory_order_acquire); }
+  void unforce() noexcept { mode_.fetch_and(kSupervised, std::memory_order_release); }
+  [[nodiscard]] bool forced() const noexcept {
+    return (mode_.load(std::memory_order_acquire) & kForced) != 0;
+  }
+
+  /// The safety supervisor's override: get() returns v until end_supervision(). RT-safe; only
+  /// the supervisor (the I/O task's thread) calls it.
+  void supervise(T v) noexcept {
+    supervised_value_.store(v, std::memory_order_relaxed);
+    mode_.fetch_or(kSupervised, std::memory_order_release);
+  }
+  void end_supervision() noexcept {
+    if ((mode_.load(std::memory_order_relaxed) & kSupervised) != 0) {
+      mode_.fetch_and(kForced, std::memory_order_release);
+    }
+  }
+  [[nodiscard]] bool supervised() const noexcept {
+    return (mode_.load(std::memory_order_acquire) & kSupervised) != 0;
+  }
 
  private:
+  static constexpr std::uint8_t kForced = 1;
+  static constexpr std::uint8_t kSupervised = 2;
+
+  [[nodiscard]] T wired() const noexcept {
+    if (via_ != nullptr) {
+      return via_->get();
+    }
+    return src_->load(std::memory_order_relaxed);
+  }
+
   std::atomic<T> constant_;
   const std::atomic<T>* src_{&constant_};
   const Input* via_{nullptr};  // follow(): read through another input
   std::atomic<T> force_value_{};
-  std::atomic<bool> forced_{false};
+  std::atomic<T> supervised_value_{};
+  std::atomic<std::uint8_t> mode_{0};  // kForced | kSupervised; one load when neither is set
   bool connected_{false};
 };
 

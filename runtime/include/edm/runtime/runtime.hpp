@@ -22,6 +22,7 @@
 #include "edm/runtime/program.hpp"
 #include "edm/runtime/retain.hpp"
 #include "edm/runtime/stats_json.hpp"
+#include "edm/runtime/supervisor.hpp"
 #include "edm/runtime/task.hpp"
 #include "edm/runtime/trace.hpp"
 #include "edm/runtime/type_registry.hpp"
@@ -81,6 +82,8 @@ class Runtime {
   [[nodiscard]] const Config& config() const noexcept { return config_; }
   /// The loaded part program and its progress (DESIGN §2: the runtime owns it).
   [[nodiscard]] JobStore& job() noexcept { return job_; }
+  /// The safety supervisor of `machine.safety`, or nullptr when the config has none.
+  [[nodiscard]] const Supervisor* supervisor() const noexcept { return supervisor_.get(); }
   /// Adds a consumer of every alarm (besides the log): called on the controlling thread, in
   /// order, each time run() drains the machine's alarm queue (every ~20 ms on the real clock,
   /// every 1024 cycles on the virtual one). The RT side only ever pushes into that lock-free
@@ -101,6 +104,7 @@ class Runtime {
   Machine machine_;
   JobStore job_;
   std::unique_ptr<IoDriver> driver_;
+  std::unique_ptr<Supervisor> supervisor_;  // after driver_: it points into the driver's pins
   std::vector<std::unique_ptr<Program>> programs_;
   std::vector<std::unique_ptr<Task>> tasks_;
   VariableRegistry variables_;

@@ -3,8 +3,9 @@
 // ordered list of programs. run_cycle() is one scan:
 //   apply queued parameter writes → safe-state hooks if the machine just entered FAULT/ESTOP →
 //   release every force while in FAULT/ESTOP (the safe state wins at the output latch) →
-//   latch inputs (I/O task only) → programs in order → publish outputs (I/O task only) →
-//   trace sample → statistics → watchdog.
+//   latch inputs (I/O task only) → programs in order → safety supervisor (I/O task only: it
+//   refuses commands and holds the safe state at the output latch) → publish outputs (I/O task
+//   only) → trace sample → statistics → watchdog.
 // The schedulers (scheduler.hpp) decide when run_cycle() is called.
 //
 // Thread-safety: run_cycle() runs on the task's own thread only. post_param_write() may be
@@ -28,6 +29,7 @@
 
 namespace edm::rt {
 
+class Supervisor;
 class TraceRecorder;
 class VariableRegistry;
 
@@ -60,6 +62,9 @@ class Task {
   void detach_trace() noexcept { trace_ = nullptr; }
   /// The registry whose forces this task releases in FAULT/ESTOP. Non-RT, before run.
   void attach_forces(VariableRegistry& r) noexcept { forces_ = &r; }
+  /// The safety supervisor, run after the programs and before the driver publishes the
+  /// outputs (the I/O task only). Non-RT, before run; it must outlive the task's run.
+  void attach_supervisor(Supervisor& s) noexcept { supervisor_ = &s; }
 
   /// One scan for the cycle scheduled at `release`. Returns the time the cycle ended. RT-safe.
   TimePoint run_cycle(TimePoint release, const Clock& clock) noexcept;
@@ -97,6 +102,7 @@ class Task {
   TraceRecorder* trace_{nullptr};
   std::uint32_t trace_channel_{0};
   VariableRegistry* forces_{nullptr};
+  Supervisor* supervisor_{nullptr};
   std::vector<CycleObserver*> observers_;
   TaskStats stats_;
   Watchdog watchdog_;

@@ -1,0 +1,194 @@
+#include "edm/runtime/supervisor.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edm::rt {
+
+namespace {
+
+// Below this, two positions or speeds are the same (the encoder resolves 1 µm).
+constexpr double kEpsilon = 1e-9;
+
+/// The highest speed from which an axis decelerating at a_max after one more cycle at that
+/// speed stops within d: v·dt + v²/(2a) = d.
+double stop_speed(double d_mm, double a_mm_s2, double dt_s) noexcept {
+  if (d_mm <= 0.0) {
+    return 0.0;
+  }
+  return a_mm_s2 * (std::sqrt(dt_s * dt_s + 2.0 * d_mm / a_mm_s2) - dt_s);
+}
+
+Alarm make_alarm(AlarmCode code, AlarmSeverity sev, TimePoint now, const char* source,
+                 const char* text, double value) noexcept {
+  return Alarm{code, sev, now, source, text, value};
+}
+
+}  // namespace
+
+Supervisor::Supervisor(Machine& machine, SupervisorSetup setup, Duration period)
+    : machine_(machine),
+      axes_(setup.axes.size()),
+      command_(setup.axes.size(), 0.0),
+      electrode_mm_(setup.electrode_mm),
+      electrode_margin_mm_(setup.electrode_margin_mm),
+      wire_broken_(setup.wire_broken),
+      generator_(std::move(setup.generator)),
+      dt_s_(to_seconds(period)) {
+  for (std::size_t k = 0; k < axes_.size(); ++k) {
+    axes_[k].cfg = setup.axes[k];
+    axes_[k].source = std::string("safety.") + setup.axes[k].limits.name;
+    axes_[k].speed_source = axes_[k].source + ".v_max";
+  }
+}
+
+void Supervisor::condition(bool active, bool& raised, const Alarm& alarm) noexcept {
+  if (active) {
+    machine_.raise(alarm);  // a repeat only counts: one alarm per occurrence
+    raised = true;
+  } else if (raised) {
+    machine_.clear_alarm(alarm.code, alarm.source);
+    raised = false;
+  }
+}
+
+void Supervisor::check_machine(TimePoint now) noexcept {
+  if (electrode_mm_ != nullptr) {
+    const double left = electrode_mm_->get();
+    condition(!(left > electrode_margin_mm_), electrode_raised_,
+              make_alarm(AlarmCode::kElectrodeUsedUp, AlarmSeverity::kFault, now,
+                         "safety.electrode", "electrode used up: its length left is at the margin",
+                         left));
+  }
+  if (wire_broken_ != nullptr) {
+    condition(wire_broken_->get(), wire_raised_,
+              make_alarm(AlarmCode::kWireBreak, AlarmSeverity::kFault, now, "safety.wire",
+                         "wire break", 1.0));
+  }
+}
+
+bool Supervisor::is_outside(const Axis& a, double x) noexcept {
+  // The command stops at the limit; the mechanics may overshoot it by their dynamic error,
+  // which the following-error band at standstill (min_ferror_mm) allows for.
+  const double tol = std::max(kEpsilon, a.cfg.min_ferror_mm);
+  return !(x >= a.cfg.limits.min_mm - tol && x <= a.cfg.limits.max_mm + tol);
+}
+
+void Supervisor::check_axis(Axis& a, TimePoint now, bool track) noexcept {
+  const double x = a.cfg.position->get();
+  const machining::AxisLimits& lim = a.cfg.limits;
+
+  double ferror = 0.0;
+  bool ferror_over = false;
+  if (track && a.tracking && a.cfg.ferror_mm > 0.0) {
+    ferror = std::abs(a.x_cmd_mm - x);
+    const double share = std::min(1.0, std::abs(a.v_cmd_mm_s) / lim.v_max_mm_s);
+    const double allowed = a.cfg.min_ferror_mm + (a.cfg.ferror_mm - a.cfg.min_ferror_mm) * share;
+    ferror_over = !(ferror <= allowed);  // a NaN position is an error too
+  }
+  a.ferror_now_mm.store(ferror, std::memory_order_relaxed);
+  condition(ferror_over, a.ferror_raised,
+            make_alarm(AlarmCode::kFollowingError, AlarmSeverity::kFault, now, a.source.c_str(),
+                       "following error: the axis lags its command beyond its limit", ferror));
+  if (!track || !a.tracking) {
+    a.x_cmd_mm = x;  // (re)start the model where the axis is
+    a.v_cmd_mm_s = 0.0;
+    a.tracking = track;
+  }
+
+  // Outside the range by more than the drive may overshoot a commanded stop (drift, a wrong
+  // offset, an axis pushed): alarm; commands that go back in are still allowed (limit_command).
+  const bool outside = is_outside(a, x);
+  if (outside) {
+    a.limit_raised = true;
+    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now,
+                              a.source.c_str(), "soft limit: the axis is outside its range", x));
+  }
+}
+
+double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
+  const double requested = a.cfg.velocity->requested();
+  const machining::AxisLimits& lim = a.cfg.limits;
+  const double x = a.cfg.position->get();
+  double v = std::isfinite(requested) ? requested : 0.0;
+
+  const bool too_fast = std::abs(v) > lim.v_max_mm_s + kEpsilon;
+  if (too_fast) {
+    v = std::clamp(v, -lim.v_max_mm_s, lim.v_max_mm_s);
+  }
+  condition(too_fast, a.speed_raised,
+            make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kWarning, now,
+                       a.speed_source.c_str(),
+                       "soft limit: velocity command above v_max_mm_s clamped", requested));
+
+  // A command the axis could not stop from inside the range is cut to one it can.
+  const double d = v > 0.0 ? lim.max_mm - x : x - lim.min_mm;
+  const double allowed = std::isfinite(x) ? stop_speed(d, lim.a_max_mm_s2, dt_s_) : 0.0;
+  const bool refused = std::abs(v) > allowed + kEpsilon;
+  if (refused) {
+    v = v > 0.0 ? allowed : -allowed;
+  }
+  const bool outside = is_outside(a, x);
+  if (refused) {
+    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now,
+                              a.source.c_str(),
+                              "soft limit: a velocity command beyond the range was refused",
+                              requested));
+    a.limit_raised = true;
+  } else if (!outside && a.limit_raised) {
+    machine_.clear_alarm(AlarmCode::kSoftLimit, a.source.c_str());
+    a.limit_raised = false;
+  }
+  if (too_fast || refused) {
+    refused_cycles_.fetch_add(1, std::memory_order_relaxed);
+  }
+  return v;
+}
+
+void Supervisor::supervise(const CycleContext& ctx) noexcept {
+  const MachineState before = machine_.state();
+  const bool track = before != MachineState::kOff && !is_safe_state(before);
+  check_machine(ctx.release);
+  for (Axis& a : axes_) {
+    check_axis(a, ctx.release, track);
+  }
+  for (std::size_t k = 0; k < axes_.size(); ++k) {
+    command_[k] = limit_command(axes_[k], ctx.release);
+  }
+
+  // The state now, after this cycle's alarms: a fault found above stops the axes in this cycle.
+  const MachineState s = machine_.state();
+  for (std::size_t k = 0; k < axes_.size(); ++k) {
+    Axis& a = axes_[k];
+    double v = command_[k];
+    if (s == MachineState::kEstop) {
+      v = 0.0;
+    } else if (s == MachineState::kFault) {
+      const double way = static_cast<double>(a.cfg.retract);
+      v = v * way > 0.0 ? v : 0.0;
+    }
+    const double requested = a.cfg.velocity->requested();
+    if (v != requested) {  // also true for a NaN request
+      a.cfg.velocity->supervise(v);
+    } else {
+      a.cfg.velocity->end_supervision();
+    }
+    if (a.tracking && !is_safe_state(s)) {
+      const double dv = a.cfg.limits.a_max_mm_s2 * dt_s_;
+      a.v_cmd_mm_s += std::clamp(v - a.v_cmd_mm_s, -dv, dv);
+      a.x_cmd_mm += a.v_cmd_mm_s * dt_s_;
+    } else {
+      a.tracking = false;
+    }
+  }
+  const bool safe = is_safe_state(s);
+  for (Input<bool>* g : generator_) {
+    if (safe) {
+      g->supervise(false);
+    } else {
+      g->end_supervision();
+    }
+  }
+}
+
+}  // namespace edm::rt
