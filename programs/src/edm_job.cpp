@@ -115,7 +115,6 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
     errs.push_back({"", "EdmJob needs the runtime's machine, job store and tables"});
     return errs;
   }
-  supervision_.configure(machine_, tables_, "job");
   const double v_needed = kLoopSpeedMargin * params_.rapid_speed_mm_s;
   for (auto [loop, name] : {std::pair<blocks::PositionLoop*, const char*>{&px_, "px"},
                             {&py_, "py"},
@@ -195,7 +194,6 @@ void EdmJob::activate_self() noexcept {
   step_ = Step::kEnter;
   condition_ = nullptr;
   polarity_positive_value_ = false;
-  supervision_.reset();
   stop_outputs();
   gen_arm.set(false);
   flushing_on.set(false);
@@ -429,7 +427,6 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
 rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
   const double x = x_mm.get(), y = y_mm.get(), z = z_mm.get();
-  supervision_.check_limits(ctx.release, x, y, z);
 
   const rt::MachineState ms = ctx.state;
   if (rt::is_safe_state(ms)) hold_valid_ = false;  // loops off: follow the axes
@@ -489,9 +486,6 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   status = rt::worst(status, step(px_, ctx));
   status = rt::worst(status, step(py_, ctx));
   status = rt::worst(status, step(pz_, ctx));
-  supervision_.check_following_error(ctx.release, px_.following_error_fault.get() ||
-                                                      py_.following_error_fault.get() ||
-                                                      pz_.following_error_fault.get());
 
   // Outputs: who drives which axis.
   const std::int64_t ds = drill_.state.get();

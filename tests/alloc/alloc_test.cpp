@@ -435,6 +435,19 @@ TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
   EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
 }
 
+TEST(Allocations, NoneInsideCyclesOfTheSafetySupervisorActing) {
+  // sink-sim's supervisor refusing a forced feed at Z's soft limit (alarm 141, FAULT), then
+  // holding the safe state; the alarms' text and sources are static, nothing is formatted.
+  auto r = build_shipped("sink-sim");
+  ASSERT_NE(r->supervisor(), nullptr);
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  ASSERT_TRUE(r->variables().force("io.vz_cmd", -30.0));  // down to Z min = -60 in 2 s
+  EXPECT_EQ(allocations_in_cycles(*r, 2500), 0u);
+  EXPECT_EQ(r->machine().state(), rt::MachineState::kFault);
+  EXPECT_EQ(r->machine().last_cause(), rt::AlarmCode::kSoftLimit);
+  EXPECT_GT(r->supervisor()->refused_cycles(), 0u);
+}
+
 TEST(Allocations, TheCounterSeesAllocations) {
   // Guards the guard: the replaced operator new really counts.
   g_allocations = 0;

@@ -41,7 +41,8 @@
 // inputs; every other child input reads one of this block's outputs (drill_start, feed_hold,
 // lin_*, arc_*, x_ref_mm, …: the signals the sequence gives its children, observable as
 // variables). The loops' v_max_mm_s must be at least 1.5 × rapid_speed_mm_s (checked at load).
-// Supervision (motion_supervision.hpp): soft limits → alarm 141, following error → alarm 140.
+// Supervision is the runtime's (machine.safety, docs/safety.md): soft limits → alarm 141,
+// following error → alarm 140, whatever program runs.
 //
 // Outputs for the I/O image: vx/vy/vz_cmd_mm_s, gen_arm, gen_on, polarity_positive,
 // on_time_us, off_time_us, servo_ref_v, flushing_on, rotation_on; progress: state, block_index,
@@ -61,7 +62,6 @@
 #include "edm/machining/motion_block.hpp"
 #include "edm/programs/deep_hole_drill.hpp"
 #include "edm/programs/job_figures.hpp"
-#include "edm/programs/motion_supervision.hpp"
 #include "edm/programs/wall_finish.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
@@ -143,7 +143,6 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::JobStore* job_{nullptr};
   const machining::MachineTables* tables_{nullptr};
   JobFigures figures_;
-  MotionSupervision supervision_;
 
   State state_value_{State::kIdle};
   Step step_{Step::kEnter};
