@@ -114,40 +114,47 @@ void SimParams::visit(rt::ParamVisitor& outer) {
            .description = "lambda_b0: bridges per second at c = c_b at the surface",
            .range = rt::kNonNegative});
   v.param("bridge_debris_ref", bridge_debris_ref,
-          {.unit = "1", .description = "c_b: reference debris of the bridge hazard",
+          {.unit = "1",
+           .description = "c_b: reference debris of the bridge hazard",
            .range = rt::open_closed(0.0, 1.0)});
   v.param("bridge_debris_exp", bridge_debris_exp,
-          {.unit = "1", .description = "n_b: bridge hazard grows as (c/c_b)^n_b",
+          {.unit = "1",
+           .description = "n_b: bridge hazard grows as (c/c_b)^n_b",
            .range = rt::kNonNegative});
   v.param("bridge_depth_mm", bridge_depth_mm,
-          {.unit = "mm", .description = "h_b: bridge hazard grows as 1 + h/h_b",
+          {.unit = "mm",
+           .description = "h_b: bridge hazard grows as 1 + h/h_b",
            .range = rt::kPositive});
-  v.param("bridge_mean_ms", bridge_mean_ms,
-          {.unit = "ms", .description = "t_b: mean life of a debris bridge",
-           .range = rt::kPositive});
+  v.param(
+      "bridge_mean_ms", bridge_mean_ms,
+      {.unit = "ms", .description = "t_b: mean life of a debris bridge", .range = rt::kPositive});
   v.param("bridge_clear_um", bridge_clear_um,
-          {.unit = "um", .description = "a back-off of the tip this large breaks a bridge",
+          {.unit = "um",
+           .description = "a back-off of the tip this large breaks a bridge",
            .range = rt::kPositive});
   v.param("tube_guide_mm", tube_guide_mm,
-          {.unit = "mm", .description = "tube: free length between the guide and the surface",
+          {.unit = "mm",
+           .description = "tube: free length between the guide and the surface",
            .range = rt::kNonNegative});
   v.param("vib_amp_ref_um", vib_amp_ref_um,
           {.unit = "um",
            .description = "tube: RMS lateral tip deflection at the free length L_ref (0: none)",
            .range = rt::kNonNegative});
-  v.param("vib_len_ref_mm", vib_len_ref_mm,
-          {.unit = "mm", .description = "tube: reference free length L_ref",
-           .range = rt::kPositive});
+  v.param(
+      "vib_len_ref_mm", vib_len_ref_mm,
+      {.unit = "mm", .description = "tube: reference free length L_ref", .range = rt::kPositive});
   v.param("vib_amp_exp", vib_amp_exp,
-          {.unit = "1", .description = "tube: deflection grows as (L/L_ref)^this",
+          {.unit = "1",
+           .description = "tube: deflection grows as (L/L_ref)^this",
            .range = rt::kNonNegative});
   v.param("vib_freq_ref_hz", vib_freq_ref_hz,
           {.unit = "Hz",
            .description = "tube: first bending frequency at L_ref (scales as (L_ref/L)^2)",
            .range = rt::kPositive});
-  v.param("contact_at_depth_mm", contact_at_depth_mm,
-          {.unit = "mm",
-           .description = "injection: a hard contact meets the tip at this hole depth (<= 0: off)"});
+  v.param(
+      "contact_at_depth_mm", contact_at_depth_mm,
+      {.unit = "mm",
+       .description = "injection: a hard contact meets the tip at this hole depth (<= 0: off)"});
   v.param("contact_clear_um", contact_clear_um,
           {.unit = "um",
            .description = "injection: the tip backed off this far from the contact is clear of it",

@@ -401,8 +401,8 @@ void Plant::publish() noexcept {
   state_.mean_current_a = current_sum_a_;
   state_.flush_effective = flush_effective();
   state_.rab = rab_.rab(state_.now.count());
-  state_.contact = contact_ == Contact::kMet &&
-                   (tip_z_mm() - contact_tip_mm_) * 1e3 < params_.contact_clear_um;
+  state_.contact =
+      contact_ == Contact::kMet && (tip_z_mm() - contact_tip_mm_) * 1e3 < params_.contact_clear_um;
 }
 
 }  // namespace edm::sim

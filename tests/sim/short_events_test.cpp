@@ -171,9 +171,9 @@ TEST(SimShortEvents, debris_bridges_form_more_often_with_more_debris_and_depth) 
     const double base = bridges_per_s(h, c, seed);
     const double more_debris = bridges_per_s(h, c_more, seed);
     const double deeper = bridges_per_s(h_more, c, seed);
-    SCOPED_TRACE(testing::Message() << "seed " << seed << ": c " << c << " -> " << c_more
-                                    << ", h " << h << " -> " << h_more << " mm: " << base
-                                    << " / " << more_debris << " / " << deeper << " per s");
+    SCOPED_TRACE(testing::Message() << "seed " << seed << ": c " << c << " -> " << c_more << ", h "
+                                    << h << " -> " << h_more << " mm: " << base << " / "
+                                    << more_debris << " / " << deeper << " per s");
     // 3 standard deviations of the difference of two Poisson counts over 4 s.
     const double noise = 3.0 * std::sqrt((2.0 * base + more_debris + deeper) / 4.0) + 1.0;
     EXPECT_GE(more_debris, base - noise);
@@ -267,14 +267,58 @@ struct Golden {
 
 TEST(SimShortEvents, switched_off_the_plant_is_edm_sim_params_6_bit_for_bit) {
   const Golden cases[] = {
-      {"drill", 1000, 25.0, 0.3, 0.0, 40.0, 1500, 29761, {801, 23713, 4195, 1052, 0},
-       0x1.963c2863b9adcp+4, 0x1.06f8d16e8f202p-1, -0x1.9af212d77319p+4, 0x1.2babba63d4a66p+8},
-      {"drill", 1001, 0.0, 1.0, -2.0, 0.0, 200, 5616, {282, 998, 81, 15, 4240},
-       0x1.a43c7a0023fb3p-6, 0x1.10534302532abp-4, -0x1.32474538ef34ep-2, 0x1.2bfa9e293c706p+8},
-      {"sink", 1002, 0.0, 1.0, 0.0, 40.0, 500, 2478, {39, 2409, 29, 1, 0},
-       0x1.3bab3862b6b8bp-8, 0x1.98a639cd37381p-10, 0x1.01a36e2eb1c43p-4, 0x1.8fffcbe1a4892p+5},
-      {"wire", 1003, 0.0, 1.0, 0.0, 40.0, 500, 2403, {629, 1667, 89, 18, 0},
-       0x1.38bb1bda7b8dcp-3, 0x1.bcd1f18f74bdp-8, -0x1.14af4f0d844dp-3, 0x1.e848p+19},
+      {"drill",
+       1000,
+       25.0,
+       0.3,
+       0.0,
+       40.0,
+       1500,
+       29761,
+       {801, 23713, 4195, 1052, 0},
+       0x1.963c2863b9adcp+4,
+       0x1.06f8d16e8f202p-1,
+       -0x1.9af212d77319p+4,
+       0x1.2babba63d4a66p+8},
+      {"drill",
+       1001,
+       0.0,
+       1.0,
+       -2.0,
+       0.0,
+       200,
+       5616,
+       {282, 998, 81, 15, 4240},
+       0x1.a43c7a0023fb3p-6,
+       0x1.10534302532abp-4,
+       -0x1.32474538ef34ep-2,
+       0x1.2bfa9e293c706p+8},
+      {"sink",
+       1002,
+       0.0,
+       1.0,
+       0.0,
+       40.0,
+       500,
+       2478,
+       {39, 2409, 29, 1, 0},
+       0x1.3bab3862b6b8bp-8,
+       0x1.98a639cd37381p-10,
+       0x1.01a36e2eb1c43p-4,
+       0x1.8fffcbe1a4892p+5},
+      {"wire",
+       1003,
+       0.0,
+       1.0,
+       0.0,
+       40.0,
+       500,
+       2403,
+       {629, 1667, 89, 18, 0},
+       0x1.38bb1bda7b8dcp-3,
+       0x1.bcd1f18f74bdp-8,
+       -0x1.14af4f0d844dp-3,
+       0x1.e848p+19},
   };
   for (const Golden& g : cases) {
     SCOPED_TRACE(g.preset);

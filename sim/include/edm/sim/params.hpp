@@ -62,18 +62,18 @@ struct SimParams {
   // (L/vib_len_ref_mm)^vib_amp_exp, L = tube_guide_mm + the tip's depth below the surface,
   // touches the wall when |δ| > the side gap: contacts arrive at Rice's up-crossing rate
   // 2 f1 e^(−u²/2), u = side gap/σ, f1 = vib_freq_ref_hz (L_ref/L)², each a hard short.
-  bool short_events{true};  // false: neither (the model before edm-sim-params/7, exactly)
-  double bridge_rate_hz{12.0};      // λ_b0, bridges/s at c = c_b at the surface [bk, cal]
-  double bridge_debris_ref{0.4};    // c_b
-  double bridge_debris_exp{2.0};    // n_b: two-body (particle meets particle)
-  double bridge_depth_mm{10.0};     // h_b: the side gap adds a front's worth per h_b of depth
-  double bridge_mean_ms{1.0};       // t_b, mean life of a bridge
-  double bridge_clear_um{10.0};     // a back-off this large shears a bridge
-  double tube_guide_mm{5.0};        // free tube between the guide and the work surface [bk]
-  double vib_amp_ref_um{20.0};      // σ at vib_len_ref_mm [bk, cal]
-  double vib_len_ref_mm{50.0};      // L_ref
-  double vib_amp_exp{1.5};          // σ ∝ L^this
-  double vib_freq_ref_hz{200.0};    // f1 of the free length at L_ref (brass Ø1.0/0.3 tube)
+  bool short_events{true};        // false: neither (the model before edm-sim-params/7, exactly)
+  double bridge_rate_hz{12.0};    // λ_b0, bridges/s at c = c_b at the surface [bk, cal]
+  double bridge_debris_ref{0.4};  // c_b
+  double bridge_debris_exp{2.0};  // n_b: two-body (particle meets particle)
+  double bridge_depth_mm{10.0};   // h_b: the side gap adds a front's worth per h_b of depth
+  double bridge_mean_ms{1.0};     // t_b, mean life of a bridge
+  double bridge_clear_um{10.0};   // a back-off this large shears a bridge
+  double tube_guide_mm{5.0};      // free tube between the guide and the work surface [bk]
+  double vib_amp_ref_um{20.0};    // σ at vib_len_ref_mm [bk, cal]
+  double vib_len_ref_mm{50.0};    // L_ref
+  double vib_amp_exp{1.5};        // σ ∝ L^this
+  double vib_freq_ref_hz{200.0};  // f1 of the free length at L_ref (brass Ø1.0/0.3 tube)
 
   // --- Injected contact (scenarios, tests; off by default) ---
   // When the hole reaches contact_at_depth_mm (> 0), a hard contact (a chip) meets the tip:
@@ -105,21 +105,21 @@ struct SimParams {
   double removal_scale_positive{0.5};  // removal multiplier for positive polarity [bk]
 
   // --- Tool and workpiece geometry ---
-  std::string tool_kind{"tube"};      // "tube" (drill), "block" (sink), "wire"
-  double tool_od_mm{1.0};             // tube outer diameter
-  double tool_id_mm{0.3};             // tube inner diameter
-  double hole_d_mm{1.1};              // tube: initial hole diameter (wall bins start here)
-  double side_gap_mm{0.07};           // block: side gap per side
-  double tool_width_mm{10.0};         // block
-  double tool_length_mm{10.0};        // block
-  double wire_d_mm{0.25};             // wire diameter D
+  std::string tool_kind{"tube"};  // "tube" (drill), "block" (sink), "wire"
+  double tool_od_mm{1.0};         // tube outer diameter
+  double tool_id_mm{0.3};         // tube inner diameter
+  double hole_d_mm{1.1};          // tube: initial hole diameter (wall bins start here)
+  double side_gap_mm{0.07};       // block: side gap per side
+  double tool_width_mm{10.0};     // block
+  double tool_length_mm{10.0};    // block
+  double wire_d_mm{0.25};         // wire diameter D
   // Tube/block length sticking out, consumed by wear. The one parameter writable at run time:
   // a write says "the electrode now measures this" (a retained length restored at start, an
   // electrode change); the driver reads the length left back through it (docs/simulator.md §5a).
   double electrode_length_mm{300.0};
-  double work_thickness_mm{0.0};      // tube/block: through at this depth; 0 = blind (no limit)
-  double start_gap_um{100.0};         // tip above the work surface at start
-  double initial_depth_mm{0.0};       // a hole already there (tip start_gap_um above its bottom)
+  double work_thickness_mm{0.0};  // tube/block: through at this depth; 0 = blind (no limit)
+  double start_gap_um{100.0};     // tip above the work surface at start
+  double initial_depth_mm{0.0};   // a hole already there (tip start_gap_um above its bottom)
 
   // --- Debris and flushing (§6.2 step 7) ---
   double debris_kappa{0.75};        // κ: c += κ V / V_gap; calibrated [bk], see simulator.md

@@ -75,9 +75,9 @@ struct PlantState {
   double flush_effective{0.0};               // F_eff = F x strength x drop (0 = off)
   std::uint64_t budget_overruns{0};          // advances that hit max_pulses_per_advance
   // Short events (docs/simulator.md §4a):
-  bool contact{false};                   // the injected contact holds the gap short now
-  std::uint64_t bridges{0};              // debris bridges formed so far
-  std::uint64_t vibration_contacts{0};   // lateral tube contacts so far
+  bool contact{false};                  // the injected contact holds the gap short now
+  std::uint64_t bridges{0};             // debris bridges formed so far
+  std::uint64_t vibration_contacts{0};  // lateral tube contacts so far
 };
 
 class Plant {

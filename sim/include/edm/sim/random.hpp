@@ -15,16 +15,16 @@ namespace edm::sim {
 /// One independent stream per use of randomness in a pulse, so adding a draw in one place does not
 /// shift the numbers another place sees. Values are part of the log format: append only.
 enum class Stream : std::uint64_t {
-  kTd = 1,              // ignition delay quantile
-  kArc = 2,             // arc yes/no
-  kArcTd = 3,           // arc delay in U(0, 0.5 µs)
-  kDebrisShort = 4,     // debris-bridge short yes/no
-  kRemovalScatter = 5,  // crater volume scatter (normal, two uniforms per pulse)
-  kSite = 6,            // discharge site when the wall bins compete (orbit)
-  kWireBreak = 7,       // WEDM: the tolerated damage of the abnormal-discharge rupture hazard
-  kShortEvent = 8,      // a short event (debris bridge, tube contact) starts at this pulse
-  kShortEventKind = 9,  // which of the competing events it is
-  kShortEventLife = 10, // how long it lasts
+  kTd = 1,               // ignition delay quantile
+  kArc = 2,              // arc yes/no
+  kArcTd = 3,            // arc delay in U(0, 0.5 µs)
+  kDebrisShort = 4,      // debris-bridge short yes/no
+  kRemovalScatter = 5,   // crater volume scatter (normal, two uniforms per pulse)
+  kSite = 6,             // discharge site when the wall bins compete (orbit)
+  kWireBreak = 7,        // WEDM: the tolerated damage of the abnormal-discharge rupture hazard
+  kShortEvent = 8,       // a short event (debris bridge, tube contact) starts at this pulse
+  kShortEventKind = 9,   // which of the competing events it is
+  kShortEventLife = 10,  // how long it lasts
 };
 
 inline constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
