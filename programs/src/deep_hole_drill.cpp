@@ -52,7 +52,7 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
            .range = rt::open_closed(0.0, 1.0)});
   v.param("short_retracts_max", short_retracts_max,
           {.unit = "",
-           .description = "retracts allowed within short_retracts_window; one more: alarm 150",
+           .description = "retracts without progress allowed within the window; one more: alarm 150",
            .range = rt::closed(1, kMaxShortRetracts)});
   v.param("short_retracts_window", short_retracts_window,
           {.unit = "s",
@@ -78,7 +78,7 @@ DeepHoleDrill::DeepHoleDrill()
   wp.wear_ratio_default = 0.6;
   wear_.set_params(wp);
   blocks::ShortRetractParams rp;
-  rp.short_cycles = 1;   // the detection window is td's
+  rp.short_cycles = 5;   // with td.window: the detection window
   rp.max_tries = 1000;   // the retract budget is this program's (short_retracts_max in a window)
   retract_.set_params(rp);
   blocks::PositionLoopParams zp;
@@ -133,8 +133,7 @@ void DeepHoleDrill::bind_self() {
   gap_.td_us.connect(td_.td_us);
   gap_.valid.connect(td_.valid);
   gap_.tdr_us.follow(tdr_us);
-  // An external servo (wired in YAML, so known only now) replaces the gap child's Vz.
-  wear_.vz_in_mm_s.connect(vz_servo_mm_s.connected() ? vz_servo_cmd_mm_s : gap_.vz_mm_s);
+  wear_.vz_in_mm_s.connect(vz_servo_cmd_mm_s);
   wear_.wear_ratio.follow(wear_ratio);
   wear_.enable.follow(enable_wear_comp);
   wear_.reset_wear.connect(reset_wear);
@@ -240,6 +239,9 @@ bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
   const std::int64_t started = retract_.retracts.get();
   if (started != last_retracts_) {  // a retract began this cycle (also from RESUME)
     last_retracts_ = started;
+    if (retract_.tries.get() <= 1) {
+      n_retract_starts_ = 0;  // the hole advanced retract.progress_mm since the last retract
+    }
     if (too_many_retracts(ctx.release)) {
       // Alarm 150: the machine goes to FAULT; the safe state backs Z off and holds.
       if (machine_ != nullptr) {
@@ -318,17 +320,22 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     status = rt::worst(status, step(gap_, ctx));
     const bool retracting = handle_short(ctx, z, status);
     if (!retracting) {
+      // The servo's command into the wear compensator: the gap child's Vz, or the external
+      // servo's clamped to the gap child's limits; ramped back in after a retract (v_scale
+      // 0 → 1), so the compensator sees the feed the axis makes; never down while the window
+      // reads short.
+      double v = gap_.vz_mm_s.get();
       if (vz_servo_mm_s.connected()) {
-        const double v = vz_servo_mm_s.get();
-        const double limit_down = -gap_.params().v_feed_max_mm_s;
-        const double limit_up = gap_.params().v_retract_max_mm_s;
+        v = vz_servo_mm_s.get();
         if (std::isfinite(v)) {
-          vz_servo_cmd_mm_s.set(std::clamp(v, limit_down, limit_up));
+          v = std::clamp(v, -gap_.params().v_feed_max_mm_s, gap_.params().v_retract_max_mm_s);
         } else {
-          vz_servo_cmd_mm_s.set(0.0);
+          v = 0.0;
           status = rt::worst(status, rt::BlockStatus::kFault);
         }
       }
+      v *= retract_.v_scale.get();
+      vz_servo_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
       status = rt::worst(status, step(wear_, ctx));
       reset_wear.set(false);
     }
@@ -349,11 +356,9 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       set_state(State::kBreakthrough);
     } else if (state_value_ == State::kDrill) {
       gen_on.set(true);
-      // Retracting: zloop follows the retract's setpoint. Else the servo's command, which ramps
-      // back in after a retract (v_scale 0 → 1). While the window reads short, never toward the
-      // work.
-      const double v = retracting ? zloop_.v_cmd_mm_s.get()
-                                  : wear_.vz_out_mm_s.get() * retract_.v_scale.get();
+      // Retracting: zloop follows the retract's setpoint; else the compensated servo command.
+      // While the window reads short, never toward the work.
+      const double v = retracting ? zloop_.v_cmd_mm_s.get() : wear_.vz_out_mm_s.get();
       vz_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
     }
   }

@@ -209,7 +209,9 @@ TEST_P(DrillMachines, NoAllocationInsideCyclesWhileAJobDrills) {
   ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "it really drilled";
-  EXPECT_EQ(r->variables().read("cnc.job.drill.state"), 2.0) << "drilling from the job";
+  EXPECT_EQ(r->variables().read("cnc.job.drill.state"), 2.0)
+      << "drilling from the job; machine " << rt::to_string(r->machine().state()) << ", cause "
+      << static_cast<int>(r->machine().last_cause());
 }
 
 INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachines, ::testing::Values("drill-sim", "drill-fuzzy-sim"),

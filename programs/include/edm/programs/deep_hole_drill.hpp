@@ -45,16 +45,19 @@
 //
 // Short circuits (DRILL). td pools a short as a pulse with Td ≈ 0 (gap truth, seed 004), so a
 // short-dominated window makes the P law back off by itself. Besides that:
-//   gap_short = td.short_ratio ≥ short_ratio_limit (the detection window is td.window cycles);
+//   gap_short = td.short_ratio ≥ short_ratio_limit (0.9: a short-dominated td.window; the
+//   occasional debris shorts of a loaded gap stay below it and are the P law's to handle);
 //   while gap_short the Z command never points down (vz ≥ 0);
-//   retract (ShortRetract, retract.short_cycles consecutive gap_short cycles, 1 by default) backs
+//   retract (ShortRetract, after retract.short_cycles consecutive gap_short cycles, 5 here) backs
 //   Z off along the path already drilled (retract.retract_distance_mm at retract_speed_mm_s),
 //   walks forward again and hands back with a ramp (v_scale); zloop (PositionLoop) follows its
 //   setpoint; the generator stays on. short_retracts counts them, short_time_s is the time
 //   they took.
-//   More than short_retracts_max retracts within short_retracts_window: alarm 150
-//   (kShortCircuit, a fault) instead of another retract; the safe state then backs Z off by
-//   short_backoff_mm with the generator off and holds (IDLE, done = false).
+//   More than short_retracts_max retracts within short_retracts_window without the hole
+//   advancing retract.progress_mm between them (a contact the retracts cannot clear; the
+//   occasional shorts of a deep hole are each followed by progress): alarm 150 (kShortCircuit,
+//   a fault) instead of another retract; the safe state then backs Z off by short_backoff_mm
+//   with the generator off and holds (IDLE, done = false).
 // Children and their parameters are variables of their own (`<instance>.gap.kg`, …), set in
 // YAML under this block's params (`gap: {kg: 0.147}`). This program gives its children these
 // defaults: gap.idle_feed_mm_s = −0.5 mm/s (the creep while the Td window holds no ignited
@@ -62,10 +65,12 @@
 // The children are connected by member in bind_self():
 //   td.{td_sum_ns,td_count,n_open,n_short} ← this block's inputs
 //   gap.td_us, gap.valid ← td;   gap.tdr_us ← tdr_us
-//   wear.vz_in_mm_s ← gap.vz_mm_s, or ← vz_servo_cmd_mm_s when vz_servo_mm_s is wired
+//   wear.vz_in_mm_s ← vz_servo_cmd_mm_s (gap.vz_mm_s, or the external servo's when
+//                     vz_servo_mm_s is wired: bind() sees the YAML wiring)
 //   wear.wear_ratio ← wear_ratio;  wear.enable ← enable_wear_comp;  wear.reset_wear ← reset_wear
 // Extra outputs: reset_wear (true in the cycle the wear estimate restarts, at the touch) and
-// vz_servo_cmd_mm_s (the external servo's command after the gap child's clamp).
+// vz_servo_cmd_mm_s (the servo command into wear: clamped, ramped after a retract, never down
+// while the gap reads short).
 //
 // Accuracy on the simulator (drill preset, 20 mm, tests/programs): the hole ends ≈ 0.25 mm short
 // with wear compensation (≈ 9 mm short without): eq. (8) estimates the wear from the bottom feed
@@ -100,7 +105,7 @@ struct DeepHoleDrillParams {
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
   // Short circuits (seed 004: a short reads as feedback ≈ 0, so it must back the electrode off).
   static constexpr std::int64_t kMaxShortRetracts = 16;
-  double short_ratio_limit{0.5};           // the Td window reads short at this fraction of shorts
+  double short_ratio_limit{0.9};           // the Td window reads short at this fraction of shorts
   std::int64_t short_retracts_max{3};      // N: retracts allowed within short_retracts_window
   rt::Duration short_retracts_window{std::chrono::seconds(10)};  // T
   double short_backoff_mm{1.0};  // [mm] Z backs off this far on alarm 150, then holds

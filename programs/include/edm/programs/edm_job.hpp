@@ -72,7 +72,7 @@ namespace edm::programs {
 struct EdmJobParams {
   double rapid_speed_mm_s{10.0};          // [mm/s]
   double feed_default_mm_s{2.0};          // [mm/s] linear/arc feed when the block has none
-  double orbit_radius_offset_mm{0.5525};  // [mm] electrode radius + finishing side gap
+  double orbit_radius_offset_mm{0.5549};  // [mm] electrode radius + finishing side gap
   rt::Duration polarity_settle{std::chrono::milliseconds(20)};
 
   void visit(rt::ParamVisitor& v);
