@@ -27,19 +27,6 @@ using namespace std::chrono_literals;
 
 const std::string kConfig = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim-program.yaml";
 
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-void replace_once(std::string& s, const std::string& from, const std::string& to) {
-  const auto at = s.find(from);
-  ASSERT_NE(at, std::string::npos) << from;
-  s.replace(at, from.size(), to);
-}
-
 struct Outcome {
   bool done{false};
   double true_depth_mm{0.0};  // io.depth_mm at DONE
@@ -54,17 +41,13 @@ struct Outcome {
 
 Outcome run(int seed, bool wear_comp, double limit_s = 200.0) {
   Outcome o;
-  std::string text = slurp(kConfig);
+  std::string text = read_file(kConfig);
   replace_once(text, "seed: 1", "seed: " + std::to_string(seed));
   if (!wear_comp) {
     replace_once(text, "drill.enable_wear_comp: true", "drill.enable_wear_comp: false");
   }
-  rt::Config cfg = rt::parse_config_text(text, "drill-sim-program.yaml");
-  auto r = build_sim_machine(cfg);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
+  SteppedMachine m(text, "drill-sim-program.yaml");
+  auto& vars = m.vars;
   auto pin = [&](const char* name) {
     const rt::Variable* v = vars.find(name);
     EXPECT_NE(v, nullptr) << name;
@@ -77,14 +60,11 @@ Outcome run(int seed, bool wear_comp, double limit_s = 200.0) {
   double shorts = 0.0;
   double pulses = 0.0;
   std::int64_t drill_cycles = 0;
-  std::ostringstream sink;
   const auto cycles = static_cast<std::int64_t>(limit_s * 1000.0);
   std::int64_t k = 0;
   double electrode0 = -1.0;
   for (; k < cycles; ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
+    m.run_cycle(k);
     if (electrode0 < 0.0) electrode0 = vars.read("io.electrode_mm").value();
     const double s = rt::read_pin_as_double(state);
     if (s == 2.0) {
@@ -92,7 +72,6 @@ Outcome run(int seed, bool wear_comp, double limit_s = 200.0) {
       shorts += rt::read_pin_as_double(n_short);
       for (const rt::PinRef& p : all) pulses += rt::read_pin_as_double(p);
     }
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
     if (s == 4.0) {
       o.done = true;
       break;
@@ -147,21 +126,11 @@ INSTANTIATE_TEST_SUITE_P(Seeds, DrillSeeds, ::testing::Values(1, 2, 3));
 // Feed hold in the middle of a hole: the generator goes off and Z stops at once, nothing erodes
 // or wears meanwhile, and on release the cycle goes on to the same accurate depth.
 TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
-  rt::Config cfg = rt::parse_config_text(slurp(kConfig), "drill-sim-program.yaml");
-  auto r = build_sim_machine(cfg);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
-  std::ostringstream sink;
-  std::int64_t k = 0;
-  auto cycle = [&] {
-    const rt::TimePoint release{1ms * k++};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
-  };
-  auto read = [&](const char* n) { return vars.read(n).value(); };
+  SteppedMachine m(read_file(kConfig), "drill-sim-program.yaml");
+  auto& vars = m.vars;
+  const std::int64_t& k = m.next;
+  auto cycle = [&] { m.cycle(); };
+  auto read = [&](const char* n) { return m.read(n); };
   while (k < 200'000 && read("cycle.drill.depth_reached_mm") < 8.0) cycle();
   ASSERT_EQ(read("cycle.drill.state"), 2.0) << "drilling";
 
@@ -206,24 +175,17 @@ struct Through {
 
 Through run_through(bool through) {
   Through t;
-  std::string text = slurp(kConfig);
+  std::string text = read_file(kConfig);
   replace_once(text, "params: {preset: drill, seed: 1}",
                "params: {preset: drill, seed: 1, work_thickness_mm: 3}");
   replace_once(text, "depth_default_mm: 20", "depth_default_mm: 10");
   replace_once(
       text, "      drill.start: true",
       std::string("      drill.start: true\n      drill.through: ") + (through ? "true" : "false"));
-  auto r = build_sim_machine(rt::parse_config_text(text, "through.yaml"));
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
-  std::ostringstream sink;
+  SteppedMachine m(text, "through.yaml");
+  auto& vars = m.vars;
   for (std::int64_t k = 0; k < 60'000; ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    m.run_cycle(k);
     if (vars.read("cycle.drill.breakthrough").value() != 0.0) t.breakthrough = true;
     if (vars.read("cycle.drill.state").value() == 4.0) {
       t.done = true;

@@ -26,11 +26,7 @@ programs::DeepHoleDrillParams params() {
   return p;
 }
 
-TEST(DeepHoleDrill, RegisteredAsAProgramType) {
-  rt::BlockRegistry r;
-  programs::register_builtin_programs(r);
-  EXPECT_NE(r.create("DeepHoleDrill"), nullptr);
-}
+TEST(DeepHoleDrill, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("DeepHoleDrill")); }
 
 TEST(DeepHoleDrill, IdleUntilARisingStartThenApproachesWithTheGeneratorOn) {
   Rig r(params());

@@ -30,12 +30,18 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+// Runs the first task of `r` one 1 ms cycle per call on its own virtual clock (trace detached).
+struct CycleByCycle {
+  rt::VirtualClock clock;
+  rt::Task& task;
+  rt::TimePoint t{};
+  explicit CycleByCycle(rt::Runtime& r) : task(*r.tasks()[0]) { task.detach_trace(); }
+  void operator()() {
+    clock.advance_to(t);
+    task.run_cycle(t, clock);
+    t += 1ms;
+  }
+};
 
 const std::string kDrillProgram =
     std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim-program.yaml";
@@ -100,7 +106,7 @@ TEST(NestedParams, ListVarsOfTheDemoMachineShowsKgWithItsMetadata) {
 }
 
 std::string with_gap_params(const std::string& gap_yaml) {
-  std::string text = slurp(kDrillProgram);
+  std::string text = read_file(kDrillProgram);
   const std::string from = "wear: {wear_ratio_default: 0.6166}";
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos);
@@ -114,7 +120,7 @@ double read_kg(const std::string& text) {
 }
 
 TEST(NestedParams, KgIsSetFromYamlAsANestedMapOrADottedKey) {
-  EXPECT_DOUBLE_EQ(read_kg(slurp(kDrillProgram)), blocks::GapControllerPParams{}.kg);
+  EXPECT_DOUBLE_EQ(read_kg(read_file(kDrillProgram)), blocks::GapControllerPParams{}.kg);
   EXPECT_DOUBLE_EQ(read_kg(with_gap_params("gap: {kg: 0.147}")), 0.147);
   EXPECT_DOUBLE_EQ(read_kg(with_gap_params("gap.kg: 0.147")), 0.147);
 }
@@ -130,7 +136,7 @@ TEST(NestedParams, BadChildParametersAreRefusedAtTheirLine) {
     return rt::Diagnostic{};
   };
   // The drill block's line in drill-sim-program.yaml.
-  const std::string text = slurp(kDrillProgram);
+  const std::string text = read_file(kDrillProgram);
   const auto at = text.find("{name: drill, type: DeepHoleDrill");
   ASSERT_NE(at, std::string::npos);
   const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
@@ -161,15 +167,7 @@ TEST(NestedParams, ABridgeWriteOfKgActsOnTheNextCycle) {
   co.timeout = 10s;
   ASSERT_EQ(client.connect(co), bridge::Role::kOperator);
 
-  rt::VirtualClock clock;
-  rt::Task& task = *r->tasks()[0];
-  task.detach_trace();
-  rt::TimePoint t{};
-  const auto cycle = [&] {
-    clock.advance_to(t);
-    task.run_cycle(t, clock);
-    t += 1ms;
-  };
+  CycleByCycle cycle(*r);
   rt::VariableRegistry& vars = r->variables();
   const auto value = [&](const char* name) { return vars.read(name).value_or(NAN); };
   // Into DRILL, then 0.5 s of gap control.
@@ -202,15 +200,7 @@ TEST(NestedParams, ABridgeWriteOfKgActsOnTheNextCycle) {
 TEST(NestedParams, AFaultNamesTheChildThatRaisedIt) {
   auto r = build_sim_machine(rt::parse_config_file(kDrillProgram));
   r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  rt::Task& task = *r->tasks()[0];
-  task.detach_trace();
-  rt::TimePoint t{};
-  const auto cycle = [&] {
-    clock.advance_to(t);
-    task.run_cycle(t, clock);
-    t += 1ms;
-  };
+  CycleByCycle cycle(*r);
   for (int k = 0; k < 20000 && r->variables().read("cycle.drill.state") != 2.0; ++k) cycle();
   ASSERT_TRUE(r->variables().force("cycle.drill.td.td_count", -5.0));  // an impossible counter
   cycle();  // the td child faults: alarm, FAULT (the next cycle releases the force and clears it)

@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,7 @@
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/scheduler.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "support/files.hpp"
 
 namespace edm::test {
 
@@ -60,6 +63,40 @@ struct VirtualMachine {
     EXPECT_NE(v, nullptr) << name;
     return v != nullptr ? v->pin : rt::PinRef{};
   }
+};
+
+/// Replaces the first `from` in `s` by `to` (a test failure if `s` has none).
+inline void replace_once(std::string& s, const std::string& from, const std::string& to) {
+  const auto at = s.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  s.replace(at, from.size(), to);
+}
+
+// A machine built from config text and powered on, its first task run one 1 ms cycle at a time on
+// a virtual clock: `run_cycle(k)` runs cycle k (released at k ms), `cycle()` the next one. The
+// trace is drained every 4096 cycles so that it never fills.
+struct SteppedMachine {
+  std::unique_ptr<rt::Runtime> runtime;
+  rt::VirtualClock clock;
+  rt::Task& task;
+  rt::VariableRegistry& vars;
+  std::int64_t next{0};  // the cycle cycle() runs
+  std::ostringstream sink;
+
+  SteppedMachine(const std::string& text, const std::string& name)
+      : runtime(build_sim_machine(rt::parse_config_text(text, name))),
+        task(*runtime->tasks()[0]),
+        vars(runtime->variables()) {
+    runtime->machine().command(rt::MachineCommand::kPowerOn);
+  }
+  void run_cycle(std::int64_t k) {
+    const rt::TimePoint release{std::chrono::milliseconds(1) * k};
+    clock.advance_to(release);
+    task.run_cycle(release, clock);
+    if (k % 4096 == 0) runtime->trace().drain(sink), sink.str({});
+  }
+  void cycle() { run_cycle(next++); }
+  double read(const char* name) { return vars.read(name).value(); }
 };
 
 }  // namespace edm::test

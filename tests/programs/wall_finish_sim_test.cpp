@@ -31,13 +31,6 @@ using namespace std::chrono_literals;
 const std::string kConfig =
     std::string(EDM_SOURCE_DIR) + "/config/machines/finish-sim-program.yaml";
 
-std::string slurp(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 struct Finish {
   bool done{false};
   bool gen_before_positive{false};
@@ -50,35 +43,22 @@ struct Finish {
   double short_fraction{0.0};
 };
 
-void replace_once(std::string& s, const std::string& from, const std::string& to) {
-  const auto at = s.find(from);
-  ASSERT_NE(at, std::string::npos) << from;
-  s.replace(at, from.size(), to);
-}
-
 Finish run(int seed, double final_offset_mm, double limit_s) {
   Finish f;
-  std::string text = slurp(kConfig);
+  std::string text = read_file(kConfig);
   replace_once(text, "seed: 1", "seed: " + std::to_string(seed));
   replace_once(text, "finish.final_offset_mm: 0.048",
                "finish.final_offset_mm: " + std::to_string(final_offset_mm));
-  rt::Config cfg = rt::parse_config_text(text, "finish-sim-program.yaml");
-  auto r = build_sim_machine(cfg);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
-  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(r->driver()).plant();
+  SteppedMachine m(text, "finish-sim-program.yaml");
+  auto& vars = m.vars;
+  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(m.runtime->driver()).plant();
   f.r_initial_mm = plant.wall_bin_radius_mm(0);
   double shorts = 0.0;
   double pulses = 0.0;
-  std::ostringstream sink;
   const auto cycles = static_cast<std::int64_t>(limit_s * 1000.0);
   std::int64_t k = 0;
   for (; k < cycles; ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
+    m.run_cycle(k);
     if (vars.read("cycle.finish.gen_on").value() != 0.0 &&
         (vars.read("cycle.finish.polarity_positive").value() == 0.0 ||
          vars.read("io.polarity_positive").value() == 0.0)) {
@@ -89,7 +69,6 @@ Finish run(int seed, double final_offset_mm, double limit_s) {
       pulses += vars.read("io.td_count").value() + vars.read("io.n_open").value() +
                 vars.read("io.n_short").value();
     }
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
     if (vars.read("cycle.finish.state").value() == 4.0) {
       f.done = true;
       break;
@@ -157,23 +136,13 @@ TEST(WallFinishSim, UncalibratedFinalOffsetEqualToTheGrowth) {
 // Feed hold in the orbit: the generator goes off and the electrode stays still, nothing erodes
 // and no revolution counts meanwhile; on release the finish ends within its ±5 µm as without.
 TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
-  rt::Config cfg = rt::parse_config_text(slurp(kConfig), "finish-sim-program.yaml");
-  auto r = build_sim_machine(cfg);
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
-  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(r->driver()).plant();
+  SteppedMachine m(read_file(kConfig), "finish-sim-program.yaml");
+  auto& vars = m.vars;
+  const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(m.runtime->driver()).plant();
   const double target = plant.wall_bin_radius_mm(0) + 0.05;
-  std::ostringstream sink;
-  std::int64_t k = 0;
-  auto cycle = [&] {
-    const rt::TimePoint release{1ms * k++};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
-  };
-  auto read = [&](const char* n) { return vars.read(n).value(); };
+  const std::int64_t& k = m.next;
+  auto cycle = [&] { m.cycle(); };
+  auto read = [&](const char* n) { return m.read(n); };
   while (k < 120'000 && read("cycle.finish.revolutions") < 5.0) cycle();
   ASSERT_EQ(read("cycle.finish.state"), 2.0) << "orbiting";
 
@@ -207,21 +176,15 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
 // An orbit that never sparks (the electrode 3 mm above the work: no wall, no front) trips the
 // no-spark timeout: a block fault, the machine goes to FAULT, the finish is abandoned.
 TEST(FinishNoSpark, AnOrbitThatNeverSparksFaultsAfterTheTimeout) {
-  std::string text = slurp(kConfig);
+  std::string text = read_file(kConfig);
   replace_once(text, "initial_depth_mm: 2}", "initial_depth_mm: 2, start_gap_um: 5000}");
   replace_once(text, "spark_out_revs: 4,", "spark_out_revs: 4, no_spark_timeout: 3s,");
-  auto r = build_sim_machine(rt::parse_config_text(text, "finish-sim-program.yaml"));
-  r->machine().command(rt::MachineCommand::kPowerOn);
-  rt::VirtualClock clock;
-  auto& task = *r->tasks()[0];
-  auto& vars = r->variables();
-  std::ostringstream sink;
+  SteppedMachine m(text, "finish-sim-program.yaml");
+  auto& r = m.runtime;
+  auto& vars = m.vars;
   std::int64_t k = 0, orbit_from = -1;
   for (; k < 20'000 && !rt::is_safe_state(r->machine().state()); ++k) {
-    const rt::TimePoint release{1ms * k};
-    clock.advance_to(release);
-    task.run_cycle(release, clock);
-    if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
+    m.run_cycle(k);
     if (orbit_from < 0 && vars.read("cycle.finish.state").value() == 2.0) orbit_from = k;
     EXPECT_EQ(vars.read("io.td_count").value(), 0.0) << "no spark at all";
   }

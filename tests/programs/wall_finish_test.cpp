@@ -4,6 +4,7 @@
 // safe state.
 
 #include "edm/programs/wall_finish.hpp"
+#include "composite_rig.hpp"
 #include "support/param_access.hpp"
 
 #include <gtest/gtest.h>
@@ -22,65 +23,31 @@ namespace {
 using namespace std::chrono_literals;
 using programs::WallFinish;
 
-struct Rig {
-  WallFinish wf;
-  rt::Output<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+struct Rig : CompositeRig<WallFinish> {
+  WallFinish& wf{block};
   rt::Output<double> x_mm, y_mm, start_offset, final_offset;
-  rt::Output<bool> start;
-  std::map<std::string, rt::PinRef> pins;
-  rt::CycleContext ctx;
 
-  explicit Rig(const programs::WallFinishParams& p) {
-    wf.set_params(p);
+  explicit Rig(const programs::WallFinishParams& p) : CompositeRig(p) {
     // orbit.kr keeps WallFinish's default 1e-4 mm/µs: Td = 10 µs → Δr = 1 µm per revolution.
     EXPECT_TRUE(write_param(wf, "orbit.dr_max_mm", rt::ParamValue::of_real(0.005)).empty());
-    EXPECT_TRUE(wf.validate().empty());
-    EXPECT_TRUE(wf.configure({"cycle.finish", 1ms}).empty());
-    struct Collect final : rt::PinVisitor {
-      std::map<std::string, rt::PinRef>* out;
-      void on_pin(std::string_view n, rt::PinRef r, std::string_view) override {
-        (*out)[std::string(n)] = r;
-      }
-    } c;
-    c.out = &pins;
-    wf.visit_pins(c);
-    in<std::int64_t>("td_sum_ns").connect(td_sum_ns);
-    in<std::int64_t>("td_count").connect(td_count);
-    in<std::int64_t>("n_open").connect(n_open);
-    in<std::int64_t>("n_short").connect(n_short);
+    configure("cycle.finish");
     in<double>("x_mm").connect(x_mm);
     in<double>("y_mm").connect(y_mm);
     in<double>("start_offset_mm").connect(start_offset);
     in<double>("final_offset_mm").connect(final_offset);
-    in<bool>("start").connect(start);
-    wf.bind();
-    wf.activate();
-    ctx.period = 1ms;
-    ctx.dt_s = 0.001;
+    activate();
     x_mm.set(3.0);
     y_mm.set(-2.0);
   }
-  template <class T>
-  rt::Input<T>& in(const std::string& n) {
-    return *pins.at(n).as_input<T>();
-  }
-  template <class T>
-  T out(const std::string& n) {
-    return pins.at(n).as_output<T>()->get();
-  }
-  std::int64_t state() { return out<std::int64_t>("state"); }
-  bool gen() { return out<bool>("gen_on"); }
   bool positive() { return out<bool>("polarity_positive"); }
   double offset() { return out<double>("offset_mm"); }
   double r() { return std::hypot(x_mm.get() - 3.0, y_mm.get() + 2.0); }
   // Sparks at a constant Td while the generator is on.
   void step(double td_us = 10.0) {
     if (gen()) {
-      td_count.set(10);
-      td_sum_ns.set(static_cast<std::int64_t>(10.0 * td_us * 1000.0));
+      sparks(10, td_us);
     } else {
-      td_count.set(0);
-      td_sum_ns.set(0);
+      sparks(0, 0.0);
     }
     wf.update(ctx);
     x_mm.set(x_mm.get() + out<double>("vx_cmd_mm_s") * ctx.dt_s);
@@ -98,11 +65,7 @@ programs::WallFinishParams params() {
   return p;
 }
 
-TEST(WallFinish, RegisteredAsAProgramType) {
-  rt::BlockRegistry r;
-  programs::register_builtin_programs(r);
-  EXPECT_NE(r.create("WallFinish"), nullptr);
-}
+TEST(WallFinish, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("WallFinish")); }
 
 TEST(WallFinish, RejectsBadParameters) {
   programs::WallFinishParams p = params();
