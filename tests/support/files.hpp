@@ -3,9 +3,13 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
+#include <utility>
 
 namespace edm::test {
 
@@ -23,5 +27,30 @@ inline void write_file(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << bytes;
 }
+
+#ifdef EDM_TEST_DATA_DIR
+/// The text of tests/data/<name> with each `{{key}}` in it replaced by its value: for configs that
+/// several tests share or that differ only in a few values. Throws when the file is missing or
+/// empty, or a key is not in it.
+inline std::string test_data(
+    const std::string& name,
+    std::initializer_list<std::pair<std::string_view, std::string>> values = {}) {
+  std::string text = read_file(std::string(EDM_TEST_DATA_DIR) + "/data/" + name);
+  if (text.empty()) {
+    throw std::runtime_error("tests/data/" + name + ": missing or empty");
+  }
+  for (const auto& [key, value] : values) {
+    const std::string marker = "{{" + std::string(key) + "}}";
+    std::size_t at = text.find(marker);
+    if (at == std::string::npos) {
+      throw std::runtime_error("tests/data/" + name + ": no " + marker);
+    }
+    for (; at != std::string::npos; at = text.find(marker, at + value.size())) {
+      text.replace(at, marker.size(), value);
+    }
+  }
+  return text;
+}
+#endif
 
 }  // namespace edm::test
