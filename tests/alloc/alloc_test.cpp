@@ -11,6 +11,7 @@
 #include "edm/machining/motion_block.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "support/files.hpp"
 #include "support/runtime_fixture.hpp"
 
 namespace {
@@ -222,67 +223,10 @@ INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachines, ::testing::Values("drill-sim", 
 
 // Every seed-004 block in one program on the simulated drill: Td detector → P gap controller →
 // wear compensation → Z, interpolators and position loops for X/Y, orbit expander, polarity
-// switch and short retract.
-constexpr const char* kSeed004 = R"(version: 1
-machine:
-  name: alloc-004
-  io: {driver: sim, params: {preset: drill, seed: 3}}
-tasks:
-  - {name: servo, interval: 1ms, priority: 0, programs: [drill]}
-programs:
-  - name: drill
-    blocks:
-      - {name: td, type: TdDetector, params: {window: 8}}
-      - {name: gap, type: GapControllerP, params: {kg: 0.05, tdr_default_us: 8}}
-      - {name: wear, type: WearCompensator}
-      - {name: retract, type: ShortRetract, params: {history_capacity: 1024}}
-      - {name: lin, type: LinearInterpolator}
-      - {name: arc, type: CircularInterpolator}
-      - {name: orbit, type: OrbitExpander, params: {samples_per_rev: 100}}
-      - {name: px, type: PositionLoop}
-      - {name: py, type: PositionLoop}
-      - {name: pol, type: PolaritySwitch}
-    wires:
-      td.td_sum_ns: io.td_sum_ns
-      td.td_count: io.td_count
-      td.n_open: io.n_open
-      td.n_short: io.n_short
-      gap.td_us: td.td_us
-      gap.valid: td.valid
-      wear.vz_in_mm_s: gap.vz_mm_s
-      wear.wear_ratio: 0.6
-      io.vz_cmd: wear.vz_out_mm_s
-      retract.z_mm: io.z_mm
-      lin.start: true
-      lin.lx_mm: 0.5
-      lin.feed_mm_min: 30
-      arc.start: true
-      arc.i_mm: 0.2
-      arc.full_circle: true
-      arc.turns: 100
-      arc.feed_mm_min: 60
-      orbit.start: true
-      orbit.final_radius_mm: 0.05
-      orbit.td_us: td.td_us
-      orbit.valid: td.valid
-      px.x_ref_mm: arc.rx_mm
-      px.v_ff_mm_s: arc.vx_mm_s
-      px.x_mm: io.x_mm
-      py.x_ref_mm: arc.ry_mm
-      py.v_ff_mm_s: arc.vy_mm_s
-      py.x_mm: io.y_mm
-      io.vx_cmd: px.v_cmd_mm_s
-      io.vy_cmd: py.v_cmd_mm_s
-      pol.generator_on_request: true
-      io.gen_on: pol.generator_on
-      io.gen_arm: true
-      io.polarity_positive: pol.polarity_positive
-trace:
-  variables: [io.depth_mm, drill.gap.vz_mm_s, drill.orbit.radius_mm]
-)";
-
+// switch and short retract (tests/data/alloc/seed_004.yaml).
 TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
-  auto r = build_sim_machine(rt::parse_config_text(kSeed004, "alloc-004.yaml"));
+  auto r =
+      build_sim_machine(rt::parse_config_text(test_data("alloc/seed_004.yaml"), "alloc-004.yaml"));
   EXPECT_EQ(allocations_in_cycles(*r, 2000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "the Td controller drilled";
   EXPECT_GT(r->variables().read("drill.arc.swept_rad").value(), 1.0) << "the arc moved";
@@ -290,55 +234,11 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed004Blocks) {
 
 // Every seed-003 and seed-000 block on the simulated wire machine: discharge-state counter →
 // fuzzy servo table → Z feed; Rab → Butterworth → GM(1,1) → self-tuning fuzzy PI → arc-off time
-// and servo reference voltage. The fuzzy rules come from YAML text (parsed at load time only).
-constexpr const char* kSeed003And000 = R"yaml(version: 1
-machine:
-  name: alloc-003-000
-  io: {driver: sim, params: {preset: wire, seed: 5}}
-tasks:
-  - {name: servo, interval: 1ms, priority: 0, programs: [wire]}
-programs:
-  - name: wire
-    blocks:
-      - {name: dsc, type: DischargeStateCounter, params: {interval: 8}}
-      - name: lut
-        type: FuzzyServoLUT
-        params:
-          v_max_mm_s: 0.5
-          velocity_terms: "NB=tri(-1.5,-1,-0.5) ZE=tri(-0.5,0,0.5) PB=tri(0.5,1,1.5)"
-          rules: |
-            if open is Z and short is Z then v is ZE;
-            if open is M and short is Z then v is PB; if open is L then v is PB;
-            if short is M then v is NB; if short is L then v is NB;
-            if open is Z and short is Z then v is ZE
-      - {name: dir, type: Gain, params: {k: -1.0}}
-      - {name: lp, type: ButterworthLowPass, params: {cutoff: 0.012}}
-      - {name: gm, type: GreyPredictorGM11, params: {window: 5, horizon: 37}}
-      - {name: pi, type: SelfTuningFuzzyPI, params: {ku: 0.06, kv: 0.03, rab_ref_default: 0.3}}
-    wires:
-      dsc.n_open: io.n_open
-      dsc.n_normal: io.n_normal
-      dsc.n_short: io.n_short
-      dsc.n_transient_arc: io.n_transient_arc
-      dsc.n_stable_arc: io.n_stable_arc
-      lut.open_count: dsc.open_count
-      lut.short_count: dsc.short_count
-      dir.in: lut.v_mm_s
-      io.vz_cmd: dir.out
-      lp.in: io.rab
-      gm.in: lp.out
-      pi.rab_p: gm.out
-      pi.rab_f: lp.out
-      io.arc_off_time_us: pi.arc_off_time_us
-      io.servo_ref_v: pi.servo_ref_v
-      io.gen_arm: true
-      io.gen_on: true
-trace:
-  variables: [io.rab, wire.lut.v_mm_s, wire.pi.arc_off_time_us, wire.gm.out]
-)yaml";
-
+// and servo reference voltage. The fuzzy rules come from YAML text (parsed at load time only)
+// (tests/data/alloc/seed_003_000.yaml).
 TEST(Allocations, NoneInsideCyclesOfTheSeed003And000Blocks) {
-  auto r = build_sim_machine(rt::parse_config_text(kSeed003And000, "alloc-003-000.yaml"));
+  auto r = build_sim_machine(
+      rt::parse_config_text(test_data("alloc/seed_003_000.yaml"), "alloc-003-000.yaml"));
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   const double pulses = r->variables().read("wire.dsc.open_count").value() +
                         r->variables().read("wire.dsc.normal_count").value() +
@@ -349,51 +249,11 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed003And000Blocks) {
 
 // Seed 001 and 002 blocks on the simulated sink machine: five-state ratios → SelfTuningRegulator
 // → servo reference voltage (the machine's own servo) and pulse-off time; a stand-alone
-// RecursiveLeastSquares; an IterativeLearningControl block learning over 100-sample cycles.
-constexpr const char* kSeed001And002 = R"yaml(version: 1
-machine:
-  name: alloc-001-002
-  io: {driver: sim, params: {preset: sink, seed: 6}}
-tasks:
-  - {name: servo, interval: 1ms, priority: 0, programs: [sink]}
-programs:
-  - name: sink
-    blocks:
-      - {name: str, type: SelfTuningRegulator, params: {delay_v: 1}}
-      - {name: rls, type: RecursiveLeastSquares, params: {n_params: 2, lambda: 0.97}}
-      - {name: ilc, type: IterativeLearningControl,
-         params: {n_samples: 100, p0: 0.5, k_delta: 0.01, q_pole: 0.2, auto_cycle: true,
-                  u_min: -0.5, u_max: 0.5}}
-      - {name: ilcw, type: IterativeLearningControl,
-         params: {n_samples: 100, p0: 0.5, k_delta: 0.01, auto_cycle: true, warm_cycles: 2,
-                  u_min: -60, u_max: 20}}
-      - {name: sel, type: Select, params: {ramp_time: 10ms}}
-    wires:
-      str.ratio_normal: io.ratio_normal
-      str.ratio_transient_arc: io.ratio_transient_arc
-      str.ratio_stable_arc: io.ratio_stable_arc
-      str.ratio_short: io.ratio_short
-      io.servo_ref_v: str.servo_ref_v
-      io.off_time_us: str.off_time_us
-      rls.y: str.y_v
-      rls.phi0: str.u_v
-      rls.phi1: 1.0
-      ilc.y: io.gap_voltage_v
-      ilc.y_ref: 45.0
-      ilcw.y: io.gap_voltage_v
-      ilcw.y_ref: 45.0
-      ilcw.track: io.z_mm
-      sel.g: ilcw.active
-      sel.in0: 0.0
-      sel.in1: ilcw.u
-      io.gen_arm: true
-      io.gen_on: true
-trace:
-  variables: [io.ratio_normal, sink.str.servo_ref_v, sink.rls.theta0, sink.ilc.u]
-)yaml";
-
+// RecursiveLeastSquares; an IterativeLearningControl block learning over 100-sample cycles
+// (tests/data/alloc/seed_001_002.yaml).
 TEST(Allocations, NoneInsideCyclesOfTheSeed001And002Blocks) {
-  auto r = build_sim_machine(rt::parse_config_text(kSeed001And002, "alloc-001-002.yaml"));
+  auto r = build_sim_machine(
+      rt::parse_config_text(test_data("alloc/seed_001_002.yaml"), "alloc-001-002.yaml"));
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.001) << "the machine servo sank";
   EXPECT_GE(r->variables().read("sink.ilc.cycles").value(), 29.0) << "the ILC learnt";
