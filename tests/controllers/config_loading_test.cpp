@@ -11,6 +11,7 @@
 #include "edm/runtime/diagnostics.hpp"
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
+#include "support/files.hpp"
 
 namespace edm::blocks {
 namespace {
@@ -25,32 +26,9 @@ std::unique_ptr<rt::Runtime> build(const std::string& yaml) {
   return rt::Runtime::build(rt::parse_config_text(yaml, "ctl.yaml"), regs.first, regs.second);
 }
 
+// A seed-003/000 program on a loopback machine whose FuzzyServoLUT has these `rules` (YAML text).
 std::string config(const std::string& rules) {
-  return R"yaml(version: 1
-machine:
-  name: ctl
-  io: {driver: loopback, task: t, params: {channels: 1}}
-tasks:
-  - {name: t, interval: 40ms, priority: 0, programs: [p]}
-programs:
-  - name: p
-    blocks:
-      - {name: dsc, type: DischargeStateCounter, params: {interval: 32}}
-      - name: lut
-        type: FuzzyServoLUT
-        params:
-          rules: )yaml" +
-         rules + R"yaml(
-      - {name: lp, type: ButterworthLowPass, params: {cutoff: 0.012}}
-      - {name: gm, type: GreyPredictorGM11, params: {window: 5, horizon: 37}}
-      - {name: pi, type: SelfTuningFuzzyPI, params: {ku: 0.08, kv: 0.16, rab_ref_default: 0.42}}
-    wires:
-      lut.open_count: dsc.open_count
-      lut.short_count: dsc.short_count
-      gm.in: lp.out
-      pi.rab_p: gm.out
-      pi.rab_f: lp.out
-)yaml";
+  return test::test_data("controllers/fuzzy_program.yaml", {{"rules", rules}});
 }
 
 TEST(ControllersConfig, a_full_seed_003_and_000_program_loads_from_yaml) {
