@@ -9,14 +9,18 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr const char* kSequencer = R"(version: 1
+// One task running program p, whose blocks follow.
+constexpr const char* kProgramP = R"(version: 1
 machine: {name: t}
 tasks:
   - {name: fast, interval: 1ms, priority: 0, programs: [p]}
 programs:
   - name: p
     blocks:
-      - {name: seq, type: TwoStep, params: {target: 3}}
+)";
+
+const std::string kSequencer =
+    std::string(kProgramP) + R"(      - {name: seq, type: TwoStep, params: {target: 3}}
       - {name: after, type: AddOne}
     wires:
       after.in: seq.fill.out
@@ -74,14 +78,8 @@ TEST(CompositeBlock, ChildPinsCanBeForced) {
 }
 
 TEST(CompositeBlock, ParameterErrorsAreLocatedAtTheComposite) {
-  const rt::Diagnostic d = build_error(R"(version: 1
-machine: {name: t}
-tasks:
-  - {name: fast, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - name: p
-    blocks:
-      - {name: seq, type: TwoStep, params: {target: -1}}
+  const rt::Diagnostic d = build_error(std::string(kProgramP) +
+                                       R"(      - {name: seq, type: TwoStep, params: {target: -1}}
 )");
   EXPECT_EQ(d.loc.line, 8);
   EXPECT_NE(d.message.find("target must be > 0"), std::string::npos) << d.str();
@@ -94,14 +92,8 @@ namespace edm::test {
 namespace {
 
 TEST(CompositeBlock, ChildParametersAreVariablesSetUnderTheCompositesParams) {
-  const std::string base = R"(version: 1
-machine: {name: t}
-tasks:
-  - {name: fast, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - name: p
-    blocks:
-      - {name: seq, type: TwoStep, params: )";
+  const std::string base =
+      std::string(kProgramP) + R"(      - {name: seq, type: TwoStep, params: )";
   auto r = build_from_text(base + "{target: 3, drain: {tag: dr}}}\n");
   const rt::Variable* tag = r->variables().find("p.seq.drain.tag");
   ASSERT_NE(tag, nullptr);

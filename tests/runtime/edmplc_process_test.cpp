@@ -10,19 +10,13 @@
 #include <sstream>
 
 #include "edm/runtime/retain.hpp"
+#include "support/files.hpp"
 #include "support/subprocess.hpp"
 
 namespace edm::test {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 class EdmplcProcess : public ::testing::Test {
  protected:
@@ -33,27 +27,8 @@ class EdmplcProcess : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     config_ = dir_ / "machine.yaml";
-    std::ofstream(config_) << R"(version: 1
-machine:
-  name: proc
-  io: {driver: loopback, params: {channels: 1}}
-tasks:
-  - {name: fast, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - name: p
-    blocks:
-      - {name: integ, type: Integrator, params: {k: 1.0}}
-    wires:
-      integ.in: 1.0
-      io.ao0: integ.out
-trace:
-  variables: [p.integ.out, io.ai0]
-retain:
-  file: )" << (dir_ / "retain.dat").string()
-                           << R"(
-  min_interval: 10ms
-  variables: [p.integ.out]
-)";
+    std::ofstream(config_) << test_data("runtime/integrator_retain.yaml",
+                                        {{"retain_file", (dir_ / "retain.dat").string()}});
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -76,10 +51,10 @@ TEST_F(EdmplcProcess, SigtermStopsInOrderAndWritesStatsTraceAndRetain) {
     ASSERT_TRUE(c.wait_for_output("running 1 task(s)")) << c.output();
     c.signal(sig);
     EXPECT_EQ(c.wait(), 0) << c.output();
-    const std::string stats = slurp(dir_ / "stats.json");
+    const std::string stats = read_file(dir_ / "stats.json");
     EXPECT_NE(stats.find("\"name\": \"fast\""), std::string::npos) << stats;
     EXPECT_NE(stats.find("\"latency_us\""), std::string::npos) << stats;
-    const std::string trace = slurp(dir_ / "trace.csv");
+    const std::string trace = read_file(dir_ / "trace.csv");
     EXPECT_EQ(trace.rfind("t_s,task,cycle,p.integ.out,io.ai0\n", 0), 0u) << trace.substr(0, 200);
     // The retain file was flushed at shutdown and holds the integrator's last value.
     const rt::RetainLoadResult r = rt::load_retain_file((dir_ / "retain.dat").string());
@@ -95,7 +70,7 @@ TEST_F(EdmplcProcess, RealClockRunForCoversExactlyTheGridSlotsOfTheDuration) {
   Child c(args(
       {"--clock", "real", "--run-for", "200ms", "--stats-out", (dir_ / "stats.json").string()}));
   ASSERT_EQ(c.wait(), 0) << c.output();
-  const std::string stats = slurp(dir_ / "stats.json");
+  const std::string stats = read_file(dir_ / "stats.json");
   auto number_after = [&](const std::string& key) {
     const auto at = stats.find("\"" + key + "\": ");
     return std::stoull(stats.substr(at + key.size() + 4));
@@ -120,7 +95,7 @@ TEST_F(EdmplcProcess, RetainedValueIsRestoredOnRestart) {
   EXPECT_EQ(c.wait(), 1) << c.output();
   EXPECT_NE(c.output().find("retain_corrupt"), std::string::npos) << c.output();
   EXPECT_NE(c.output().find("retain.dat.corrupt"), std::string::npos) << c.output();
-  EXPECT_EQ(slurp(dir_ / "retain.dat.corrupt"), corrupt);
+  EXPECT_EQ(read_file(dir_ / "retain.dat.corrupt"), corrupt);
   const rt::RetainLoadResult r = rt::load_retain_file((dir_ / "retain.dat").string());
   EXPECT_NEAR(r.values.at("p.integ.out").r, 0.25, 1e-12);
 }
@@ -134,14 +109,14 @@ TEST_F(EdmplcProcess, CheckAndListVarsNeverWriteTheRetainFile) {
   for (const char* flag : {"--check", "--list-vars"}) {
     Child c(args({flag}));
     EXPECT_EQ(c.wait(), 0) << flag << ": " << c.output();
-    EXPECT_EQ(slurp(path), corrupt) << flag;
+    EXPECT_EQ(read_file(path), corrupt) << flag;
   }
   rt::write_retain_file_atomic(path.string(), {{"p.integ.out", rt::RetainValue::make_real(42.5)}});
-  const std::string good = slurp(path);
+  const std::string good = read_file(path);
   for (const char* flag : {"--check", "--list-vars", "--check"}) {
     Child c(args({flag}));
     EXPECT_EQ(c.wait(), 0) << flag << ": " << c.output();
-    EXPECT_EQ(slurp(path), good) << flag << " rewrote the retain file";
+    EXPECT_EQ(read_file(path), good) << flag << " rewrote the retain file";
   }
   std::size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) {
@@ -162,7 +137,7 @@ TEST_F(EdmplcProcess, RetainFileThatIsNotARegularFileIsRefusedWithItsLocation) {
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const fs::path target = dir_ / "target.dat";
   rt::write_retain_file_atomic(target.string(), {{"p.integ.out", rt::RetainValue::make_real(1)}});
-  const std::string target_bytes = slurp(target);
+  const std::string target_bytes = read_file(target);
   const fs::path link = dir_ / "retain.link";
   fs::create_symlink(target, link);
   for (const fs::path& bad : {fifo, dir_, fs::path("/dev/null"), link}) {
@@ -186,7 +161,7 @@ TEST_F(EdmplcProcess, RetainFileThatIsNotARegularFileIsRefusedWithItsLocation) {
   }
   EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
   EXPECT_TRUE(fs::is_symlink(link));
-  EXPECT_EQ(slurp(target), target_bytes);
+  EXPECT_EQ(read_file(target), target_bytes);
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
 }
 
@@ -210,7 +185,7 @@ TEST_F(EdmplcProcess, VirtualClockTracesAreByteIdentical) {
     const fs::path out = dir_ / ("trace" + std::to_string(run) + ".csv");
     Child c(args({"--clock", "virtual", "--run-for", "500ms", "--trace-out", out.string()}));
     ASSERT_EQ(c.wait(), 0) << c.output();
-    const std::string t = slurp(out);
+    const std::string t = read_file(out);
     EXPECT_EQ(std::count(t.begin(), t.end(), '\n'), 501);
     if (run == 0) {
       first = t;
