@@ -15,6 +15,7 @@
 #include "edm/sim/params.hpp"
 #include "edm/sim/sim_driver.hpp"
 #include "sim_registries.hpp"
+#include "support/files.hpp"
 
 namespace edm::sim {
 namespace {
@@ -23,26 +24,8 @@ using namespace std::chrono_literals;
 
 std::unique_ptr<rt::Runtime> build(const std::string& preset, double servo_ref_v) {
   const auto& regs = test::sim_registries();
-  const std::string yaml = R"(version: 1
-machine:
-  name: servo
-  io: {driver: sim, params: {preset: )" +
-                           preset + R"(, seed: 4}}
-tasks:
-  - {name: servo, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - name: p
-    blocks:
-      - {name: u, type: MovingAverage, params: {window: 100}}
-      - {name: g, type: MovingAverage, params: {window: 100}}
-    wires:
-      u.in: io.gap_voltage_v
-      g.in: io.true_gap_um
-      io.servo_ref_v: )" + std::to_string(servo_ref_v) +
-                           R"(
-      io.gen_arm: true
-      io.gen_on: true
-)";
+  const std::string yaml = edm::test::test_data(
+      "sim/servo_ref.yaml", {{"preset", preset}, {"servo_ref_v", std::to_string(servo_ref_v)}});
   auto r = rt::Runtime::build(rt::parse_config_text(yaml, "servo.yaml"), regs.first, regs.second);
   r->machine().command(rt::MachineCommand::kPowerOn);
   return r;
