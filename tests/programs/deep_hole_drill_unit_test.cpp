@@ -8,9 +8,9 @@
 #include <string>
 #include <utility>
 
+#include "drill_rig.hpp"
 #include "edm/programs/deep_hole_drill.hpp"
 #include "edm/programs/register.hpp"
-#include "drill_rig.hpp"
 
 namespace edm::test {
 namespace {

@@ -50,9 +50,7 @@ const std::string kDemo = std::string(EDM_SOURCE_DIR) + "/config/machines/drill-
 std::vector<std::string> param_names(rt::Block& b) {
   struct Names final : rt::ParamVisitor {
     std::vector<std::string> out;
-    void on_param(std::string_view n, rt::ParamRef, rt::ParamSpec) override {
-      out.emplace_back(n);
-    }
+    void on_param(std::string_view n, rt::ParamRef, rt::ParamSpec) override { out.emplace_back(n); }
   } v;
   b.visit_params(v);
   return v.out;

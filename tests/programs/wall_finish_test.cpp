@@ -4,8 +4,6 @@
 // safe state.
 
 #include "edm/programs/wall_finish.hpp"
-#include "composite_rig.hpp"
-#include "support/param_access.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "composite_rig.hpp"
 #include "edm/programs/register.hpp"
+#include "support/param_access.hpp"
 
 namespace edm::test {
 namespace {
