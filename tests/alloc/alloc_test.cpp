@@ -188,6 +188,13 @@ std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
   return total;
 }
 
+// Runs `cycles` 1 ms cycles of the shipped `machine` and expects no allocation inside them.
+std::unique_ptr<rt::Runtime> run_shipped(const std::string& machine, int cycles) {
+  auto r = build_shipped(machine);
+  EXPECT_EQ(allocations_in_cycles(*r, cycles), 0u) << machine;
+  return r;
+}
+
 class DrillMachines : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(DrillMachines, NoAllocationInsideCyclesWhileAJobDrills) {
@@ -264,37 +271,32 @@ TEST(Allocations, NoneInsideCyclesOfTheSeed001And002Blocks) {
 
 TEST(Allocations, NoneInsideCyclesOfTheDeepHoleDrillProgram) {
   // Approach, touch, drilling with wear compensation, on the simulated machine.
-  auto r = build_shipped("drill-sim-program");
-  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
+  auto r = run_shipped("drill-sim-program", 5000);
   EXPECT_EQ(r->variables().read("cycle.drill.state"), 2.0) << "drilling after 5 s";
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheWireMachineWithItsControllerSwitch) {
   // Butterworth → GM(1,1) → SelfTuningFuzzyPI and the two Selects of the operator's switch.
-  auto r = build_shipped("wire-stfpi-sim");
-  EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
+  auto r = run_shipped("wire-stfpi-sim", 3000);
   EXPECT_EQ(r->variables().read("rupture.sel_u.active1"), 1.0);
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheSinkMachineWithJumpsAndTheIlc) {
   // JumpCycle, the integral controller's warm cycles, the ILC's learning at each jump edge and
   // its take-over through the Select at the third jump (4.5 s).
-  auto r = build_shipped("sink-ilc-sim");
-  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
+  auto r = run_shipped("sink-ilc-sim", 5000);
   EXPECT_EQ(r->variables().read("gap.jump.jumps"), 3.0);
   EXPECT_EQ(r->variables().read("gap.ilc.active"), 1.0) << "the ILC drives after the take-over";
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheSinkMachineWithJumpsAndTheStr) {
   // JumpCycle holding the STR through each jump and its approach (two jumps in 3.5 s).
-  auto r = build_shipped("sink-str-jump-sim");
-  EXPECT_EQ(allocations_in_cycles(*r, 3500), 0u);
+  auto r = run_shipped("sink-str-jump-sim", 3500);
   EXPECT_EQ(r->variables().read("ratios.jump.jumps"), 2.0);
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
-  auto r = build_shipped("finish-sim-program");  // polarity switch, then orbiting
-  EXPECT_EQ(allocations_in_cycles(*r, 5000), 0u);
+  run_shipped("finish-sim-program", 5000);  // polarity switch, then orbiting
 }
 
 TEST(Allocations, NoneInsideCyclesOfTheSafetySupervisorActing) {
