@@ -102,9 +102,7 @@ TEST(DeepHoleDrill, DrillsOnTdThenRetractsAtDepthAndEndsDone) {
 
 TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
   Rig r(params());
-  r.start.set(true);
-  r.sparks(20, 12.0);
-  for (int k = 0; k < 20; ++k) r.step();
+  r.start_sparking(20, 12.0, 20);
   ASSERT_EQ(r.state(), 2);
   const double vz_in = -0.05 * 4.0;
   const double area = (1.1 * 1.1) / (1.0 - 0.09);
@@ -121,13 +119,10 @@ TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
 TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
   Rig r(params());
   rt::Output<double> servo;
-  r.in<double>("vz_servo_mm_s").connect(servo);
-  r.drill.bind();  // as the runtime does after the YAML wiring: the servo is now wired
+  r.wire_servo(servo);
   r.comp.set(false);
-  r.start.set(true);
-  r.sparks(20, 12.0);  // the P law would feed at −0.2 mm/s
-  servo.set(-0.3);     // the external servo says otherwise
-  for (int k = 0; k < 2; ++k) r.step();
+  servo.set(-0.3);                // the external servo says −0.3 mm/s,
+  r.start_sparking(20, 12.0, 2);  // the P law −0.2 mm/s
   ASSERT_EQ(r.state(), 1) << "approach is the sequence's own: the servo is not used";
   EXPECT_DOUBLE_EQ(r.vz(), -0.5);
   r.step();  // the third cycle with sparks: touch, and the first DRILL cycle
@@ -152,12 +147,9 @@ TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
 TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
   Rig r(params());
   rt::Output<double> servo;
-  r.in<double>("vz_servo_mm_s").connect(servo);
-  r.drill.bind();  // as the runtime does after the YAML wiring: the servo is now wired
-  r.start.set(true);
-  r.sparks(20, 12.0);
+  r.wire_servo(servo);
   servo.set(-0.25);
-  for (int k = 0; k < 20; ++k) r.step();
+  r.start_sparking(20, 12.0, 20);
   ASSERT_EQ(r.state(), 2);
   const double area = (1.1 * 1.1) / (1.0 - 0.09);
   EXPECT_NEAR(r.vz(), -0.25 - 0.6 * area * 0.25, 1e-9);  // vz_in − Vd, vz_in = the servo's
@@ -165,9 +157,7 @@ TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
 
 TEST(DeepHoleDrill, SafeStateTurnsTheGeneratorOffAndBacksZOffWithoutFinishing) {
   Rig r(params());
-  r.start.set(true);
-  r.sparks(20, 12.0);
-  for (int k = 0; k < 10; ++k) r.step();
+  r.start_sparking(20, 12.0, 10);
   ASSERT_EQ(r.state(), 2);
   r.z_mm.set(-0.5);
   r.drill.enter_safe_state({rt::MachineState::kFault, rt::AlarmCode::kNone});

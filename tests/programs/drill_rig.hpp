@@ -24,6 +24,17 @@ struct Rig : CompositeRig<programs::DeepHoleDrill> {
     activate();
   }
   double vz() { return out<double>("vz_cmd_mm_s"); }
+  // Wires `servo` to vz_servo_mm_s and binds again, as the runtime does after the YAML wiring.
+  void wire_servo(rt::Output<double>& servo) {
+    in<double>("vz_servo_mm_s").connect(servo);
+    drill.bind();
+  }
+  // Sets start, then runs `cycles` cycles with `n` sparks each at a mean Td of `td_us`.
+  void start_sparking(std::int64_t n, double td_us, int cycles) {
+    start.set(true);
+    sparks(n, td_us);
+    for (int k = 0; k < cycles; ++k) step();
+  }
   void step() {
     drill.update(ctx);
     ++ctx.cycle;
