@@ -23,29 +23,10 @@ MachineTables drill_tables() {
   t.axes = {{'X', -100.0, 100.0, 30.0, 2000.0},
             {'Y', -90.5, 80.25, 25.0, 1500.0},
             {'Z', -60.0, 20.0, 12.5, 999.75}};
-  Condition e1;
-  e1.e = 1;
-  e1.name = "drill-rough";
-  e1.polarity = Polarity::kNegative;
-  e1.open_voltage_v = 100.0;
-  e1.peak_current_a = 15.0;
-  e1.on_time_us = 20.0;
-  e1.off_time_us = 10.0;
-  e1.tdr_us = 8.0;
-  e1.servo_ref_v = 40.0;
-  e1.wear_ratio = 0.6195;
-  Condition e7 = e1;
-  e7.e = 7;
-  e7.name = "wall-finish";
-  e7.polarity = Polarity::kPositive;
-  e7.open_voltage_v = 80.0;
-  e7.peak_current_a = 3.5;
-  e7.on_time_us = 2.25;
-  e7.off_time_us = 17.0;
-  e7.tdr_us = 1.5;
-  e7.servo_ref_v = 33.0;
-  e7.wear_ratio = 0.05;
-  t.conditions = {e1, e7};
+  // e, name, polarity, open V, peak A, on µs, off µs, Tdr µs, servo ref V, wear ratio.
+  t.conditions = {
+      {1, "drill-rough", Polarity::kNegative, 100.0, 15.0, 20.0, 10.0, 8.0, 40.0, 0.6195},
+      {7, "wall-finish", Polarity::kPositive, 80.0, 3.5, 2.25, 17.0, 1.5, 33.0, 0.05}};
   return t;
 }
 
