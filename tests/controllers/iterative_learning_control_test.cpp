@@ -326,9 +326,7 @@ TEST(IterativeLearningControl, warm_start_continues_the_advance_per_cycle) {
 }
 
 TEST(IterativeLearningControl, warm_start_needs_track_wired_and_is_load_time_only) {
-  IterativeLearningControlParams p;
-  p.n_samples = 4;
-  p.warm_cycles = 1;
+  IterativeLearningControlParams p{.n_samples = 4, .warm_cycles = 1};
   BlockHarness<IterativeLearningControl> h;
   ASSERT_TRUE(h.start(p).empty());
   h.source<double>("y").set(0.0);
@@ -343,9 +341,7 @@ TEST(IterativeLearningControl, warm_start_needs_track_wired_and_is_load_time_onl
 }
 
 TEST(IterativeLearningControl, cycle_handling_and_validation) {
-  IterativeLearningControlParams p;
-  p.n_samples = 4;
-  p.u_initial = 1.5;
+  IterativeLearningControlParams p{.n_samples = 4, .u_initial = 1.5};
   BlockHarness<IterativeLearningControl> h;
   ASSERT_TRUE(h.start(p).empty());
   auto& edge = h.source<bool>("cycle_start");
@@ -367,12 +363,8 @@ TEST(IterativeLearningControl, cycle_handling_and_validation) {
   EXPECT_EQ(h.out<std::int64_t>("sample"), 0);
   p.p0 = 0.0;
   EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.lambda3 = 1.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.q_pole = 1.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
+  EXPECT_FALSE(rt::validate_params(IterativeLearningControlParams{.lambda3 = 1.0}).empty());
+  EXPECT_FALSE(rt::validate_params(IterativeLearningControlParams{.q_pole = 1.0}).empty());
   EXPECT_FALSE(h.block().stage_param(0, rt::ParamValue::of_int(8)).empty());
 }
 

@@ -127,8 +127,8 @@ TEST(RecursiveLeastSquares, forgetting_factor_tracks_a_parameter_step) {
 
 // n = 2, λ = 0.97, p0 = 10 under the given trace bound, driven with φ = [1, 0] and y = 2: the
 // second direction is never excited.
-RecursiveLeastSquaresParams start_with_one_direction_excited(
-    BlockHarness<RecursiveLeastSquares>& h, double trace_max) {
+RecursiveLeastSquaresParams start_with_one_direction_excited(BlockHarness<RecursiveLeastSquares>& h,
+                                                             double trace_max) {
   RecursiveLeastSquaresParams p;
   p.n_params = 2;
   p.lambda = 0.97;
@@ -173,15 +173,10 @@ TEST(RecursiveLeastSquares, the_trace_bound_keeps_the_covariance_bounded) {
 }
 
 TEST(RecursiveLeastSquares, rejects_bad_parameters_and_non_finite_inputs) {
-  RecursiveLeastSquaresParams p;
-  p.lambda = 0.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.n_params = 5;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.trace_max = p.p0 / 2.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
+  EXPECT_FALSE(rt::validate_params(RecursiveLeastSquaresParams{.lambda = 0.0}).empty());
+  EXPECT_FALSE(rt::validate_params(RecursiveLeastSquaresParams{.n_params = 5}).empty());
+  constexpr double kP0 = RecursiveLeastSquaresParams{}.p0;
+  EXPECT_FALSE(rt::validate_params(RecursiveLeastSquaresParams{.trace_max = kP0 / 2.0}).empty());
   BlockHarness<RecursiveLeastSquares> h;
   ASSERT_TRUE(h.start(RecursiveLeastSquaresParams{}).empty());
   h.source<double>("y").set(std::nan(""));

@@ -362,18 +362,12 @@ TEST(SelfTuningFuzzyPI, settle_samples_hold_the_actuators_after_activation) {
 
 TEST(SelfTuningFuzzyPI, validate_refuses_bad_ranges) {
   EXPECT_TRUE(rt::validate_params(SelfTuningFuzzyPIParams{}).empty());
-  SelfTuningFuzzyPIParams p;
-  p.u_min_us = 60.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.alpha = 1.5;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.v_initial_v = 80.0;
-  EXPECT_FALSE(rt::validate_params(p).empty());
-  p = {};
-  p.ge = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_FALSE(rt::validate_params(p).empty());
+  EXPECT_FALSE(rt::validate_params(SelfTuningFuzzyPIParams{.u_min_us = 60.0}).empty());
+  EXPECT_FALSE(rt::validate_params(SelfTuningFuzzyPIParams{.alpha = 1.5}).empty());
+  EXPECT_FALSE(rt::validate_params(SelfTuningFuzzyPIParams{.v_initial_v = 80.0}).empty());
+  EXPECT_FALSE(
+      rt::validate_params(SelfTuningFuzzyPIParams{.ge = std::numeric_limits<double>::quiet_NaN()})
+          .empty());
 }
 
 }  // namespace

@@ -190,12 +190,8 @@ TEST(SelfTuningRegulator, clamps_and_faults) {
   EXPECT_EQ(s, BlockStatus::kSaturated);
   EXPECT_DOUBLE_EQ(str.out("u_v"), p.u_v_max);
   EXPECT_EQ(str.step(std::nan("")), BlockStatus::kFault);
-  SelfTuningRegulatorParams bad;
-  bad.beta00 = 0.0;
-  EXPECT_FALSE(rt::validate_params(bad).empty());
-  bad = {};
-  bad.u_v_initial = 5.0;
-  EXPECT_FALSE(rt::validate_params(bad).empty());
+  EXPECT_FALSE(rt::validate_params(SelfTuningRegulatorParams{.beta00 = 0.0}).empty());
+  EXPECT_FALSE(rt::validate_params(SelfTuningRegulatorParams{.u_v_initial = 5.0}).empty());
 }
 
 }  // namespace
