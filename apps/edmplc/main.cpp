@@ -37,7 +37,8 @@ using edm::apps::reject;
 constexpr const char* kUsage =
     "edmplc --config FILE [--clock real|virtual [--speed F]] [--run-for DURATION]\n"
     "              [--stats-out FILE.json] [--trace-out FILE.csv] [--seed N]\n"
-    "              [--bridge-port P] [--check] [--list-vars] [--log-level LEVEL]";
+    "              [--bridge-port P] [--state-dir DIR] [--check] [--list-vars]\n"
+    "              [--log-level LEVEL]";
 
 std::atomic<bool> g_stop{false};
 
@@ -52,6 +53,7 @@ struct Options {
   std::string trace_out;
   std::optional<std::uint64_t> seed;
   std::optional<int> bridge_port;
+  std::string state_dir;  // --state-dir, else $EDM_STATE_DIR: where a relative retain.file lives
   bool check{false};
   bool list_vars{false};
   std::string log_level{"info"};
@@ -127,6 +129,9 @@ std::variant<Options, int> parse_args(int argc, char** argv) {
         o.bridge_port = static_cast<int>(*p);
       },
       "override the bridge port (0 = no bridge)");
+  app.add_option("--state-dir", o.state_dir,
+                 "directory of a relative retain.file (default: $EDM_STATE_DIR; neither: "
+                 "nothing is retained)");
   app.add_flag("--check", o.check,
                "validate the config and exit (0 ok, 2 invalid: file:line:col: message)");
   app.add_flag("--list-vars", o.list_vars,
@@ -181,6 +186,10 @@ int main(int argc, char** argv) {
     edm::rt::BuildOptions bo;
     bo.seed = opt.seed;
     bo.load_retain = !opt.check && !opt.list_vars;
+    bo.state_dir = opt.state_dir;
+    if (const char* env = std::getenv("EDM_STATE_DIR"); bo.state_dir.empty() && env != nullptr) {
+      bo.state_dir = env;  // the packaging's seam (systemd StateDirectory=, docs/runtime.md)
+    }
     rt = edm::rt::Runtime::build(cfg, blocks, drivers, bo);
   } catch (const edm::rt::ConfigError& e) {
     edm::rt::shutdown_logging();

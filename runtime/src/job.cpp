@@ -4,7 +4,7 @@
 
 namespace edm::rt {
 
-LoadResult JobStore::load(std::vector<machining::MotionBlock> program) {
+LoadResult JobStore::load(std::vector<machining::MotionBlock> program, std::uint32_t program_id) {
   Phase expected = Phase::kIdle;
   if (!phase_.compare_exchange_strong(expected, Phase::kLoading, std::memory_order_acq_rel)) {
     return LoadResult::kBusy;
@@ -15,6 +15,7 @@ LoadResult JobStore::load(std::vector<machining::MotionBlock> program) {
   count_.store(n, std::memory_order_relaxed);
   index_.store(0, std::memory_order_relaxed);
   line_.store(0, std::memory_order_relaxed);
+  program_id_.store(program_id, std::memory_order_relaxed);
   outcome_.store(JobOutcome::kNone, std::memory_order_relaxed);
   generation_.fetch_add(1, std::memory_order_relaxed);
   phase_.store(Phase::kIdle, std::memory_order_release);
@@ -66,6 +67,7 @@ JobProgress JobStore::progress() const noexcept {
   p.block_index = index_.load(std::memory_order_relaxed);
   p.block_count = count_.load(std::memory_order_relaxed);
   p.line = line_.load(std::memory_order_relaxed);
+  p.program_id = program_id_.load(std::memory_order_relaxed);
   return p;
 }
 

@@ -72,6 +72,8 @@ std::string_view to_string(AlarmCode c) noexcept {
       return "retain_corrupt";
     case AlarmCode::kForcesReleased:
       return "forces_released";
+    case AlarmCode::kJobInterrupted:
+      return "job_interrupted";
   }
   return "?";
 }

@@ -94,8 +94,12 @@ bool RetainStore::poll(TimePoint now) noexcept {
     if (written_ && *written_ == current_) {
       return false;
     }
+    bool urgent = false;
+    for (std::size_t k = 0; k < vars_.size() && !urgent; ++k) {
+      urgent = vars_[k].urgent && (!written_ || !((*written_)[k] == current_[k]));
+    }
     // A `now` before the last attempt means a new time line (e.g. virtual, then real): no wait.
-    if (last_attempt_ && now >= *last_attempt_ && now - *last_attempt_ < min_interval_) {
+    if (!urgent && last_attempt_ && now >= *last_attempt_ && now - *last_attempt_ < min_interval_) {
       return false;
     }
     last_attempt_ = now;

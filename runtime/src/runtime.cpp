@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <fstream>
@@ -74,6 +75,18 @@ RunSummary Runtime::run(const RunOptions& options) {
     a.time = options.clock == ClockKind::kReal ? RealClock{}.now() : TimePoint{};
     machine_.raise(a);
     startup_alarm_ = AlarmCode::kNone;
+  }
+  if (interrupted_job_ && !job_alarm_raised_) {
+    // Comes up in FAULT: the operator checks the work before anything moves (DESIGN §11).
+    Alarm a;
+    a.code = AlarmCode::kJobInterrupted;
+    a.severity = AlarmSeverity::kFault;
+    a.source = "job";
+    a.text = job_alarm_text_.c_str();
+    a.value = interrupted_job_->depth_mm.value_or(std::nan(""));
+    a.time = options.clock == ClockKind::kReal ? RealClock{}.now() : TimePoint{};
+    machine_.raise(a);
+    job_alarm_raised_ = true;
   }
   if (options.trace_out.empty()) {
     // Nobody drains the rings without a trace file: don't sample, don't count drops.

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include "edm/runtime/runtime.hpp"
 #include "param_reader.hpp"
+#include "retain_job.hpp"
 #include "supervisor_builder.hpp"
 
 namespace edm::rt {
@@ -505,49 +507,79 @@ class RuntimeBuilder {
     std::vector<RetainStore::Variable> vars;
     VariableRegistry& reg = rt_->variables_;
     for (const NameRef& n : rs.variables) {
-      const Variable* v = reg.find(n.name);
-      if (v == nullptr) {
-        diag_.error(n.loc, "retain: unknown variable '" + n.name + "'");
-        continue;
+      if (auto t = retainable(n)) {
+        vars.push_back({n.name, t->second,
+                        [&reg, var = t->first, type = t->second]() {
+                          return read_retained(reg, *var, type);
+                        }});
       }
-      if (v->kind == VarKind::kInput) {
-        diag_.error(n.loc,
-                    "retain: '" + n.name + "' is an input (wired); retain outputs or parameters");
-        continue;
+    }
+    std::function<double()> read_depth;
+    if (rs.job_depth) {
+      if (auto t = retainable(*rs.job_depth)) {
+        if (t->second != RetainType::kReal) {
+          diag_.error(rs.job_depth->loc, "retain.job_depth: '" + rs.job_depth->name +
+                                             "' is not LREAL (a depth in mm)");
+        } else {
+          read_depth = [&reg, var = t->first] {
+            return read_retained(reg, *var, RetainType::kReal).r;
+          };
+        }
       }
-      RetainType type = RetainType::kReal;
-      if (v->is_pin()) {
-        type = v->pin.type == PinType::kBool  ? RetainType::kBool
-               : v->pin.type == PinType::kInt ? RetainType::kInt
-                                              : RetainType::kReal;
-      } else if (v->param_type == ParamType::kBool) {
-        type = RetainType::kBool;
-      } else if (v->param_type == ParamType::kInt) {
-        type = RetainType::kInt;
-      } else if (v->param_type == ParamType::kString || v->param_type == ParamType::kDuration) {
-        diag_.error(n.loc, "retain: parameter '" + n.name + "' is " + std::string(v->type_name()) +
-                               "; retain BOOL, LINT or LREAL");
-        continue;
-      }
-      const Variable* var = v;
-      vars.push_back(
-          {n.name, type, [&reg, var, type]() { return read_retained(reg, *var, type); }});
     }
     if (!diag_.empty()) {
       return;
     }
+    const SourceLoc& file_loc = rs.file_loc.line != 0 ? rs.file_loc : rs.loc;
+    namespace fs = std::filesystem;
+    std::string path = rs.file;
+    if (fs::path(path).is_relative()) {
+      if (options_.state_dir.empty()) {
+        // The application decides where state lives (edmplc: --state-dir, EDM_STATE_DIR).
+        if (options_.load_retain) {
+          spdlog::info(
+              "retain: '{}' is relative and no state directory is set (--state-dir or "
+              "EDM_STATE_DIR): nothing is retained in this run",
+              rs.file);
+        }
+        return;
+      }
+      path = (fs::path(options_.state_dir) / path).lexically_normal().string();
+    }
     // Judged also by --check: a device, FIFO, directory or link is never read nor replaced.
-    if (const std::string problem = retain_target_problem(rs.file); !problem.empty()) {
-      diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc, "retain.file: " + problem);
+    if (const std::string problem = retain_target_problem(path); !problem.empty()) {
+      diag_.error(file_loc, "retain.file: " + problem);
       return;
     }
     // --check and --list-vars: no store is constructed, so nothing can write the file.
     if (!options_.load_retain) {
       return;
     }
-    RetainLoadResult loaded = load_retain_file(rs.file);
+    if (const fs::path dir = fs::path(path).parent_path(); !dir.empty()) {
+      std::error_code ec;
+      fs::create_directories(dir, ec);  // a first start with a new state directory
+      if (ec) {
+        diag_.error(file_loc, "retain.file: cannot create the directory '" + dir.string() +
+                                  "': " + ec.message());
+        return;
+      }
+    }
+    // While a part-program runner exists, the job record is retained beside the variables.
+    const bool job_record = rt_->job_.has_runner();
+    if (job_record) {
+      auto job_vars = retain_job::variables(rt_->job_, rt_->interrupted_job_, read_depth);
+      vars.insert(vars.end(), std::make_move_iterator(job_vars.begin()),
+                  std::make_move_iterator(job_vars.end()));
+    }
+    RetainLoadResult loaded = load_retain_file(path);
     switch (loaded.status) {
       case RetainLoadStatus::kLoaded:
+        if (job_record) {
+          rt_->interrupted_job_ = retain_job::take(loaded.values);
+          if (rt_->interrupted_job_) {
+            rt_->job_alarm_text_ = retain_job::alarm_text(*rt_->interrupted_job_);
+          }
+        }
         for (const auto& [name, value] : loaded.values) {
           restore(name, value);
         }
@@ -557,19 +589,19 @@ class RuntimeBuilder {
                      loaded.warning);
         break;
       case RetainLoadStatus::kNotRegular:  // replaced between the check above and the open
-        diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc, "retain.file: " + loaded.warning);
+        diag_.error(file_loc, "retain.file: " + loaded.warning);
         return;
       case RetainLoadStatus::kCorrupt:
       case RetainLoadStatus::kUnreadable:
         // Never overwrite what could not be read: move it aside (evidence, manual recovery) and
         // raise an alarm at power-on so the operator knows the retained values are defaults.
         try {
-          const std::string aside = set_aside_retain_file(rs.file);
+          const std::string aside = set_aside_retain_file(path);
           rt_->retain_warning_ = loaded.warning + "; kept as '" + aside +
                                  "'; retained variables start from their defaults";
           rt_->startup_alarm_ = AlarmCode::kRetainCorrupt;
         } catch (const std::exception& e) {
-          diag_.error(rs.file_loc.line != 0 ? rs.file_loc : rs.loc,
+          diag_.error(file_loc,
                       "retain.file: " + loaded.warning +
                           "; it cannot be moved aside either, so the runtime will not overwrite "
                           "it: " +
@@ -578,7 +610,37 @@ class RuntimeBuilder {
         }
         break;
     }
-    rt_->retain_ = std::make_unique<RetainStore>(rs.file, rs.min_interval, std::move(vars));
+    rt_->retain_path_ = path;
+    rt_->retain_ = std::make_unique<RetainStore>(path, rs.min_interval, std::move(vars));
+  }
+
+  // The variable `n` names and its type in the retain file, or nullopt (reported).
+  std::optional<std::pair<const Variable*, RetainType>> retainable(const NameRef& n) {
+    const Variable* v = rt_->variables_.find(n.name);
+    if (v == nullptr) {
+      diag_.error(n.loc, "retain: unknown variable '" + n.name + "'");
+      return std::nullopt;
+    }
+    if (v->kind == VarKind::kInput) {
+      diag_.error(n.loc,
+                  "retain: '" + n.name + "' is an input (wired); retain outputs or parameters");
+      return std::nullopt;
+    }
+    RetainType type = RetainType::kReal;
+    if (v->is_pin()) {
+      type = v->pin.type == PinType::kBool  ? RetainType::kBool
+             : v->pin.type == PinType::kInt ? RetainType::kInt
+                                            : RetainType::kReal;
+    } else if (v->param_type == ParamType::kBool) {
+      type = RetainType::kBool;
+    } else if (v->param_type == ParamType::kInt) {
+      type = RetainType::kInt;
+    } else if (v->param_type == ParamType::kString || v->param_type == ParamType::kDuration) {
+      diag_.error(n.loc, "retain: parameter '" + n.name + "' is " + std::string(v->type_name()) +
+                             "; retain BOOL, LINT or LREAL");
+      return std::nullopt;
+    }
+    return std::pair{v, type};
   }
 
   // Reads a retained variable with its exact type (LINT stays exact beyond 2^53).

@@ -283,7 +283,7 @@ Body op_program_commit(Session& s, const Json& msg) {
                  Json{{"issues", std::move(list)}, {"count", issues.size()}});
   }
   const std::size_t n = u.blocks.size();
-  if (rt.job().load(std::move(u.blocks)) != rt::LoadResult::kOk) {
+  if (rt.job().load(std::move(u.blocks), got) != rt::LoadResult::kOk) {
     s.upload_.reset();
     return error(ErrorCode::kBusy, "a job became active; program not swapped");
   }

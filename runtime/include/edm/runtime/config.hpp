@@ -163,6 +163,10 @@ struct RetainSpec {
   std::string file;                                // empty = no retain store
   Duration min_interval{std::chrono::seconds(1)};  // rate limit of on-change writes
   std::vector<NameRef> variables;
+  /// The depth a job has reached (an LREAL variable, e.g. io.depth_mm), kept in the job record
+  /// the runtime retains while a part program runs (docs/runtime.md, "Restart after an unclean
+  /// stop"); absent: the record has no depth.
+  std::optional<NameRef> job_depth;
   SourceLoc loc;
   SourceLoc file_loc;  // of the `file:` value, for problems with the path itself
 };

@@ -39,6 +39,7 @@ struct JobProgress {
   std::size_t block_index{0};  // index of the block being executed (= count when finished)
   std::size_t block_count{0};  // blocks in the loaded program
   std::int32_t line{0};        // G-code line of the block being executed
+  std::uint32_t program_id{0};  // the id the program was loaded under (bridge: its CRC-32); 0 = none
 };
 
 class JobStore {
@@ -48,8 +49,10 @@ class JobStore {
   JobStore& operator=(const JobStore&) = delete;
 
   /// Non-RT. Replaces the loaded program (validated by the caller). kBusy while a job is active
-  /// or another load is in progress; the previous program is then kept untouched.
-  LoadResult load(std::vector<machining::MotionBlock> program);
+  /// or another load is in progress; the previous program is then kept untouched. `program_id`
+  /// names it in progress() and in the retained job record (the bridge passes the CRC-32 it was
+  /// committed with; 0 = unnamed).
+  LoadResult load(std::vector<machining::MotionBlock> program, std::uint32_t program_id = 0);
   /// Non-RT. Number of blocks in the loaded program (0 = none).
   [[nodiscard]] std::size_t loaded_blocks() const noexcept {
     return count_.load(std::memory_order_acquire);
@@ -86,6 +89,7 @@ class JobStore {
   std::atomic<std::size_t> count_{0};
   std::atomic<std::size_t> index_{0};
   std::atomic<std::int32_t> line_{0};
+  std::atomic<std::uint32_t> program_id_{0};
   std::atomic<JobOutcome> outcome_{JobOutcome::kNone};
   std::atomic<std::uint64_t> generation_{0};
   std::atomic<std::uint64_t> jobs_started_{0};

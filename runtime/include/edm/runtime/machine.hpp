@@ -63,6 +63,7 @@ enum class AlarmCode : std::uint16_t {
   kWireBreak = 170,        // wire EDM wire break (safety supervisor)
   kRetainCorrupt = 180,    // the retain file could not be read: set aside, defaults in use
   kForcesReleased = 181,   // a safe state released forced pins (value: how many)
+  kJobInterrupted = 182,   // the retain file shows a job running at an unclean stop (value: depth)
 };
 
 std::string_view to_string(AlarmCode c) noexcept;

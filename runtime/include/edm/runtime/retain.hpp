@@ -145,6 +145,9 @@ class RetainStore {
     /// Called on a non-RT thread (the store's or the caller of poll/flush); loads the RT side's
     /// atomics. Must return a value of `type` (a mismatch is logged and the value ignored).
     std::function<RetainValue()> read;
+    /// A change of this variable is written at the next poll, without waiting for min_interval
+    /// (the runtime's job-running flag: the record must reach the disk before a power loss).
+    bool urgent{false};
   };
 
   /// Throws std::invalid_argument on an invalid or duplicate name, an empty read function or a
@@ -158,7 +161,8 @@ class RetainStore {
   RetainStore& operator=(RetainStore&&) = delete;
 
   /// Reads every variable; writes when a value differs from the last written set (or nothing was
-  /// written yet) and at least min_interval passed since the last write attempt. `now` is on any
+  /// written yet) and at least min_interval passed since the last write attempt — or at once when
+  /// an `urgent` variable differs. `now` is on any
   /// monotonic time line (virtual time in tests); a `now` earlier than the last attempt is taken
   /// as a new time line and does not wait. Returns true if it wrote. A failed write is logged and
   /// counted (retried at the next allowed poll), never thrown.

@@ -35,6 +35,21 @@ struct BuildOptions {
   /// Read the retain file at build and keep the store that writes it. false (--check,
   /// --list-vars, offline tools): no store is constructed, so nothing can write the file.
   bool load_retain{true};
+  /// The state directory: a relative `retain.file` is resolved against it (edmplc: --state-dir,
+  /// else $EDM_STATE_DIR). Empty: a relative retain file is not used (no store, an info line),
+  /// so a library user or a test that runs a shipped config never reads nor writes one by
+  /// accident. An absolute `retain.file` is used as written either way.
+  std::string state_dir;
+};
+
+/// The job the retain file showed running when the previous runtime stopped without a clean
+/// shutdown (kill -9, power loss). The seam for resuming it from its block (issue 21).
+struct InterruptedJob {
+  std::uint32_t program_id{0};  // the id it was committed under (bridge: CRC-32); 0 = none
+  std::int64_t block_index{0};  // the block being executed (0-based)
+  std::int64_t block_count{0};  // blocks in the program
+  std::int64_t line{0};         // its G-code line
+  std::optional<double> depth_mm;  // `retain.job_depth` at the last retain write, if configured
 };
 
 struct RunOptions {
@@ -78,6 +93,14 @@ class Runtime {
   [[nodiscard]] RetainStore* retain() noexcept { return retain_.get(); }
   /// Why the retained values are defaults (a corrupt file was set aside), or "".
   [[nodiscard]] const std::string& retain_warning() const noexcept { return retain_warning_; }
+  /// The job an unclean stop interrupted (alarm 182 at power-on), or nullopt. Fixed for the life
+  /// of this runtime; the retain file keeps the record until the next job begins. Any thread.
+  [[nodiscard]] const std::optional<InterruptedJob>& interrupted_job() const noexcept {
+    return interrupted_job_;
+  }
+  /// The resolved retain file (`retain.file` against BuildOptions::state_dir), or "" when no
+  /// retain store is in use.
+  [[nodiscard]] const std::string& retain_path() const noexcept { return retain_path_; }
   [[nodiscard]] std::vector<TaskStatsReport> stats_reports() const;
   [[nodiscard]] const Config& config() const noexcept { return config_; }
   /// The loaded part program and its progress (DESIGN §2: the runtime owns it).
@@ -113,6 +136,10 @@ class Runtime {
   std::unique_ptr<RetainStore> retain_;
   std::string retain_warning_;
   AlarmCode startup_alarm_{AlarmCode::kNone};  // raised at power-on in run() (retain lost)
+  std::optional<InterruptedJob> interrupted_job_;
+  std::string job_alarm_text_;  // alarm 182's text (the alarm holds a pointer to it)
+  bool job_alarm_raised_{false};
+  std::string retain_path_;
   bool ran_{false};  // only a runtime that ran flushes the retain file when destroyed
   std::vector<std::function<void(const Alarm&)>> alarm_listeners_;
 };

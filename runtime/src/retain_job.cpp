@@ -1,0 +1,96 @@
+#include "retain_job.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <utility>
+
+namespace edm::rt::retain_job {
+namespace {
+
+constexpr const char* kRunning = "job.running";
+constexpr const char* kProgram = "job.program";
+constexpr const char* kBlock = "job.block";
+constexpr const char* kBlocks = "job.blocks";
+constexpr const char* kLine = "job.line";
+constexpr const char* kDepth = "job.depth_mm";
+
+}  // namespace
+
+std::vector<RetainStore::Variable> variables(const JobStore& job,
+                                             const std::optional<InterruptedJob>& kept,
+                                             std::function<double()> depth) {
+  // Until a job begins here, the interrupted record stays on disk.
+  auto keep = [&job, &kept] { return kept.has_value() && job.progress().jobs_started == 0; };
+  std::vector<RetainStore::Variable> out;
+  out.push_back({kRunning, RetainType::kBool,
+                 [&job, keep] { return RetainValue::make_bool(keep() || job.active()); },
+                 /*urgent=*/true});
+  out.push_back({kProgram, RetainType::kInt, [&job, &kept, keep] {
+                   return RetainValue::make_int(keep() ? kept->program_id
+                                                       : job.progress().program_id);
+                 }});
+  out.push_back({kBlock, RetainType::kInt, [&job, &kept, keep] {
+                   return RetainValue::make_int(
+                       keep() ? kept->block_index
+                              : static_cast<std::int64_t>(job.progress().block_index));
+                 }});
+  out.push_back({kBlocks, RetainType::kInt, [&job, &kept, keep] {
+                   return RetainValue::make_int(
+                       keep() ? kept->block_count
+                              : static_cast<std::int64_t>(job.progress().block_count));
+                 }});
+  out.push_back({kLine, RetainType::kInt, [&job, &kept, keep] {
+                   return RetainValue::make_int(keep() ? kept->line : job.progress().line);
+                 }});
+  if (depth) {
+    out.push_back({kDepth, RetainType::kReal, [&kept, keep, depth = std::move(depth)] {
+                     return RetainValue::make_real(keep() ? kept->depth_mm.value_or(0.0) : depth());
+                   }});
+  }
+  return out;
+}
+
+std::optional<InterruptedJob> take(RetainMap& values) {
+  auto pop = [&values](const char* name) -> std::optional<RetainValue> {
+    auto it = values.find(name);
+    if (it == values.end()) return std::nullopt;
+    RetainValue v = it->second;
+    values.erase(it);
+    return v;
+  };
+  const auto running = pop(kRunning);
+  const auto program = pop(kProgram);
+  const auto block = pop(kBlock);
+  const auto blocks = pop(kBlocks);
+  const auto line = pop(kLine);
+  const auto depth = pop(kDepth);
+  if (!running || running->type != RetainType::kBool || !running->b) {
+    return std::nullopt;
+  }
+  auto as_int = [](const std::optional<RetainValue>& v) -> std::int64_t {
+    return v && v->type == RetainType::kInt ? v->i : 0;
+  };
+  InterruptedJob j;
+  j.program_id = static_cast<std::uint32_t>(as_int(program));
+  j.block_index = as_int(block);
+  j.block_count = as_int(blocks);
+  j.line = as_int(line);
+  if (depth && depth->type == RetainType::kReal && std::isfinite(depth->r)) {
+    j.depth_mm = depth->r;
+  }
+  return j;
+}
+
+std::string alarm_text(const InterruptedJob& j) {
+  const std::string program =
+      j.program_id != 0 ? fmt::format("program {:08x}", j.program_id) : "an unnamed program";
+  const std::string depth =
+      j.depth_mm ? fmt::format(", depth {:.3f} mm", *j.depth_mm) : std::string();
+  return fmt::format(
+      "job interrupted by an unclean stop: {}, block {} of {} (G-code line {}){}; the part "
+      "program is not kept: check the work, reset, commit it again",
+      program, j.block_index, j.block_count, j.line, depth);
+}
+
+}  // namespace edm::rt::retain_job
