@@ -53,7 +53,7 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
   v.param("short_retracts_max", short_retracts_max,
           {.unit = "",
            .description = "retracts without progress allowed within the window; one more: alarm 150",
-           .range = rt::closed(1, kMaxShortRetracts)});
+           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
   v.param("short_retracts_window", short_retracts_window,
           {.unit = "s",
            .description = "the time over which short retracts are counted",
@@ -168,7 +168,7 @@ void DeepHoleDrill::activate_self() noexcept {
   short_retracts.set(0);
   short_time_s.set(0.0);
   last_retracts_ = 0;
-  n_retract_starts_ = 0;
+  budget_.reset();
   set_state(State::kIdle);
 }
 
@@ -189,7 +189,7 @@ void DeepHoleDrill::begin_cycle() noexcept {
   wear_mm.set(0.0);
   short_retracts.set(0);
   short_time_s.set(0.0);
-  n_retract_starts_ = 0;
+  budget_.reset();
   set_state(State::kApproach);
 }
 
@@ -218,18 +218,6 @@ void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcep
   }
 }
 
-bool DeepHoleDrill::too_many_retracts(rt::TimePoint now) noexcept {
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < n_retract_starts_; ++k) {
-    if (now - retract_starts_[k] <= params_.short_retracts_window) {
-      retract_starts_[kept++] = retract_starts_[k];
-    }
-  }
-  retract_starts_[kept++] = now;  // fits: more than short_retracts_max (≤ 16) raises the alarm
-  n_retract_starts_ = kept;
-  return static_cast<std::int64_t>(kept) > params_.short_retracts_max;
-}
-
 bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
                                  rt::BlockStatus& status) noexcept {
   retract_enable.set(true);
@@ -239,15 +227,13 @@ bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
   const std::int64_t started = retract_.retracts.get();
   if (started != last_retracts_) {  // a retract began this cycle (also from RESUME)
     last_retracts_ = started;
-    if (retract_.tries.get() <= 1) {
-      n_retract_starts_ = 0;  // the hole advanced retract.progress_mm since the last retract
-    }
-    if (too_many_retracts(ctx.release)) {
+    if (budget_.exceeded(ctx.release, retract_.tries.get(), params_.short_retracts_max,
+                         params_.short_retracts_window)) {
       // Alarm 150: the machine goes to FAULT; the safe state backs Z off and holds.
       if (machine_ != nullptr) {
         machine_->raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, ctx.release,
                          source_, "short circuit: too many retracts within the window",
-                         static_cast<double>(n_retract_starts_)});
+                         static_cast<double>(budget_.count())});
       } else {
         safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
       }

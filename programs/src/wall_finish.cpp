@@ -33,6 +33,18 @@ void WallFinishParams::visit(rt::ParamVisitor& v) {
           {.unit = "s",
            .description = "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
            .range = rt::kNonNegative});
+  v.param("short_ratio_limit", short_ratio_limit,
+          {.unit = "",
+           .description = "the Td window reads short at this fraction of shorted pulses",
+           .range = rt::open_closed(0.0, 1.0)});
+  v.param("short_retracts_max", short_retracts_max,
+          {.unit = "",
+           .description = "retracts without progress allowed within the window; one more: alarm 150",
+           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
+  v.param("short_retracts_window", short_retracts_window,
+          {.unit = "s",
+           .description = "the time over which short retracts are counted",
+           .range = rt::kPositive});
 }
 
 WallFinish::WallFinish()
@@ -40,7 +52,8 @@ WallFinish::WallFinish()
       td_(add_child<blocks::TdDetector>("td")),
       orbit_(add_child<blocks::OrbitExpander>("orbit")),
       px_(add_child<blocks::PositionLoop>("px")),
-      py_(add_child<blocks::PositionLoop>("py")) {
+      py_(add_child<blocks::PositionLoop>("py")),
+      retract_(add_child<blocks::ShortRetract>("retract")) {
   // This program's defaults for its children (variables of their own, set in YAML).
   blocks::PolaritySwitchParams pp;
   pp.initial_positive = false;
@@ -55,6 +68,13 @@ WallFinish::WallFinish()
     lp.v_max_mm_s = 5.0;
     l->set_params(lp);
   }
+  blocks::ShortRetractParams rp;
+  rp.short_cycles = 5;             // with td.window: the detection window
+  rp.max_tries = 1000;             // the retract budget is this program's
+  rp.retract_distance_mm = 0.2;    // along the contour
+  rp.retract_speed_mm_s = 2.0;     // within the loops' 5 mm/s
+  rp.resume_speed_mm_s = 1.0;
+  retract_.set_params(rp);
 }
 
 void WallFinish::visit_own_pins(rt::PinVisitor& v) {
@@ -90,9 +110,14 @@ void WallFinish::visit_own_pins(rt::PinVisitor& v) {
   v.output("vx_ff_mm_s", vx_ff_mm_s, "mm/s");
   v.output("vy_ff_mm_s", vy_ff_mm_s, "mm/s");
   v.output("loop_enable", loop_enable);
+  v.output("gap_short", gap_short);
+  v.output("retract_enable", retract_enable);
+  v.output("short_retracts", short_retracts);
 }
 
-std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& /*setup*/) {
+std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& setup) {
+  machine_ = setup.machine;
+  source_ = std::string(setup.instance);
   if (orbit_.params().samples_per_rev != 0) {
     return {{"orbit.samples_per_rev",
              "must be 0 in WallFinish (revolutions come from the orbit phase)"}};
@@ -122,6 +147,10 @@ void WallFinish::bind_self() {
   py_.v_ff_mm_s.connect(vy_ff_mm_s);
   py_.x_mm.follow(y_mm);
   py_.enable.connect(loop_enable);
+  retract_.x_mm.connect(x_ref_mm);  // the contour as commanded
+  retract_.y_mm.connect(y_ref_mm);
+  retract_.short_detected.connect(gap_short);
+  retract_.enable.connect(retract_enable);
 }
 
 void WallFinish::activate_self() noexcept {
@@ -143,6 +172,11 @@ void WallFinish::activate_self() noexcept {
   rho_mm.set(0.0);
   revolutions.set(0);
   done.set(false);
+  gap_short.set(false);
+  retract_enable.set(false);
+  short_retracts.set(0);
+  last_retracts_ = 0;
+  budget_.reset();
   set_state(State::kIdle);
 }
 
@@ -174,6 +208,32 @@ void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexce
     done.set(false);
     set_state(State::kIdle);
   }
+}
+
+bool WallFinish::handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept {
+  retract_enable.set(true);
+  gap_short.set(td_.valid.get() && td_.short_ratio.get() >= params_.short_ratio_limit);
+  status = rt::worst(status, step(retract_, ctx));
+  const std::int64_t started = retract_.retracts.get();
+  if (started != last_retracts_) {  // a retract began this cycle
+    last_retracts_ = started;
+    if (budget_.exceeded(ctx.release, retract_.tries.get(), params_.short_retracts_max,
+                         params_.short_retracts_window)) {
+      // Alarm 150: the machine goes to FAULT and the safe state stops the orbit (without a
+      // machine, as in unit tests, this block stops it itself and reports a fault).
+      if (machine_ != nullptr) {
+        machine_->raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, ctx.release,
+                         source_.c_str(), "short circuit: too many retracts within the window",
+                         static_cast<double>(budget_.count())});
+      } else {
+        safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
+        status = rt::BlockStatus::kFault;
+      }
+    } else {
+      short_retracts.set(short_retracts.get() + 1);
+    }
+  }
+  return retract_.active.get();
 }
 
 rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
@@ -229,6 +289,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
   }
 
   double rho_target = 0.0;
+  bool retracting = false;
   if (held) {
     rho_target = rho_;
   } else if (state_value_ == State::kOrbit) {
@@ -239,46 +300,62 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       no_spark.set(true);  // the task raises the block-fault alarm: safe state, job aborted
       status = rt::BlockStatus::kFault;
     }
-    const double radius = orbit_.radius_mm.get();
-    // Revolutions count (and Td is collected) only once the reference radius has reached the
-    // orbit radius: the entry from the centre is not a machining revolution.
-    const bool on_radius = rho_ == radius;
-    const double prev_theta = theta_;
-    theta_ += kTwoPi * dt / params_.orbit_period_s;
-    bool wrapped = false;
-    if (theta_ >= kTwoPi) {
-      theta_ -= kTwoPi;
-      wrapped = prev_theta < kTwoPi;
-    }
-    orbit_enable.set(on_radius);
-    rev_pulse.set(wrapped && on_radius);
-    if (wrapped && on_radius) {
-      ++revs_;
-      if (spark_out_ && spark_out_left_ > 0) {
-        --spark_out_left_;
+    retracting = handle_short(ctx, status);
+    if (retracting || gap_short.get()) {
+      rho_target = rho_;  // a short: the phase and the radius wait
+    } else {
+      const double radius = orbit_.radius_mm.get();
+      // Revolutions count (and Td is collected) only once the reference radius has reached the
+      // orbit radius: the entry from the centre is not a machining revolution.
+      const bool on_radius = rho_ == radius;
+      const double prev_theta = theta_;
+      theta_ += kTwoPi * dt / params_.orbit_period_s;
+      bool wrapped = false;
+      if (theta_ >= kTwoPi) {
+        theta_ -= kTwoPi;
+        wrapped = prev_theta < kTwoPi;
+      }
+      orbit_enable.set(on_radius);
+      rev_pulse.set(wrapped && on_radius);
+      if (wrapped && on_radius) {
+        ++revs_;
+        if (spark_out_ && spark_out_left_ > 0) {
+          --spark_out_left_;
+        }
+      }
+      status = rt::worst(status, step(orbit_, ctx));
+      orbit_start.set(false);
+      if (!spark_out_ && orbit_.done.get() && orbit_.radius_mm.get() == rho_) {
+        spark_out_ = true;  // the final radius is reached: spark out for spark_out_revs more
+      }
+      offset_mm.set(orbit_.radius_mm.get());
+      revolutions.set(revs_);
+      if (spark_out_ && spark_out_left_ == 0) {
+        set_state(State::kBack);
+      } else {
+        rho_target = orbit_.radius_mm.get();
       }
     }
-    status = rt::worst(status, step(orbit_, ctx));
-    orbit_start.set(false);
-    if (!spark_out_ && orbit_.done.get() && orbit_.radius_mm.get() == rho_) {
-      spark_out_ = true;  // the final radius is reached: spark out for spark_out_revs more
-    }
-    offset_mm.set(orbit_.radius_mm.get());
-    revolutions.set(revs_);
-    if (spark_out_ && spark_out_left_ == 0) {
-      set_state(State::kBack);
-    } else {
-      rho_target = orbit_.radius_mm.get();
-    }
+  }
+  if (state_value_ != State::kOrbit && retract_enable.get()) {
+    retract_enable.set(false);  // the history is this orbit's contour only
+    status = rt::worst(status, step(retract_, ctx));
   }
 
   if (state_value_ == State::kOrbit || state_value_ == State::kBack) {
-    // Slew the reference radius toward its target, then place the reference point.
-    const double slew = params_.radial_speed_mm_s * dt;
-    rho_ =
-        rho_ < rho_target ? std::min(rho_ + slew, rho_target) : std::max(rho_ - slew, rho_target);
-    const double xr = x0_ + rho_ * std::cos(theta_);
-    const double yr = y0_ + rho_ * std::sin(theta_);
+    double xr = 0.0;
+    double yr = 0.0;
+    if (retracting) {
+      xr = retract_.x_sp_mm.get();  // back along the contour, and forward again
+      yr = retract_.y_sp_mm.get();
+    } else {
+      // Slew the reference radius toward its target, then place the reference point.
+      const double slew = params_.radial_speed_mm_s * dt;
+      rho_ = rho_ < rho_target ? std::min(rho_ + slew, rho_target)
+                               : std::max(rho_ - slew, rho_target);
+      xr = x0_ + rho_ * std::cos(theta_);
+      yr = y0_ + rho_ * std::sin(theta_);
+    }
     vx_ff_mm_s.set(dt > 0.0 ? (xr - x_ref_) / dt : 0.0);
     vy_ff_mm_s.set(dt > 0.0 ? (yr - y_ref_) / dt : 0.0);
     set_reference(xr, yr);

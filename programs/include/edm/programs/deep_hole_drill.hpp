@@ -89,6 +89,7 @@
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
 #include "edm/blocks/wear_compensator.hpp"
+#include "edm/programs/retract_budget.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 
@@ -104,7 +105,6 @@ struct DeepHoleDrillParams {
   double breakthrough_min_mm{0.5};        // [mm] no breakthrough before this depth
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
   // Short circuits (seed 004: a short reads as feedback ≈ 0, so it must back the electrode off).
-  static constexpr std::int64_t kMaxShortRetracts = 16;
   double short_ratio_limit{0.9};           // the Td window reads short at this fraction of shorts
   std::int64_t short_retracts_max{3};      // N: retracts allowed within short_retracts_window
   rt::Duration short_retracts_window{std::chrono::seconds(10)};  // T
@@ -166,8 +166,6 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   void begin_retract(double target_z) noexcept;
   /// One DRILL cycle of the short handling; true while the retract owns the Z command.
   bool handle_short(const rt::CycleContext& ctx, double z, rt::BlockStatus& status) noexcept;
-  /// A retract began at `now`: true when it is more than short_retracts_max within the window.
-  bool too_many_retracts(rt::TimePoint now) noexcept;
 
   blocks::TdDetector& td_;
   blocks::GapControllerP& gap_;
@@ -188,8 +186,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   bool safe_retract_{false};  // the running retract was started by the safe state
   std::int64_t last_retracts_{0};  // retract.retracts seen last cycle
   double last_z_sp_mm_{0.0};
-  std::array<rt::TimePoint, DeepHoleDrillParams::kMaxShortRetracts + 1> retract_starts_{};
-  std::size_t n_retract_starts_{0};  // entries of retract_starts_ in use (oldest first)
+  RetractBudget budget_;
 };
 
 }  // namespace edm::programs

@@ -37,6 +37,13 @@
 // orbit phase: another value is refused), pol.initial_positive = false, px/py.v_max_mm_s = 5.
 // Connected by member in bind_self(): td's counters and px/py's positions follow this block's
 // inputs; orbit.td_us/valid ← td; the rest come from this block's outputs below.
+// Short circuits in ORBIT: td pools shorts as Td ≈ 0, so Tdm and the growth Δr = kr·Tdm shrink
+// by themselves. While the window reads short (gap_short: td.short_ratio ≥ short_ratio_limit)
+// the phase and the radius wait (no advance toward the wall); a retract child (ShortRetract on
+// the commanded reference x_ref_mm/y_ref_mm) backs the electrode along the contour already
+// travelled and walks it forward again, the loops following its setpoint; then the orbit
+// continues from where it stopped. Too many retracts without progress: alarm 150 (fault); the
+// safe state stops the orbit.
 // Extra outputs (the signals the sequence gives its children): polarity_request,
 // generator_request, orbit_start, orbit_enable, rev_pulse, orbit_r0_mm, orbit_final_mm,
 // x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s, loop_enable.
@@ -45,12 +52,15 @@
 // Not thread-safe: the owning task calls every member except the pins (see pin.hpp).
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "edm/blocks/orbit_expander.hpp"
 #include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/position_loop.hpp"
+#include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
+#include "edm/programs/retract_budget.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 
@@ -64,6 +74,12 @@ struct WallFinishParams {
   // ORBIT without a single ignited or shorted pulse for this long (outside spark-out) is a fault:
   // no work, no generator, a wrong offset. 0 s: off.
   rt::Duration no_spark_timeout{std::chrono::seconds(30)};
+  // Short circuits in the orbit (as DeepHoleDrill's): the window reads short at this fraction
+  // of shorted pulses; more than short_retracts_max retracts without progress within
+  // short_retracts_window raise alarm 150.
+  double short_ratio_limit{0.9};
+  std::int64_t short_retracts_max{3};
+  rt::Duration short_retracts_window{std::chrono::seconds(10)};
 
   void visit(rt::ParamVisitor& v);
 };
@@ -96,6 +112,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<double> orbit_r0_mm, orbit_final_mm;
   rt::Output<double> x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s;
   rt::Output<bool> loop_enable;
+  rt::Output<bool> gap_short;       // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable;  // the short retract records the contour (ORBIT only)
+  rt::Output<std::int64_t> short_retracts;  // retracts in this cycle
 
  protected:
   void visit_own_pins(rt::PinVisitor& v) override;
@@ -110,12 +129,19 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   void set_state(State s) noexcept;
   void stop_outputs() noexcept;
   void set_reference(double x, double y) noexcept;
+  /// One ORBIT cycle of the short handling; true while the retract owns the reference.
+  bool handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept;
 
   blocks::PolaritySwitch& pol_;
   blocks::TdDetector& td_;
   blocks::OrbitExpander& orbit_;
   blocks::PositionLoop& px_;
   blocks::PositionLoop& py_;
+  blocks::ShortRetract& retract_;
+  rt::Machine* machine_{nullptr};
+  std::string source_;  // this block's instance name, for alarm 150
+  RetractBudget budget_;
+  std::int64_t last_retracts_{0};
 
   State state_value_{State::kIdle};
   bool prev_start_{false};
