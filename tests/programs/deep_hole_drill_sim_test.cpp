@@ -128,20 +128,18 @@ INSTANTIATE_TEST_SUITE_P(Seeds, DrillSeeds, ::testing::Values(1, 2, 3));
 TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
   SteppedMachine m(read_file(kConfig), "drill-sim-program.yaml");
   auto& vars = m.vars;
-  const std::int64_t& k = m.next;
-  auto cycle = [&] { m.cycle(); };
   auto read = [&](const char* n) { return m.read(n); };
-  while (k < 200'000 && read("cycle.drill.depth_reached_mm") < 8.0) cycle();
+  m.run_while(200'000, [&] { return read("cycle.drill.depth_reached_mm") < 8.0; });
   ASSERT_EQ(read("cycle.drill.state"), 2.0) << "drilling";
 
   ASSERT_TRUE(vars.force("cycle.drill.hold", 1.0));
-  cycle();
+  m.cycle();
   EXPECT_EQ(read("cycle.drill.gen_on"), 0.0) << "generator off in the first held cycle";
   EXPECT_EQ(read("cycle.drill.vz_cmd_mm_s"), 0.0);
-  for (int i = 0; i < 50; ++i) cycle();  // the axis comes to rest
+  m.run(50);  // the axis comes to rest
   const double depth0 = read("io.depth_mm"), electrode0 = read("io.electrode_mm");
   const double z0 = read("io.z_mm"), estimate0 = read("cycle.drill.depth_reached_mm");
-  for (int i = 0; i < 2000; ++i) cycle();  // 2 s held
+  m.run(2000);  // 2 s held
   EXPECT_EQ(read("io.depth_mm"), depth0) << "nothing eroded while held";
   EXPECT_EQ(read("io.electrode_mm"), electrode0) << "no wear while held";
   EXPECT_NEAR(read("io.z_mm"), z0, 1e-3) << "Z still";
@@ -149,7 +147,7 @@ TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
   EXPECT_EQ(read("cycle.drill.state"), 2.0) << "still in DRILL, not restarted";
 
   ASSERT_TRUE(vars.unforce("cycle.drill.hold"));
-  while (k < 400'000 && read("cycle.drill.state") != 4.0) cycle();
+  m.run_while(400'000, [&] { return read("cycle.drill.state") != 4.0; });
   ASSERT_EQ(read("cycle.drill.state"), 4.0) << "DONE after the release";
   std::printf("[drill] held 2 s at %.3f mm, finished at %.4f mm (true %.4f)\n", estimate0,
               read("cycle.drill.depth_reached_mm"), read("io.depth_mm"));

@@ -96,6 +96,14 @@ struct SteppedMachine {
     if (k % 4096 == 0) runtime->trace().drain(sink), sink.str({});
   }
   void cycle() { run_cycle(next++); }
+  void run(int cycles) {
+    for (int i = 0; i < cycles; ++i) cycle();
+  }
+  /// Runs cycles while `go_on()` holds, up to cycle `max_cycles` (counted from the first).
+  template <class Pred>
+  void run_while(std::int64_t max_cycles, Pred go_on) {
+    while (next < max_cycles && go_on()) cycle();
+  }
   double read(const char* name) { return vars.read(name).value(); }
 };
 

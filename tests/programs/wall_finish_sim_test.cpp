@@ -140,19 +140,17 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
   auto& vars = m.vars;
   const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(m.runtime->driver()).plant();
   const double target = plant.wall_bin_radius_mm(0) + 0.05;
-  const std::int64_t& k = m.next;
-  auto cycle = [&] { m.cycle(); };
   auto read = [&](const char* n) { return m.read(n); };
-  while (k < 120'000 && read("cycle.finish.revolutions") < 5.0) cycle();
+  m.run_while(120'000, [&] { return read("cycle.finish.revolutions") < 5.0; });
   ASSERT_EQ(read("cycle.finish.state"), 2.0) << "orbiting";
 
   ASSERT_TRUE(vars.force("cycle.finish.hold", 1.0));
-  cycle();
+  m.cycle();
   EXPECT_EQ(read("cycle.finish.gen_on"), 0.0) << "generator off in the first held cycle";
-  for (int i = 0; i < 200; ++i) cycle();  // the axes come to rest
+  m.run(200);  // the axes come to rest
   const double r0 = read("io.wall_radius_mm"), x0 = read("io.x_mm"), y0 = read("io.y_mm");
   const double revs0 = read("cycle.finish.revolutions");
-  for (int i = 0; i < 2000; ++i) cycle();  // 2 s held
+  m.run(2000);  // 2 s held
   EXPECT_EQ(read("io.wall_radius_mm"), r0) << "nothing eroded while held";
   EXPECT_NEAR(read("io.x_mm"), x0, 1e-3);
   EXPECT_NEAR(read("io.y_mm"), y0, 1e-3);
@@ -160,7 +158,7 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
   EXPECT_EQ(read("cycle.finish.state"), 2.0);
 
   ASSERT_TRUE(vars.unforce("cycle.finish.hold"));
-  while (k < 240'000 && read("cycle.finish.state") != 4.0) cycle();
+  m.run_while(240'000, [&] { return read("cycle.finish.state") != 4.0; });
   ASSERT_EQ(read("cycle.finish.state"), 4.0) << "DONE after the release";
   double r_min = 1e9, r_max = -1e9;
   for (std::size_t j = 0; j < sim::Plant::kWallBins; ++j) {
