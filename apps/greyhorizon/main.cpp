@@ -15,7 +15,6 @@
 #include <fstream>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -23,13 +22,12 @@
 #include <vector>
 
 #include "edm/apps/cli.hpp"
-#include "edm/blocks/register.hpp"
+#include "edm/apps/offline_runtime.hpp"
+#include "edm/apps/text_file.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
-#include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/scheduler.hpp"
-#include "edm/sim/sim_driver.hpp"
 #include "horizon.hpp"
 
 namespace {
@@ -50,21 +48,11 @@ constexpr const char* kUsage =
     "edm-greyhorizon [--seed S] [--samples N] [--skip-s T] [--config PATH] [--io PARAMS]\n"
     "                       [--csv PATH] [--raw PATH] [--max-p P] [--window n] [--warmup W]";
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot read");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Rab every 40 ms from the wire simulator, after skip_ms of cutting.
 std::vector<double> record_rab(const std::string& config_path, std::int64_t seed,
                                const std::string& io_extra, std::size_t samples,
                                std::int64_t skip_ms) {
-  std::string text = slurp(config_path);
+  std::string text = edm::apps::read_text_file(config_path);
   const std::string from = "seed: 1}";
   const auto at = text.find(from);
   if (at == std::string::npos) {
@@ -73,14 +61,7 @@ std::vector<double> record_rab(const std::string& config_path, std::int64_t seed
   text.replace(at, from.size(),
                "seed: " + std::to_string(seed) + (io_extra.empty() ? "" : ", " + io_extra) + "}");
 
-  rt::BlockRegistry blocks;
-  rt::DriverRegistry drivers;
-  edm::blocks::register_builtin_blocks(blocks);
-  rt::register_runtime_drivers(drivers);
-  edm::sim::register_sim_driver(drivers);
-  rt::BuildOptions options;
-  options.load_retain = false;
-  auto r = rt::Runtime::build(rt::parse_config_text(text, config_path), blocks, drivers, options);
+  auto r = edm::apps::build_offline(rt::parse_config_text(text, config_path));
   std::vector<rt::Task*> tasks;
   for (const auto& t : r->tasks()) {
     t->detach_trace();

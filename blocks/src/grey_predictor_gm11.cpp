@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/blocks/validation.hpp"
+
 namespace edm::blocks {
 std::vector<rt::ParamError> GreyPredictorGM11Params::validate() const {
   std::vector<rt::ParamError> errs;
@@ -76,14 +78,11 @@ void GreyPredictorGM11::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> GreyPredictorGM11::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = rt::validate_params(params_);
-  if (!errs.empty()) {
-    return errs;
-  }
-  window_.allocate(static_cast<std::size_t>(params_.window));
-  work_.assign(window_.capacity(), 0.0);
-  activate();
-  return errs;
+  return configure_checked(params_, [this] {
+    window_.allocate(static_cast<std::size_t>(params_.window));
+    work_.assign(window_.capacity(), 0.0);
+    activate();
+  });
 }
 
 void GreyPredictorGM11::activate() noexcept {

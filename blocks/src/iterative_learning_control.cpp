@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/blocks/validation.hpp"
+
 namespace edm::blocks {
 std::vector<rt::ParamError> IterativeLearningControlParams::validate() const {
   std::vector<rt::ParamError> errs;
@@ -47,13 +49,10 @@ void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> IterativeLearningControl::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = rt::validate_params(params_);
-  if (!errs.empty()) {
-    return errs;
-  }
-  u_.assign(static_cast<std::size_t>(params_.n_samples), params_.u_initial);
-  e_.assign(u_.size(), 0.0);
-  return errs;
+  return configure_checked(params_, [this] {
+    u_.assign(static_cast<std::size_t>(params_.n_samples), params_.u_initial);
+    e_.assign(u_.size(), 0.0);
+  });
 }
 
 void IterativeLearningControl::activate() noexcept {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/blocks/validation.hpp"
+
 namespace edm::blocks {
 void MovingAverage::CompensatedSum::add(double x) noexcept {
   // Knuth's TwoSum: s + e == hi + x exactly (needs strict IEEE evaluation: no -ffast-math).
@@ -20,13 +22,10 @@ void MovingAverage::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> MovingAverage::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = rt::validate_params(params_);
-  if (!errs.empty()) {
-    return errs;
-  }
-  window_.allocate(static_cast<std::size_t>(params_.window));
-  activate();
-  return errs;
+  return configure_checked(params_, [this] {
+    window_.allocate(static_cast<std::size_t>(params_.window));
+    activate();
+  });
 }
 
 void MovingAverage::activate() noexcept {

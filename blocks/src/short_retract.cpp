@@ -36,16 +36,12 @@ void ShortRetract::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup) {
-  auto errs = rt::validate_params(params_);
-  require_task_period(errs, setup.period);
-  if (!errs.empty()) {
-    return errs;
-  }
-  dt_s_ = rt::to_seconds(setup.period);
-  history_.allocate(static_cast<std::size_t>(params_.history_capacity));
-  compute_ramp();
-  activate();
-  return errs;
+  return configure_checked(params_, setup.period, [&] {
+    dt_s_ = rt::to_seconds(setup.period);
+    history_.allocate(static_cast<std::size_t>(params_.history_capacity));
+    compute_ramp();
+    activate();
+  });
 }
 
 void ShortRetract::activate() noexcept {

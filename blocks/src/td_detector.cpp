@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "edm/blocks/validation.hpp"
+
 namespace edm::blocks {
 namespace {
 
@@ -23,13 +25,10 @@ void TdDetector::visit_pins(rt::PinVisitor& v) {
 }
 
 std::vector<rt::ParamError> TdDetector::configure(const rt::BlockSetup& /*setup*/) {
-  auto errs = rt::validate_params(params_);
-  if (!errs.empty()) {
-    return errs;
-  }
-  window_.allocate(static_cast<std::size_t>(params_.window));
-  activate();
-  return errs;
+  return configure_checked(params_, [this] {
+    window_.allocate(static_cast<std::size_t>(params_.window));
+    activate();
+  });
 }
 
 void TdDetector::activate() noexcept {

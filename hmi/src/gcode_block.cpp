@@ -2,7 +2,10 @@
 
 #include "gcode_block.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 #include <string>
 
 namespace edm::hmi::detail {
@@ -20,6 +23,25 @@ bool is_whole(double v) noexcept { return std::fabs(v) < 1e9 && v == std::floor(
 
 namespace {
 
+// The G and M codes this dialect knows (as code10: G02 is 20, G160 is 1600), by modal group.
+struct CodeGroup {
+  char letter;
+  std::array<int, 4> codes;
+  std::size_t count;
+  const Word* Block::*slot;
+  const char* name;  // how a conflict names the group
+};
+constexpr CodeGroup kCodeGroups[] = {
+    {'G', {0, 10, 20, 30}, 4, &Block::motion_g, "motion codes (modal group 1: G00 G01 G02 G03)"},
+    {'G', {40, 1600}, 2, &Block::nonmodal_g, "non-modal codes (group 0: G04 G160)"},
+    {'G', {170}, 1, &Block::plane_g, "plane codes (modal group 2)"},
+    {'G', {210}, 1, &Block::units_g, "unit codes (modal group 6)"},
+    {'G', {900, 910}, 2, &Block::distance_g, "distance-mode codes (modal group 3: G90 G91)"},
+    {'M', {20, 300}, 2, &Block::stop_m, "program-end codes (modal group 4: M02 M30)"},
+    {'M', {30, 50}, 2, &Block::rotation_m, "rotation codes (modal group 7: M03 M05)"},
+    {'M', {80, 90}, 2, &Block::flushing_m, "flushing codes (modal group 8: M08 M09)"},
+};
+
 class Sorter {
  public:
   explicit Sorter(std::vector<GcodeError>& errors) : errors_(errors) {}
@@ -35,52 +57,26 @@ class Sorter {
     return true;
   }
 
-  bool sort_g(Block& b, const Word& w) {
-    switch (code10(w)) {
-      case 0:
-      case 10:
-      case 20:
-      case 30:
-        return set_group(b, b.motion_g, w, "motion codes (modal group 1: G00 G01 G02 G03)");
-      case 40:
-      case 1600:
-        return set_group(b, b.nonmodal_g, w, "non-modal codes (group 0: G04 G160)");
-      case 170:
-        return set_group(b, b.plane_g, w, "plane codes (modal group 2)");
-      case 210:
-        return set_group(b, b.units_g, w, "unit codes (modal group 6)");
-      case 900:
-      case 910:
-        return set_group(b, b.distance_g, w, "distance-mode codes (modal group 3: G90 G91)");
-      case 180:
-      case 190:
-        error(b, &w, word_text(w) + " is not supported: arcs are in the XY plane only (G17)");
-        return false;
-      case 200:
-        error(b, &w,
-              word_text(w) + " (inch units) is not supported: this dialect is mm only (G21)");
-        return false;
-      default:
-        error(b, &w, "unknown G code " + word_text(w));
-        return false;
+  // G and M words: the modal group's slot (a second word of the group is a conflict), else why
+  // the code is refused.
+  bool sort_code(Block& b, const Word& w) {
+    const int code = code10(w);
+    for (const CodeGroup& g : kCodeGroups) {
+      const auto codes = std::span(g.codes).first(g.count);
+      if (g.letter == w.letter && std::find(codes.begin(), codes.end(), code) != codes.end()) {
+        return set_group(b, b.*g.slot, w, g.name);
+      }
     }
-  }
-
-  bool sort_m(Block& b, const Word& w) {
-    switch (code10(w)) {
-      case 20:
-      case 300:
-        return set_group(b, b.stop_m, w, "program-end codes (modal group 4: M02 M30)");
-      case 30:
-      case 50:
-        return set_group(b, b.rotation_m, w, "rotation codes (modal group 7: M03 M05)");
-      case 80:
-      case 90:
-        return set_group(b, b.flushing_m, w, "flushing codes (modal group 8: M08 M09)");
-      default:
-        error(b, &w, "unknown M code " + word_text(w));
-        return false;
+    if (w.letter == 'M') {
+      error(b, &w, "unknown M code " + word_text(w));
+    } else if (code == 180 || code == 190) {
+      error(b, &w, word_text(w) + " is not supported: arcs are in the XY plane only (G17)");
+    } else if (code == 200) {
+      error(b, &w, word_text(w) + " (inch units) is not supported: this dialect is mm only (G21)");
+    } else {
+      error(b, &w, "unknown G code " + word_text(w));
     }
+    return false;
   }
 
   bool sort_words(const std::vector<Word>& words, Block& b) {
@@ -99,10 +95,8 @@ class Sorter {
           }
           break;
         case 'G':
-          ok = sort_g(b, w) && ok;
-          break;
         case 'M':
-          ok = sort_m(b, w) && ok;
+          ok = sort_code(b, w) && ok;
           break;
         case 'X':
         case 'Y':

@@ -120,50 +120,56 @@ SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out)
   return e_loc;
 }
 
-}  // namespace
+/// What makes a list item unique: its key, where it was written, and how an error names it.
+struct ItemKey {
+  std::string key;
+  SourceLoc loc;
+  const char* field;  // appended to the item's path
+  std::string label;  // "axis 'X'", "condition E3"
+};
 
-std::vector<LocatedAxis> read_axes(yaml::Reader& r, const Value& axes) {
-  std::vector<LocatedAxis> out;
-  auto items = r.list(axes);
+/// Reads each item of a list with read_one(item, out) -> optional<ItemKey>; a key written twice is
+/// an error "duplicate <label> (first at line L)".
+template <class T, class ReadOne>
+std::vector<T> read_keyed_list(yaml::Reader& r, const Value& list, ReadOne read_one) {
+  std::vector<T> out;
+  auto items = r.list(list);
   if (!items) {
     return out;
   }
-  FirstSeen names;
+  FirstSeen seen;
   for (const Value& item : *items) {
-    LocatedAxis a;
-    SourceLoc name_loc;
-    if (const std::optional<char> name = read_axis(r, item, a, name_loc)) {
-      const std::string s(1, *name);
-      if (const std::optional<int> first = names.add(s, name_loc)) {
-        r.error(name_loc, item.path + ".name",
-                "duplicate axis '" + s + "' (first at line " + std::to_string(*first) + ")");
+    T t;
+    if (const std::optional<ItemKey> k = read_one(item, t)) {
+      if (const std::optional<int> first = seen.add(k->key, k->loc)) {
+        r.error(k->loc, item.path + k->field,
+                "duplicate " + k->label + " (first at line " + std::to_string(*first) + ")");
       }
     }
-    out.push_back(std::move(a));
+    out.push_back(std::move(t));
   }
   return out;
 }
 
+}  // namespace
+
+std::vector<LocatedAxis> read_axes(yaml::Reader& r, const Value& axes) {
+  return read_keyed_list<LocatedAxis>(r, axes, [&r](const Value& item, LocatedAxis& a) {
+    SourceLoc name_loc;
+    const std::optional<char> name = read_axis(r, item, a, name_loc);
+    return name ? std::optional<ItemKey>({std::string(1, *name), name_loc, ".name",
+                                          "axis '" + std::string(1, *name) + "'"})
+                : std::nullopt;
+  });
+}
+
 std::vector<LocatedCondition> read_conditions(yaml::Reader& r, const Value& conditions) {
-  std::vector<LocatedCondition> out;
-  auto items = r.list(conditions);
-  if (!items) {
-    return out;
-  }
-  FirstSeen e_numbers;
-  for (const Value& item : *items) {
-    LocatedCondition c;
+  const auto read_one = [&r](const Value& item, LocatedCondition& c) {
     const SourceLoc e_loc = read_condition(r, item, c);
-    if (c.e >= 1) {
-      if (const std::optional<int> first = e_numbers.add(std::to_string(c.e), e_loc)) {
-        r.error(e_loc, item.path + ".E",
-                "duplicate condition E" + std::to_string(c.e) + " (first at line " +
-                    std::to_string(*first) + ")");
-      }
-    }
-    out.push_back(std::move(c));
-  }
-  return out;
+    const std::string e = std::to_string(c.e);
+    return c.e >= 1 ? std::optional<ItemKey>({e, e_loc, ".E", "condition E" + e}) : std::nullopt;
+  };
+  return read_keyed_list<LocatedCondition>(r, conditions, read_one);
 }
 
 }  // namespace edm::machining

@@ -2,6 +2,8 @@
 
 #include <array>
 
+#include "edm/machining/enum_names.hpp"
+
 namespace edm::machining {
 namespace {
 constexpr std::array<std::string_view, kMotionKindCount> kNames{
@@ -9,19 +11,10 @@ constexpr std::array<std::string_view, kMotionKindCount> kNames{
     "dwell", "condition", "rotation", "flushing", "end"};
 }  // namespace
 
-std::string_view to_string(MotionKind k) noexcept {
-  const auto i = static_cast<std::size_t>(k);
-  return i < kNames.size() ? kNames[i] : std::string_view{"?"};
-}
+std::string_view to_string(MotionKind k) noexcept { return enum_name(kNames, k); }
 
 bool motion_kind_from_string(std::string_view s, MotionKind& out) noexcept {
-  for (std::size_t i = 0; i < kNames.size(); ++i) {
-    if (kNames[i] == s) {
-      out = static_cast<MotionKind>(i);
-      return true;
-    }
-  }
-  return false;
+  return enum_from_name(kNames, s, out);
 }
 
 }  // namespace edm::machining

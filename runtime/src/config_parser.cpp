@@ -61,19 +61,8 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
       if (items->empty()) {
         r_.error(f->value, "must list at least one task");
       }
-      UniqueNames names;
-      for (const Value& item : *items) {
-        TaskSpec t;
-        parse_task(item, t);
-        if (!t.name.empty()) {
-          if (const SourceLoc* first = names.add(t.name, t.name_loc)) {
-            r_.error(
-                t.name_loc, item.path + ".name",
-                "duplicate task name '" + t.name + "' (first at line " + line_of(*first) + ")");
-          }
-        }
-        cfg.tasks.push_back(std::move(t));
-      }
+      parse_named(
+          *items, cfg.tasks, [this](const Value& v, TaskSpec& t) { parse_task(v, t); }, "task");
     }
   }
   program_names_complete_ = false;
@@ -83,19 +72,9 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
       if (items->empty()) {
         r_.error(f->value, "must list at least one program");
       }
-      UniqueNames names;
-      for (const Value& item : *items) {
-        ProgramSpec p;
-        parse_program(item, p);
-        if (!p.name.empty()) {
-          if (const SourceLoc* first = names.add(p.name, p.name_loc)) {
-            r_.error(
-                p.name_loc, item.path + ".name",
-                "duplicate program name '" + p.name + "' (first at line " + line_of(*first) + ")");
-          }
-        }
-        cfg.programs.push_back(std::move(p));
-      }
+      parse_named(
+          *items, cfg.programs, [this](const Value& v, ProgramSpec& p) { parse_program(v, p); },
+          "program");
     }
   }
   if (const Field* f = m->find("trace")) {

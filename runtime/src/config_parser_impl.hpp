@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "edm/runtime/config.hpp"
@@ -70,6 +71,10 @@ class Parser {
 
   // Optional-field helpers: read `key` if present and store it on success.
   std::optional<std::string> identifier(const Value& v, const char* what);
+  // The required `name` of a program or block: an identifier other than the reserved "io" (which
+  // is still stored, so that references to it don't cascade).
+  void program_or_block_name(const MapView& m, const char* what, std::string& name,
+                             SourceLoc& name_loc);
   template <class Int>
   void int_in(const MapView& m, std::string_view key, std::int64_t min, std::int64_t max,
               Int& out) {
@@ -77,6 +82,26 @@ class Parser {
       if (auto x = r_.integer(f->value, min, max)) {
         out = static_cast<Int>(*x);
       }
+    }
+  }
+
+  // Parses each list item with parse_one(item, spec) into `out`; a name seen before is an error
+  // "duplicate <kind> name 'n'<context> (first at line L)".
+  template <class Spec, class ParseOne>
+  void parse_named(const std::vector<Value>& items, std::vector<Spec>& out, ParseOne parse_one,
+                   const std::string& kind, const std::string& context = {}) {
+    UniqueNames names;
+    for (const Value& item : items) {
+      Spec spec;
+      parse_one(item, spec);
+      if (!spec.name.empty()) {
+        if (const SourceLoc* first = names.add(spec.name, spec.name_loc)) {
+          r_.error(spec.name_loc, item.path + ".name",
+                   "duplicate " + kind + " name '" + spec.name + "'" + context +
+                       " (first at line " + line_of(*first) + ")");
+        }
+      }
+      out.push_back(std::move(spec));
     }
   }
 

@@ -143,6 +143,20 @@ void Parser::parse_watchdog(const Value& v, WatchdogSpec& out) {
   }
 }
 
+void Parser::program_or_block_name(const MapView& m, const char* what, std::string& name,
+                                   SourceLoc& name_loc) {
+  if (const Field* f = r_.require(m, "name")) {
+    name_loc = f->value.loc;
+    if (auto s = identifier(f->value, what)) {
+      // Reserved names still count as known so tasks naming them don't cascade.
+      name = *s;
+      if (*s == "io") {
+        r_.error(f->value, "'io' is reserved (it names the process image); pick another name");
+      }
+    }
+  }
+}
+
 void Parser::parse_program(const Value& v, ProgramSpec& out) {
   out.loc = v.loc;
   out.name_loc = v.loc;
@@ -151,34 +165,15 @@ void Parser::parse_program(const Value& v, ProgramSpec& out) {
     program_names_complete_ = false;
     return;
   }
-  if (const Field* f = r_.require(*m, "name")) {
-    out.name_loc = f->value.loc;
-    if (auto s = identifier(f->value, "program name")) {
-      // Reserved names still count as known so tasks naming them don't cascade.
-      out.name = *s;
-      if (*s == "io") {
-        r_.error(f->value, "'io' is reserved (it names the process image); pick another name");
-      }
-    }
-  }
+  program_or_block_name(*m, "program name", out.name, out.name_loc);
   if (out.name.empty()) {
     program_names_complete_ = false;
   }
   if (const Field* f = m->find("blocks")) {
     if (auto items = r_.list(f->value)) {
-      UniqueNames names;
-      for (const Value& item : *items) {
-        BlockSpec b;
-        parse_block(item, b);
-        if (!b.name.empty()) {
-          if (const SourceLoc* first = names.add(b.name, b.name_loc)) {
-            r_.error(b.name_loc, item.path + ".name",
-                     "duplicate block name '" + b.name + "' in program '" + out.name +
-                         "' (first at line " + line_of(*first) + ")");
-          }
-        }
-        out.blocks.push_back(std::move(b));
-      }
+      parse_named(
+          *items, out.blocks, [this](const Value& item, BlockSpec& b) { parse_block(item, b); },
+          "block", " in program '" + out.name + "'");
     }
   }
   if (const Field* f = m->find("wires")) {
@@ -194,15 +189,7 @@ void Parser::parse_block(const Value& v, BlockSpec& out) {
   if (!m) {
     return;
   }
-  if (const Field* f = r_.require(*m, "name")) {
-    out.name_loc = f->value.loc;
-    if (auto s = identifier(f->value, "block name")) {
-      out.name = *s;
-      if (*s == "io") {
-        r_.error(f->value, "'io' is reserved (it names the process image); pick another name");
-      }
-    }
-  }
+  program_or_block_name(*m, "block name", out.name, out.name_loc);
   if (const Field* f = r_.require(*m, "type")) {
     out.type_loc = f->value.loc;
     out.type = r_.string(f->value).value_or("");

@@ -182,40 +182,38 @@ void force_pin(const PinRef& ref, T value) {
   }
 }
 
+// Calls f.template operator()<T>() with T the value type of a pin of type t.
+template <class F>
+auto with_value_type(PinType t, F&& f) {
+  using R = decltype(f.template operator()<double>());
+  switch (t) {
+    case PinType::kBool:
+      return f.template operator()<bool>();
+    case PinType::kInt:
+      return f.template operator()<std::int64_t>();
+    case PinType::kReal:
+      return f.template operator()<double>();
+  }
+  return R();
+}
+
+// Ends a force. `release` (the safe state's): an output gets its block's last computed value
+// back at once.
 template <class T>
-void unforce_pin(const PinRef& ref) {
+void end_force(const PinRef& ref, bool release) {
   if (ref.dir == PinDir::kInput) {
     ref.as_input<T>()->unforce();
+  } else if (release) {
+    ref.as_output<T>()->release();
   } else {
     ref.as_output<T>()->unforce();
   }
 }
 
-// The safe state's release: an output gets its block's last computed value back at once.
-template <class T>
-void release_pin(const PinRef& ref) {
-  if (ref.dir == PinDir::kInput) {
-    ref.as_input<T>()->unforce();
-  } else {
-    ref.as_output<T>()->release();
-  }
-}
-
-template <class T>
-bool is_forced(const PinRef& ref) {
-  return ref.dir == PinDir::kInput ? ref.as_input<T>()->forced() : ref.as_output<T>()->forced();
-}
-
 bool pin_forced(const PinRef& ref) {
-  switch (ref.type) {
-    case PinType::kBool:
-      return is_forced<bool>(ref);
-    case PinType::kInt:
-      return is_forced<std::int64_t>(ref);
-    case PinType::kReal:
-      return is_forced<double>(ref);
-  }
-  return false;
+  return with_value_type(ref.type, [&ref]<class T>() {
+    return ref.dir == PinDir::kInput ? ref.as_input<T>()->forced() : ref.as_output<T>()->forced();
+  });
 }
 
 }  // namespace
@@ -271,17 +269,7 @@ std::size_t VariableRegistry::release_forces() noexcept {
     if (!v.is_pin() || !pin_forced(v.pin)) {
       continue;
     }
-    switch (v.pin.type) {
-      case PinType::kBool:
-        release_pin<bool>(v.pin);
-        break;
-      case PinType::kInt:
-        release_pin<std::int64_t>(v.pin);
-        break;
-      case PinType::kReal:
-        release_pin<double>(v.pin);
-        break;
-    }
+    with_value_type(v.pin.type, [&v]<class T>() { end_force<T>(v.pin, /*release=*/true); });
     ++released;
   }
   return released;
@@ -295,17 +283,7 @@ VarStatus VariableRegistry::unforce(std::string_view name) {
   if (!v->is_pin()) {
     return {VarResult::kWrongKind, "'" + std::string(name) + "' is a parameter"};
   }
-  switch (v->pin.type) {
-    case PinType::kBool:
-      unforce_pin<bool>(v->pin);
-      break;
-    case PinType::kInt:
-      unforce_pin<std::int64_t>(v->pin);
-      break;
-    case PinType::kReal:
-      unforce_pin<double>(v->pin);
-      break;
-  }
+  with_value_type(v->pin.type, [v]<class T>() { end_force<T>(v->pin, /*release=*/false); });
   return {};
 }
 

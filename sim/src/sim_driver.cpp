@@ -77,6 +77,27 @@ bool SimDriver::set_seed(std::uint64_t seed) {
   return true;
 }
 
+struct SimDriver::StateOutput {
+  std::string_view name;
+  std::string_view unit;
+  rt::Output<double> SimDriver::*pin;
+  double PlantState::*field;
+};
+
+const SimDriver::StateOutput SimDriver::kAxisOutputs[6] = {
+    {"x_mm", "mm", &SimDriver::x_mm_, &PlantState::x_mm},
+    {"y_mm", "mm", &SimDriver::y_mm_, &PlantState::y_mm},
+    {"z_mm", "mm", &SimDriver::z_mm_, &PlantState::z_mm},
+    {"electrode_mm", "mm", &SimDriver::electrode_mm_, &PlantState::electrode_length_mm},
+    {"depth_mm", "mm", &SimDriver::depth_mm_, &PlantState::depth_mm},
+    {"wall_radius_mm", "mm", &SimDriver::wall_radius_mm_, &PlantState::wall_radius_mm}};
+
+const SimDriver::StateOutput SimDriver::kTruthOutputs[4] = {
+    {"true_gap_um", "um", &SimDriver::true_gap_um_, &PlantState::gap_um},
+    {"true_debris", "1", &SimDriver::true_debris_, &PlantState::debris},
+    {"true_kerf_debris", "1", &SimDriver::true_kerf_debris_, &PlantState::kerf_debris},
+    {"wire_load", "1", &SimDriver::wire_load_, &PlantState::wire_load}};
+
 void SimDriver::visit_pins(rt::PinVisitor& v) {
   v.output("td_sum_ns", td_sum_ns_, "ns");
   v.output("td_count", td_count_);
@@ -95,18 +116,14 @@ void SimDriver::visit_pins(rt::PinVisitor& v) {
   v.output("hist_arc", hist_arc_);
   v.output("rab", rab_, "1");
   v.output("gap_voltage_v", gap_voltage_v_, "V");
-  v.output("x_mm", x_mm_, "mm");
-  v.output("y_mm", y_mm_, "mm");
-  v.output("z_mm", z_mm_, "mm");
-  v.output("electrode_mm", electrode_mm_, "mm");
-  v.output("depth_mm", depth_mm_, "mm");
-  v.output("wall_radius_mm", wall_radius_mm_, "mm");
+  for (const StateOutput& o : kAxisOutputs) {
+    v.output(o.name, this->*o.pin, o.unit);
+  }
   v.output("wire_broken", wire_broken_);
   v.output("driver_fault", driver_fault_);
-  v.output("true_gap_um", true_gap_um_, "um");
-  v.output("true_debris", true_debris_, "1");
-  v.output("true_kerf_debris", true_kerf_debris_, "1");
-  v.output("wire_load", wire_load_, "1");
+  for (const StateOutput& o : kTruthOutputs) {
+    v.output(o.name, this->*o.pin, o.unit);
+  }
 
   v.input("vx_cmd", vx_cmd_, "mm/s");
   v.input("vy_cmd", vy_cmd_, "mm/s");
@@ -150,19 +167,15 @@ void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
   hist_arc_.set(st.history_arc);
   rab_.set(st.rab);
   gap_voltage_v_.set(s.mean_gap_voltage_v);
-  x_mm_.set(st.x_mm);
-  y_mm_.set(st.y_mm);
-  z_mm_.set(st.z_mm);
-  electrode_mm_.set(st.electrode_length_mm);
+  for (const StateOutput& o : kAxisOutputs) {
+    (this->*o.pin).set(st.*o.field);
+  }
   electrode_left_mm_.store(st.electrode_length_mm, std::memory_order_relaxed);
-  depth_mm_.set(st.depth_mm);
-  wall_radius_mm_.set(st.wall_radius_mm);
   wire_broken_.set(st.wire_broken);
   driver_fault_.set(st.wire_broken);
-  true_gap_um_.set(st.gap_um);
-  true_debris_.set(st.debris);
-  true_kerf_debris_.set(st.kerf_debris);
-  wire_load_.set(st.wire_load);
+  for (const StateOutput& o : kTruthOutputs) {
+    (this->*o.pin).set(st.*o.field);
+  }
 }
 
 void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {

@@ -3,20 +3,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "bench.hpp"
-#include "edm/blocks/register.hpp"
-#include "edm/programs/register.hpp"
+#include "edm/apps/offline_runtime.hpp"
+#include "edm/apps/text_file.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
-#include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/scheduler.hpp"
 #include "edm/sim/plant.hpp"
@@ -27,16 +24,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw std::runtime_error(path + ": cannot read");
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void replace_once(std::string& s, const std::string& from, const std::string& to,
                   const std::string& where) {
   const auto at = s.find(from);
@@ -44,21 +31,6 @@ void replace_once(std::string& s, const std::string& from, const std::string& to
     throw std::runtime_error(where + ": edit target '" + from + "' not found");
   }
   s.replace(at, from.size(), to);
-}
-
-std::unique_ptr<rt::Runtime> build(const rt::Config& cfg) {
-  // Built once (thread-safe static init), read-only afterwards: shared by all runs.
-  static const auto registries = [] {
-    std::pair<rt::BlockRegistry, rt::DriverRegistry> r;
-    blocks::register_builtin_blocks(r.first);
-    programs::register_builtin_programs(r.first);
-    rt::register_runtime_drivers(r.second);
-    sim::register_sim_driver(r.second);
-    return r;
-  }();
-  rt::BuildOptions options;
-  options.load_retain = false;
-  return rt::Runtime::build(cfg, registries.first, registries.second, options);
 }
 
 // Least-squares line through (t, z); the RMS residual is the jitter of one cycle.
@@ -159,7 +131,7 @@ std::pair<double, double> mean_sd(const std::vector<double>& v) {
 }
 
 Outcome run(const std::string& source_root, const RunSpec& spec) {
-  std::string text = slurp(source_root + "/" + spec.config);
+  std::string text = apps::read_text_file(source_root + "/" + spec.config);
   for (const Edit& e : spec.edits) {
     replace_once(text, e.from, e.to, spec.config);
   }
@@ -168,7 +140,7 @@ Outcome run(const std::string& source_root, const RunSpec& spec) {
     seed += ", " + spec.io_extra;
   }
   replace_once(text, "seed: 1}", seed + "}", spec.config);
-  auto r = build(rt::parse_config_text(text, spec.config));
+  auto r = apps::build_offline(rt::parse_config_text(text, spec.config));
   std::vector<rt::Task*> tasks;
   for (const auto& t : r->tasks()) {
     t->detach_trace();  // nobody drains the trace rings here

@@ -2,6 +2,8 @@
 
 #include <array>
 
+#include "edm/machining/enum_names.hpp"
+
 namespace edm::bridge {
 
 namespace {
@@ -23,19 +25,10 @@ constexpr std::array<OpInfo, 24> kOps = {{
 
 }  // namespace
 
-std::string_view to_string(ErrorCode c) noexcept {
-  const auto i = static_cast<std::size_t>(c);
-  return i < kErrorNames.size() ? kErrorNames[i] : std::string_view{"?"};
-}
+std::string_view to_string(ErrorCode c) noexcept { return machining::enum_name(kErrorNames, c); }
 
 bool error_code_from_string(std::string_view s, ErrorCode& out) noexcept {
-  for (std::size_t i = 0; i < kErrorNames.size(); ++i) {
-    if (kErrorNames[i] == s) {
-      out = static_cast<ErrorCode>(i);
-      return true;
-    }
-  }
-  return false;
+  return machining::enum_from_name(kErrorNames, s, out);
 }
 
 std::string_view to_string(Role r) noexcept { return r == Role::kOperator ? "operator" : "viewer"; }

@@ -70,7 +70,6 @@ class GapControllerP final : public rt::BlockWithParams<GapControllerPParams> {
   /// RT-safe. kOk, kSaturated (clamped), or kFault (broken Td or Tdr while the P law runs).
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
- private:
  public:
   // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
   rt::Input<double> td_us;

@@ -53,7 +53,6 @@ class PolaritySwitch final : public rt::BlockWithParams<PolaritySwitchParams> {
   /// RT-safe. Always kOk.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
- private:
  public:
   // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
   rt::Input<bool> request_positive;

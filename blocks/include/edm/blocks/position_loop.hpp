@@ -72,7 +72,6 @@ class PositionLoop final : public rt::BlockWithParams<PositionLoopParams> {
   /// RT-safe. Stops the axis: v_cmd = 0 and the integral is cleared.
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
 
- private:
  public:
   // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
   rt::Input<double> x_ref_mm;

@@ -87,6 +87,11 @@ class SimDriver final : public edm::rt::BlockWithParams<SimDriverParams, edm::rt
   bool started_{false};
   edm::rt::TimePoint origin_{};  // clock time of the first latch = plant time 0
 
+  // Plant-state fields published as they are: one row names the pin and the field (sim_driver.cpp).
+  struct StateOutput;
+  static const StateOutput kAxisOutputs[6];
+  static const StateOutput kTruthOutputs[4];
+
   // Inputs to the runtime (the driver's outputs).
   edm::rt::Output<std::int64_t> td_sum_ns_, td_count_;
   edm::rt::Output<std::int64_t> n_[5];
