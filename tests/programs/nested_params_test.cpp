@@ -189,6 +189,17 @@ TEST(NestedParams, ABridgeWriteOfKgActsOnTheNextCycle) {
   cycle();
   ASSERT_EQ(value("cycle.drill.td.valid"), 1.0);
   EXPECT_DOUBLE_EQ(value("cycle.drill.gap.vz_mm_s"), p_law(0.02));
+
+  // A load-time child parameter and an out-of-range value are refused, and change nothing.
+  const bridge::Reply window =
+      client.request("var.write", {{"name", "cycle.drill.td.window"}, {"value", 16}});
+  EXPECT_FALSE(window);
+  EXPECT_NE(window.message.find("load time only"), std::string::npos) << window.message;
+  const bridge::Reply negative =
+      client.request("var.write", {{"name", "cycle.drill.gap.kg"}, {"value", -1.0}});
+  EXPECT_FALSE(negative);
+  EXPECT_NE(negative.message.find("gap.kg must be > 0"), std::string::npos) << negative.message;
+  EXPECT_EQ(value("cycle.drill.gap.kg"), 0.02);
   EXPECT_NE(p_law(0.02), p_law(0.05));
   server.stop();
 }
