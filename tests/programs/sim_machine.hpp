@@ -36,6 +36,13 @@ inline std::unique_ptr<rt::Runtime> build_sim_machine(const rt::Config& cfg,
   return rt::Runtime::build(cfg, registries.first, registries.second, options);
 }
 
+/// Build options that seed the simulator with `seed`.
+inline rt::BuildOptions seeded(int seed) {
+  rt::BuildOptions o;
+  o.seed = static_cast<std::uint64_t>(seed);
+  return o;
+}
+
 // A shipped machine (config/machines/<name>.yaml) powered on, every task on one virtual clock
 // (traces detached): `run_until(t)` runs all cycles released before t, `pin(name)` finds a
 // variable's pin (a test failure, and an empty PinRef, if there is none).

@@ -31,14 +31,12 @@ struct Cycle {
 class SinkIlcJump : public ::testing::TestWithParam<int> {};
 
 TEST_P(SinkIlcJump, the_ilc_takes_over_from_the_integral_controller_and_its_jitter_falls) {
-  rt::BuildOptions opts;
-  opts.seed = static_cast<std::uint64_t>(GetParam());
-  VirtualMachine m("sink-ilc-sim", opts);
-  auto pin = [&](const char* name) { return m.pin(name); };
-  const rt::PinRef z = pin("io.z_mm"), vz = pin("io.vz_cmd"), jumping = pin("gap.jump.jumping");
-  const rt::PinRef active = pin("gap.ilc.active"), jumps = pin("gap.jump.jumps");
-  const rt::PinRef shorts = pin("io.n_short"), opens = pin("io.n_open"),
-                   normal = pin("io.n_normal");
+  VirtualMachine m("sink-ilc-sim", seeded(GetParam()));
+  const rt::PinRef z = m.pin("io.z_mm"), vz = m.pin("io.vz_cmd"),
+                   jumping = m.pin("gap.jump.jumping");
+  const rt::PinRef active = m.pin("gap.ilc.active"), jumps = m.pin("gap.jump.jumps");
+  const rt::PinRef shorts = m.pin("io.n_short"), opens = m.pin("io.n_open"),
+                   normal = m.pin("io.n_normal");
 
   std::vector<Cycle> cycles;
   std::vector<double> ts, zs;

@@ -25,15 +25,12 @@ using namespace std::chrono_literals;
 class SinkStrJump : public ::testing::TestWithParam<int> {};
 
 TEST_P(SinkStrJump, held_through_the_approach_the_str_tracks_its_reference) {
-  rt::BuildOptions opts;
-  opts.seed = static_cast<std::uint64_t>(GetParam());
-  VirtualMachine m("sink-str-jump-sim", opts);
-  auto pin = [&](const char* name) { return m.pin(name); };
-  const rt::PinRef z = pin("io.z_mm"), jumping = pin("ratios.jump.jumping");
+  VirtualMachine m("sink-str-jump-sim", seeded(GetParam()));
+  const rt::PinRef z = m.pin("io.z_mm"), jumping = m.pin("ratios.jump.jumping");
   // The STR's enable is wired from servo_part (read here at the source: the STR's own input is
   // latched at its 50 ms task).
-  const rt::PinRef enable = pin("ratios.jump.servo_part"), y_v = pin("adapt.str.y_v"),
-                   y_rv = pin("adapt.str.y_rv");
+  const rt::PinRef enable = m.pin("ratios.jump.servo_part"), y_v = m.pin("adapt.str.y_v"),
+                   y_rv = m.pin("adapt.str.y_rv");
 
   constexpr std::int64_t kJumpMs = 90, kApproachMs = 200, kCycleMs = 1500;
   std::vector<double> jitter_um, z_end_mm, ts, zs;
