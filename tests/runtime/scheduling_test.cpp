@@ -4,10 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <random>
 
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/scheduler.hpp"
+#include "support/files.hpp"
 #include "support/runtime_fixture.hpp"
 
 namespace edm::test {
@@ -27,24 +29,24 @@ TEST(NextRelease, OnTimeCycleKeepsTheGrid) {
   EXPECT_FALSE(n.overrun);
 }
 
-TEST(NextRelease, SkipWaitsForTheNextSlotAndCountsThePassedOnes) {
-  auto n = rt::next_release(TimePoint{0ms}, TimePoint{3500us}, 1ms, rt::OverrunPolicy::kSkip);
+// A cycle released at 0 on a 1 ms grid that ends at `end` overran; `policy` releases the next one
+// at `release`, omitting `omitted` slots.
+void expect_overrun(rt::OverrunPolicy policy, Duration end, Duration release,
+                    std::uint64_t omitted) {
+  const auto n = rt::next_release(TimePoint{0ms}, TimePoint{end}, 1ms, policy);
   EXPECT_TRUE(n.overrun);
-  EXPECT_EQ(n.release, TimePoint{4ms});
-  EXPECT_EQ(n.omitted, 3u);
-  n = rt::next_release(TimePoint{0ms}, TimePoint{1001us}, 1ms, rt::OverrunPolicy::kSkip);
-  EXPECT_EQ(n.release, TimePoint{2ms});
-  EXPECT_EQ(n.omitted, 1u);
+  EXPECT_EQ(n.release, TimePoint{release});
+  EXPECT_EQ(n.omitted, omitted);
+}
+
+TEST(NextRelease, SkipWaitsForTheNextSlotAndCountsThePassedOnes) {
+  expect_overrun(rt::OverrunPolicy::kSkip, 3500us, 4ms, 3u);
+  expect_overrun(rt::OverrunPolicy::kSkip, 1001us, 2ms, 1u);
 }
 
 TEST(NextRelease, AsapRunsTheLatestPassedSlotAtOnce) {
-  auto n = rt::next_release(TimePoint{0ms}, TimePoint{3500us}, 1ms, rt::OverrunPolicy::kAsap);
-  EXPECT_TRUE(n.overrun);
-  EXPECT_EQ(n.release, TimePoint{3ms});
-  EXPECT_EQ(n.omitted, 2u);
-  n = rt::next_release(TimePoint{0ms}, TimePoint{1500us}, 1ms, rt::OverrunPolicy::kAsap);
-  EXPECT_EQ(n.release, TimePoint{1ms});
-  EXPECT_EQ(n.omitted, 0u);
+  expect_overrun(rt::OverrunPolicy::kAsap, 3500us, 3ms, 2u);
+  expect_overrun(rt::OverrunPolicy::kAsap, 1500us, 1ms, 0u);
 }
 
 TEST(NextRelease, PropertyOverRandomCases) {
@@ -190,25 +192,9 @@ programs:
   EXPECT_EQ(fast.omitted_cycles, 1u);
 }
 
+// One 1 ms task with `task_extra` lines, running a Recorder and a Cost block with `cost` params.
 std::string one_task(const std::string& task_extra, const std::string& cost) {
-  return R"(version: 1
-machine:
-  name: t
-  io: {driver: loopback, params: {channels: 1}}
-tasks:
-  - name: fast
-    interval: 1ms
-    priority: 0
-)" + task_extra +
-         R"(
-    programs: [p]
-programs:
-  - name: p
-    blocks:
-      - {name: r, type: Recorder, params: {tag: fast}}
-      - {name: c, type: Cost, params: {)" +
-         cost + R"(}}
-)";
+  return test_data("runtime/one_task.yaml", {{"task_extra", task_extra}, {"cost", cost}});
 }
 
 TEST_F(VirtualRun, SkipVersusAsapOmittedCycles) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "edm/runtime/scheduler.hpp"
+#include "support/files.hpp"
 #include "support/runtime_fixture.hpp"
 
 namespace edm::test {
@@ -12,21 +13,9 @@ namespace {
 
 using namespace std::chrono_literals;
 
+// Programs p (these `blocks` and `wires` lines) and q on one task of a loopback machine.
 std::string with_program(const std::string& blocks, const std::string& wires) {
-  return R"(version: 1
-machine:
-  name: t
-  io: {driver: loopback, params: {channels: 2}}
-tasks:
-  - {name: fast, interval: 1ms, priority: 0, programs: [p, q]}
-programs:
-  - name: p
-    blocks:
-)" + blocks +
-         "    wires:\n" + wires + R"(  - name: q
-    blocks:
-      - {name: b, type: AddOne}
-)";
+  return test_data("runtime/two_programs.yaml", {{"blocks", blocks}, {"wires", wires}});
 }
 
 const std::string kChain =
