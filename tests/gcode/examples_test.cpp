@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "edm/machining/machine_config.hpp"
 #include "gcode_fixture.hpp"
@@ -27,6 +28,13 @@ GcodeResult interpret_part(const std::string& name,
   return interpret_gcode(ss.str(), name, tables);
 }
 
+// The part's blocks of `kind` (a test failure if it does not interpret cleanly).
+std::vector<MotionBlock> part_blocks(const std::string& name, MotionKind kind) {
+  const GcodeResult r = interpret_part(name);
+  EXPECT_TRUE(r.ok()) << joined(r);
+  return of_kind(r.blocks, kind);
+}
+
 TEST(GcodeExamples, EveryExampleInterpretsCleanly) {
   const machining::MachineTables drill_sim = machining::read_machine_tables(
       std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
@@ -45,9 +53,7 @@ TEST(GcodeExamples, EveryExampleInterpretsCleanly) {
 }
 
 TEST(GcodeExamples, BlindHoleIsOneDrillTo20mmWithE1) {
-  const GcodeResult r = interpret_part("blind-hole.nc");
-  ASSERT_TRUE(r.ok()) << joined(r);
-  const auto d = of_kind(r.blocks, MotionKind::kDrill);
+  const auto d = part_blocks("blind-hole.nc", MotionKind::kDrill);
   ASSERT_EQ(d.size(), 1u);
   EXPECT_DOUBLE_EQ(d[0].target.z, -20.0);
   EXPECT_EQ(d[0].condition, 1);
@@ -55,9 +61,7 @@ TEST(GcodeExamples, BlindHoleIsOneDrillTo20mmWithE1) {
 }
 
 TEST(GcodeExamples, ThroughHoleGoesPastTheFarSide) {
-  const GcodeResult r = interpret_part("through-hole.nc");
-  ASSERT_TRUE(r.ok()) << joined(r);
-  const auto d = of_kind(r.blocks, MotionKind::kDrill);
+  const auto d = part_blocks("through-hole.nc", MotionKind::kDrill);
   ASSERT_EQ(d.size(), 1u);
   EXPECT_LT(d[0].target.z, -10.0);
 }
