@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <utility>
 
 #include "edm/hmi/web_capabilities.hpp"
 #include "edm/hmi/web_job.hpp"
@@ -52,10 +53,11 @@ TEST_F(StaticRoot, a_symlink_out_of_the_root_is_refused) {
 }
 
 TEST(WebStatic, content_types_and_caching) {
-  EXPECT_EQ(content_type_for("a/index.html"), "text/html; charset=utf-8");
-  EXPECT_EQ(content_type_for("x.js"), "text/javascript; charset=utf-8");
-  EXPECT_EQ(content_type_for("x.css"), "text/css; charset=utf-8");
-  EXPECT_EQ(content_type_for("x.bin"), "application/octet-stream");
+  const std::pair<const char*, const char*> types[] = {{"a/index.html", "text/html; charset=utf-8"},
+                                                       {"x.js", "text/javascript; charset=utf-8"},
+                                                       {"x.css", "text/css; charset=utf-8"},
+                                                       {"x.bin", "application/octet-stream"}};
+  for (const auto& [path, type] : types) EXPECT_EQ(content_type_for(path), type) << path;
   EXPECT_EQ(cache_control_for("/"), "no-cache");
   EXPECT_EQ(cache_control_for("/index.html"), "no-cache");
   EXPECT_EQ(cache_control_for("/assets/index-abc.js"), "public, max-age=31536000, immutable");
