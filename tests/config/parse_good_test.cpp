@@ -111,6 +111,14 @@ TEST_F(FullConfigTest, conditions_with_defaults) {
   EXPECT_EQ(finish.loc.line, 16);
 }
 
+// An enabled watchdog of `time`, `sensitivity` and `action`.
+void expect_watchdog(const WatchdogSpec& w, Duration time, int sensitivity, WatchdogAction action) {
+  EXPECT_TRUE(w.enabled);
+  EXPECT_EQ(w.time, time);
+  EXPECT_EQ(w.sensitivity, sensitivity);
+  EXPECT_EQ(w.action, action);
+}
+
 TEST_F(FullConfigTest, tasks) {
   ASSERT_EQ(cfg_.tasks.size(), 2u);
   const TaskSpec& fast = cfg_.tasks[0];
@@ -122,10 +130,7 @@ TEST_F(FullConfigTest, tasks) {
   ASSERT_TRUE(fast.cpu.has_value());
   EXPECT_EQ(*fast.cpu, 1);
   EXPECT_EQ(fast.overrun, OverrunPolicy::kAsap);
-  EXPECT_TRUE(fast.watchdog.enabled);
-  EXPECT_EQ(fast.watchdog.time, milliseconds(1));
-  EXPECT_EQ(fast.watchdog.sensitivity, 3);
-  EXPECT_EQ(fast.watchdog.action, WatchdogAction::kWarn);
+  expect_watchdog(fast.watchdog, milliseconds(1), 3, WatchdogAction::kWarn);
   ASSERT_EQ(fast.programs.size(), 1u);
   EXPECT_EQ(fast.programs[0].name, "gap");
   EXPECT_EQ(fast.programs[0].loc.line, 27);
@@ -137,10 +142,7 @@ TEST_F(FullConfigTest, tasks) {
   EXPECT_EQ(slow.priority, 5);
   EXPECT_FALSE(slow.cpu.has_value());
   EXPECT_EQ(slow.overrun, OverrunPolicy::kSkip);
-  EXPECT_TRUE(slow.watchdog.enabled);
-  EXPECT_EQ(slow.watchdog.time, milliseconds(20));
-  EXPECT_EQ(slow.watchdog.sensitivity, 1);
-  EXPECT_EQ(slow.watchdog.action, WatchdogAction::kFault);
+  expect_watchdog(slow.watchdog, milliseconds(20), 1, WatchdogAction::kFault);
   ASSERT_EQ(slow.programs.size(), 2u);
   EXPECT_EQ(slow.programs[0].name, "supervisor");
   EXPECT_EQ(slow.programs[1].name, "logger");
