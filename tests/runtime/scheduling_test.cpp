@@ -112,22 +112,11 @@ class VirtualRun : public ::testing::Test {
   }
 };
 
-constexpr const char* kTwoTasks = R"(version: 1
-machine:
-  name: t
-  io: {driver: loopback, params: {channels: 1}}
-tasks:
-  - {name: slow, interval: 10ms, priority: 5, programs: [p_slow]}
-  - {name: fast, interval: 1ms, priority: 0, programs: [p_fast]}
-programs:
-  - name: p_fast
-    blocks: [{name: r, type: Recorder, params: {tag: fast}}]
-  - name: p_slow
-    blocks: [{name: r, type: Recorder, params: {tag: slow}}]
-)";
+// A 1 ms priority-0 and a 10 ms priority-5 task, each running a Recorder.
+const char* const kTwoTasks = "runtime/two_tasks.yaml";
 
 TEST_F(VirtualRun, OneMsPrio0AndTenMsPrio5TasksReleaseInTimeThenPriorityOrder) {
-  auto r = build_from_text(kTwoTasks);
+  auto r = build_from_text(test_data(kTwoTasks));
   rt::RunOptions o;
   o.clock = rt::ClockKind::kVirtual;
   o.run_for = 100ms;
@@ -166,17 +155,7 @@ TEST_F(VirtualRun, SlowCycleDelaysTheFastTaskWithoutPreemption) {
   // Virtual time does not preempt: the 10 ms task's 2.5 ms cycle at t=0 runs after the fast
   // task's cycle 0, so the fast release at 1 ms starts at 2.5 ms (1.5 ms late) and, since the
   // slot at 2 ms passed meanwhile, the skip policy omits it and resumes the grid at 3 ms.
-  auto r = build_from_text(R"(version: 1
-machine: {name: t}
-tasks:
-  - {name: slow, interval: 10ms, priority: 5, programs: [p_slow]}
-  - {name: fast, interval: 1ms, priority: 0, programs: [p_fast]}
-programs:
-  - name: p_fast
-    blocks: [{name: r, type: Recorder, params: {tag: fast}}]
-  - name: p_slow
-    blocks: [{name: c, type: Cost, params: {cost_us: 2500, cycles: 1}}]
-)");
+  auto r = build_from_text(test_data("runtime/slow_cycle.yaml"));
   VirtualRig rig(std::move(r));
   rig.run_until(5ms);
   const auto& log = run_log();
@@ -293,7 +272,7 @@ TEST_F(VirtualRun, WatchdogWarnCountsButDoesNotFault) {
 TEST_F(VirtualRun, SameConfigGivesTheSameRunTwice) {
   auto once = [] {
     run_log().clear();
-    VirtualRig rig(build_from_text(kTwoTasks));
+    VirtualRig rig(build_from_text(test_data(kTwoTasks)));
     rig.run_until(50ms);
     std::vector<std::pair<std::string, TimePoint>> seq;
     for (const auto& e : run_log()) {
