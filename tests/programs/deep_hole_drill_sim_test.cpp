@@ -127,13 +127,11 @@ INSTANTIATE_TEST_SUITE_P(Seeds, DrillSeeds, ::testing::Values(1, 2, 3));
 // or wears meanwhile, and on release the cycle goes on to the same accurate depth.
 TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
   SteppedMachine m(read_file(kConfig), "drill-sim-program.yaml");
-  auto& vars = m.vars;
   auto read = [&](const char* n) { return m.read(n); };
   m.run_while(200'000, [&] { return read("cycle.drill.depth_reached_mm") < 8.0; });
   ASSERT_EQ(read("cycle.drill.state"), 2.0) << "drilling";
 
-  ASSERT_TRUE(vars.force("cycle.drill.hold", 1.0));
-  m.cycle();
+  ASSERT_TRUE(m.hold("cycle.drill.hold"));
   EXPECT_EQ(read("cycle.drill.gen_on"), 0.0) << "generator off in the first held cycle";
   EXPECT_EQ(read("cycle.drill.vz_cmd_mm_s"), 0.0);
   m.run(50);  // the axis comes to rest
@@ -146,7 +144,7 @@ TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
   EXPECT_EQ(read("cycle.drill.depth_reached_mm"), estimate0);
   EXPECT_EQ(read("cycle.drill.state"), 2.0) << "still in DRILL, not restarted";
 
-  ASSERT_TRUE(vars.unforce("cycle.drill.hold"));
+  ASSERT_TRUE(m.vars.unforce("cycle.drill.hold"));
   m.run_while(400'000, [&] { return read("cycle.drill.state") != 4.0; });
   ASSERT_EQ(read("cycle.drill.state"), 4.0) << "DONE after the release";
   std::printf("[drill] held 2 s at %.3f mm, finished at %.4f mm (true %.4f)\n", estimate0,

@@ -19,7 +19,11 @@ using namespace std::chrono_literals;
 using programs::DeepHoleDrill;
 
 programs::DeepHoleDrillParams params() {
-  return {.depth_default_mm = 2.0, .touch_cycles = 3, .clearance_mm = 1.0};
+  programs::DeepHoleDrillParams p;
+  p.depth_default_mm = 2.0;
+  p.touch_cycles = 3;
+  p.clearance_mm = 1.0;
+  return p;
 }
 
 TEST(DeepHoleDrill, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("DeepHoleDrill")); }

@@ -112,6 +112,12 @@ struct SteppedMachine {
     while (next < max_cycles && go_on()) cycle();
   }
   double read(const char* name) { return vars.read(name).value(); }
+  /// Forces the hold input `var` on and runs one cycle (false, and no cycle, if it cannot).
+  bool hold(const char* var) {
+    if (!vars.force(var, 1.0)) return false;
+    cycle();
+    return true;
+  }
 };
 
 }  // namespace edm::test

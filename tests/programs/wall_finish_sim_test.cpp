@@ -137,15 +137,13 @@ TEST(WallFinishSim, UncalibratedFinalOffsetEqualToTheGrowth) {
 // and no revolution counts meanwhile; on release the finish ends within its ±5 µm as without.
 TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
   SteppedMachine m(read_file(kConfig), "finish-sim-program.yaml");
-  auto& vars = m.vars;
   const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(m.runtime->driver()).plant();
   const double target = plant.wall_bin_radius_mm(0) + 0.05;
   auto read = [&](const char* n) { return m.read(n); };
   m.run_while(120'000, [&] { return read("cycle.finish.revolutions") < 5.0; });
   ASSERT_EQ(read("cycle.finish.state"), 2.0) << "orbiting";
 
-  ASSERT_TRUE(vars.force("cycle.finish.hold", 1.0));
-  m.cycle();
+  ASSERT_TRUE(m.hold("cycle.finish.hold"));
   EXPECT_EQ(read("cycle.finish.gen_on"), 0.0) << "generator off in the first held cycle";
   m.run(200);  // the axes come to rest
   const double r0 = read("io.wall_radius_mm"), x0 = read("io.x_mm"), y0 = read("io.y_mm");
@@ -157,7 +155,7 @@ TEST(FinishHold, HoldMidOrbitFreezesAndResumes) {
   EXPECT_EQ(read("cycle.finish.revolutions"), revs0);
   EXPECT_EQ(read("cycle.finish.state"), 2.0);
 
-  ASSERT_TRUE(vars.unforce("cycle.finish.hold"));
+  ASSERT_TRUE(m.vars.unforce("cycle.finish.hold"));
   m.run_while(240'000, [&] { return read("cycle.finish.state") != 4.0; });
   ASSERT_EQ(read("cycle.finish.state"), 4.0) << "DONE after the release";
   double r_min = 1e9, r_max = -1e9;

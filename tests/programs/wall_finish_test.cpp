@@ -58,7 +58,11 @@ struct Rig : CompositeRig<WallFinish> {
 };
 
 programs::WallFinishParams params() {
-  return {.orbit_period_s = 0.2, .radial_speed_mm_s = 0.05, .spark_out_revs = 2};
+  programs::WallFinishParams p;
+  p.orbit_period_s = 0.2;
+  p.radial_speed_mm_s = 0.05;
+  p.spark_out_revs = 2;
+  return p;
 }
 
 TEST(WallFinish, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("WallFinish")); }
