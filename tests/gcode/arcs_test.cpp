@@ -11,12 +11,17 @@ namespace {
 
 using machining::Vec3;
 
+// `b` is an arc of `kind` about `centre` that ends at `target`.
+void expect_arc(const MotionBlock& b, MotionKind kind, const Vec3& centre, const Vec3& target) {
+  EXPECT_EQ(b.kind, kind);
+  EXPECT_EQ(b.centre, centre);
+  EXPECT_EQ(b.target, target);
+}
+
 TEST(GcodeArcs, QuarterCircleCounterClockwise) {
   const auto b = blocks_of("G00 X10 Y0\nG03 X0 Y10 I-10 J0 F60");
   ASSERT_EQ(b.size(), 2u);
-  EXPECT_EQ(b[1].kind, MotionKind::kArcCcw);
-  EXPECT_EQ(b[1].centre, (Vec3{0, 0, 0}));
-  EXPECT_EQ(b[1].target, (Vec3{0, 10, 0}));
+  expect_arc(b[1], MotionKind::kArcCcw, {0, 0, 0}, {0, 10, 0});
   EXPECT_EQ(b[1].turns, 0);
   EXPECT_DOUBLE_EQ(b[1].feed_mm_s, 1.0);
   EXPECT_EQ(b[1].line, 2);
@@ -26,11 +31,8 @@ TEST(GcodeArcs, QuarterCircleCounterClockwise) {
 TEST(GcodeArcs, HalfCircleClockwiseAndDirectionKinds) {
   const auto b = blocks_of("G00 X-5 Y0\nG02 X5 Y0 I5 F60\nG03 X-5 Y0 I-5");
   ASSERT_EQ(b.size(), 3u);
-  EXPECT_EQ(b[1].kind, MotionKind::kArcCw);
-  EXPECT_EQ(b[1].centre, (Vec3{0, 0, 0}));
-  EXPECT_EQ(b[1].target, (Vec3{5, 0, 0}));
-  EXPECT_EQ(b[2].kind, MotionKind::kArcCcw);
-  EXPECT_EQ(b[2].target, (Vec3{-5, 0, 0}));
+  expect_arc(b[1], MotionKind::kArcCw, {0, 0, 0}, {5, 0, 0});
+  expect_arc(b[2], MotionKind::kArcCcw, {0, 0, 0}, {-5, 0, 0});
 }
 
 TEST(GcodeArcs, CentreIsRelativeToTheStartEvenInAbsoluteMode) {
@@ -49,12 +51,8 @@ TEST(GcodeArcs, IncrementalEndPoint) {
 TEST(GcodeArcs, FullCircleWhenTheEndIsTheStart) {
   const auto b = blocks_of("G00 X10 Y10\nG02 I-3 F60\nG03 X10 Y10 J2");
   ASSERT_EQ(b.size(), 3u);
-  EXPECT_EQ(b[1].kind, MotionKind::kArcCw);
-  EXPECT_EQ(b[1].centre, (Vec3{7, 10, 0}));
-  EXPECT_EQ(b[1].target, (Vec3{10, 10, 0}));
-  EXPECT_EQ(b[2].kind, MotionKind::kArcCcw);
-  EXPECT_EQ(b[2].centre, (Vec3{10, 12, 0}));
-  EXPECT_EQ(b[2].target, (Vec3{10, 10, 0}));
+  expect_arc(b[1], MotionKind::kArcCw, {7, 10, 0}, {10, 10, 0});
+  expect_arc(b[2], MotionKind::kArcCcw, {10, 12, 0}, {10, 10, 0});
 }
 
 TEST(GcodeArcs, PAddsWholeTurns) {
