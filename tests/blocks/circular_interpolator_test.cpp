@@ -11,14 +11,16 @@
 #include <random>
 
 #include "block_harness.hpp"
+#include "interpolator_rig.hpp"
 
 namespace edm::blocks {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-struct Rig {
-  explicit Rig(rt::Duration period = 1ms, CircularInterpolatorParams p = {}) : h(period) {
+struct Rig : InterpolatorRig<CircularInterpolator> {
+  explicit Rig(rt::Duration period = 1ms, CircularInterpolatorParams p = {})
+      : InterpolatorRig(period) {
     h.start_ok(p);
     ov.set(1.0);
     turns.set(1);
@@ -47,11 +49,7 @@ struct Rig {
   BlockStatus edge() { return h.rising_edge("start"); }
   [[nodiscard]] double x() const { return h.out("rx_mm"); }
   [[nodiscard]] double y() const { return h.out("ry_mm"); }
-  [[nodiscard]] bool busy() const { return h.out<bool>("busy"); }
-  [[nodiscard]] bool done() const { return h.out<bool>("done"); }
 
-  BlockHarness<CircularInterpolator> h;
-  rt::Output<bool>& start = h.source<bool>("start");
   rt::Output<bool>& cw = h.source<bool>("cw");
   rt::Output<double>& i = h.source<double>("i_mm");
   rt::Output<double>& j = h.source<double>("j_mm");
@@ -59,12 +57,6 @@ struct Rig {
   rt::Output<std::int64_t>& turns = h.source<std::int64_t>("turns");
   rt::Output<double>& ex = h.source<double>("ex_mm");
   rt::Output<double>& ey = h.source<double>("ey_mm");
-  rt::Output<double>& feed = h.source<double>("feed_mm_min");
-  rt::Output<double>& ov = h.source<double>("override");
-  rt::Output<bool>& hold = h.source<bool>("hold");
-  rt::Output<bool>& load = h.source<bool>("load");
-  rt::Output<double>& load_x = h.source<double>("load_x_mm");
-  rt::Output<double>& load_y = h.source<double>("load_y_mm");
 };
 
 TEST(CircularInterpolatorTest, matches_the_seeds_recurrence_eq_14_19) {

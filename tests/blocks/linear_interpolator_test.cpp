@@ -11,16 +11,17 @@
 #include <random>
 
 #include "block_harness.hpp"
+#include "interpolator_rig.hpp"
 
 namespace edm::blocks {
 namespace {
 
 using Vec3 = std::array<double, 3>;
 
-
 // The block with every input wired to a test-owned output.
-struct Rig {
-  explicit Rig(rt::Duration period = 1ms, LinearInterpolatorParams p = {}) : h(period) {
+struct Rig : InterpolatorRig<LinearInterpolator> {
+  explicit Rig(rt::Duration period = 1ms, LinearInterpolatorParams p = {})
+      : InterpolatorRig(period) {
     h.start_ok(p);
     ov.set(1.0);
   }
@@ -35,8 +36,6 @@ struct Rig {
   }
   [[nodiscard]] Vec3 pos() const { return {h.out("rx_mm"), h.out("ry_mm"), h.out("rz_mm")}; }
   [[nodiscard]] Vec3 vel() const { return {h.out("vx_mm_s"), h.out("vy_mm_s"), h.out("vz_mm_s")}; }
-  [[nodiscard]] bool busy() const { return h.out<bool>("busy"); }
-  [[nodiscard]] bool done() const { return h.out<bool>("done"); }
   /// Steps until the move is done; returns the number of steps (the edge cycle not included).
   int run_to_end(int limit = 10'000'000) {
     int n = 0;
@@ -47,17 +46,9 @@ struct Rig {
     return n;
   }
 
-  BlockHarness<LinearInterpolator> h;
-  rt::Output<bool>& start = h.source<bool>("start");
   rt::Output<double>& lx = h.source<double>("lx_mm");
   rt::Output<double>& ly = h.source<double>("ly_mm");
   rt::Output<double>& lz = h.source<double>("lz_mm");
-  rt::Output<double>& feed = h.source<double>("feed_mm_min");
-  rt::Output<double>& ov = h.source<double>("override");
-  rt::Output<bool>& hold = h.source<bool>("hold");
-  rt::Output<bool>& load = h.source<bool>("load");
-  rt::Output<double>& load_x = h.source<double>("load_x_mm");
-  rt::Output<double>& load_y = h.source<double>("load_y_mm");
   rt::Output<double>& load_z = h.source<double>("load_z_mm");
 };
 
