@@ -98,10 +98,7 @@ TEST(CircularInterpolatorTest, g03_is_counter_clockwise_and_g02_clockwise) {
   ccw.arc(-1.0, 0.0, false, -1.0, 1.0, 60.0);  // quarter to (0, 1)
   EXPECT_GT(ccw.y(), 0.0);
   EXPECT_GT(ccw.h.out("angle_rad"), 0.0);
-  int n = 0;
-  while (ccw.busy() && n++ < 100000) {
-    ccw.h.step();
-  }
+  const int n = ccw.run_to_end(100000);
   EXPECT_EQ(ccw.x(), 0.0);
   EXPECT_EQ(ccw.y(), 1.0);
   EXPECT_NEAR(ccw.h.out("swept_rad"), kPi / 2, 1e-12);
@@ -112,10 +109,7 @@ TEST(CircularInterpolatorTest, g03_is_counter_clockwise_and_g02_clockwise) {
   cw.arc(-1.0, 0.0, true, -1.0, 1.0, 60.0);  // clockwise to (0, 1): three quarters
   EXPECT_LT(cw.y(), 0.0);
   EXPECT_LT(cw.h.out("angle_rad"), 0.0);
-  n = 0;
-  while (cw.busy() && n++ < 100000) {
-    cw.h.step();
-  }
+  cw.run_to_end(100000);
   EXPECT_EQ(cw.x(), 0.0);
   EXPECT_EQ(cw.y(), 1.0);
   EXPECT_NEAR(cw.h.out("swept_rad"), 1.5 * kPi, 1e-12);
@@ -239,10 +233,7 @@ TEST(CircularInterpolatorTest, hold_and_override) {
   r.hold.set(false);
   r.h.step();
   EXPECT_NEAR(r.h.out("swept_rad"), 6e-3, 1e-15);
-  int n = 0;
-  while (r.busy() && n++ < 100000) {
-    r.h.step();
-  }
+  r.run_to_end(100000);
   EXPECT_EQ(r.x(), 1.0);
   EXPECT_EQ(r.y(), 0.0);
 }
@@ -250,10 +241,7 @@ TEST(CircularInterpolatorTest, hold_and_override) {
 TEST(CircularInterpolatorTest, zero_end_increment_is_one_full_circle) {
   Rig r(1ms, {.x0_mm = 0.0, .y0_mm = 0.0});
   r.arc(0.0, 0.5, true, 0.0, 0.0, 600.0);
-  int n = 0;
-  while (r.busy() && n++ < 100000) {
-    r.h.step();
-  }
+  r.run_to_end(100000);
   EXPECT_NEAR(r.h.out("swept_rad"), 2.0 * kPi, 1e-12);
   EXPECT_EQ(r.x(), 0.0);
   EXPECT_EQ(r.y(), 0.0);
@@ -275,10 +263,7 @@ TEST(CircularInterpolatorTest, refuses_bad_moves) {
   EXPECT_EQ(r.y(), 0.0);
   // Within the tolerance: accepted, and the last step lands on the programmed point.
   EXPECT_EQ(r.arc(1.0, 0.0, false, 2.0005, 0.0, 600.0), BlockStatus::kOk);
-  int n = 0;
-  while (r.busy() && n++ < 100000) {
-    r.h.step();
-  }
+  r.run_to_end(100000);
   EXPECT_EQ(r.x(), 2.0005);
   EXPECT_EQ(r.y(), 0.0);
 }

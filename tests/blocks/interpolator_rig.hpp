@@ -12,6 +12,16 @@ struct InterpolatorRig {
   explicit InterpolatorRig(rt::Duration period) : h(period) {}
   [[nodiscard]] bool busy() const { return h.template out<bool>("busy"); }
   [[nodiscard]] bool done() const { return h.template out<bool>("done"); }
+  /// Steps until the move is done, at most `limit` steps; returns the number of steps (the edge
+  /// cycle not included).
+  int run_to_end(int limit = 10'000'000) {
+    int n = 0;
+    while (busy() && n < limit) {
+      h.step();
+      ++n;
+    }
+    return n;
+  }
 
   BlockHarness<B> h;
   rt::Output<bool>& start = h.template source<bool>("start");

@@ -36,15 +36,6 @@ struct Rig : InterpolatorRig<LinearInterpolator> {
   }
   [[nodiscard]] Vec3 pos() const { return {h.out("rx_mm"), h.out("ry_mm"), h.out("rz_mm")}; }
   [[nodiscard]] Vec3 vel() const { return {h.out("vx_mm_s"), h.out("vy_mm_s"), h.out("vz_mm_s")}; }
-  /// Steps until the move is done; returns the number of steps (the edge cycle not included).
-  int run_to_end(int limit = 10'000'000) {
-    int n = 0;
-    while (busy() && n < limit) {
-      h.step();
-      ++n;
-    }
-    return n;
-  }
 
   rt::Output<double>& lx = h.source<double>("lx_mm");
   rt::Output<double>& ly = h.source<double>("ly_mm");
