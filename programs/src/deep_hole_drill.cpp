@@ -46,18 +46,7 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
            .range = rt::kNonNegative});
   v.param("overtravel_mm", overtravel_mm,
           {.unit = "mm", .description = "feed on after breakthrough", .range = rt::kNonNegative});
-  v.param("short_ratio_limit", short_ratio_limit,
-          {.unit = "",
-           .description = "the Td window reads short at this fraction of shorted pulses",
-           .range = rt::open_closed(0.0, 1.0)});
-  v.param("short_retracts_max", short_retracts_max,
-          {.unit = "",
-           .description = "retracts without progress allowed within the window; one more: alarm 150",
-           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
-  v.param("short_retracts_window", short_retracts_window,
-          {.unit = "s",
-           .description = "the time over which short retracts are counted",
-           .range = rt::kPositive});
+  shorts.visit(v);
   v.param("short_backoff_mm", short_backoff_mm,
           {.unit = "mm",
            .description = "Z backs off this far on alarm 150, generator off, then holds",
@@ -167,8 +156,7 @@ void DeepHoleDrill::activate_self() noexcept {
   retract_vff_mm_s.set(0.0);
   short_retracts.set(0);
   short_time_s.set(0.0);
-  last_retracts_ = 0;
-  budget_.reset();
+  guard_.reset();
   set_state(State::kIdle);
 }
 
@@ -189,7 +177,7 @@ void DeepHoleDrill::begin_cycle() noexcept {
   wear_mm.set(0.0);
   short_retracts.set(0);
   short_time_s.set(0.0);
-  budget_.reset();
+  guard_.reset();
   set_state(State::kApproach);
 }
 
@@ -221,25 +209,23 @@ void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcep
 bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
                                  rt::BlockStatus& status) noexcept {
   retract_enable.set(true);
-  gap_short.set(td_.valid.get() && td_.short_ratio.get() >= params_.short_ratio_limit);
+  gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
   status = rt::worst(status, step(retract_, ctx));
   const bool active = retract_.active.get();
-  const std::int64_t started = retract_.retracts.get();
-  if (started != last_retracts_) {  // a retract began this cycle (also from RESUME)
-    last_retracts_ = started;
-    if (budget_.exceeded(ctx.release, retract_.tries.get(), params_.short_retracts_max,
-                         params_.short_retracts_window)) {
+  switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
+    case ShortGuard::Event::kNone:
+      break;
+    case ShortGuard::Event::kRetract:
+      short_retracts.set(short_retracts.get() + 1);
+      break;
+    case ShortGuard::Event::kBudgetSpent:
       // Alarm 150: the machine goes to FAULT; the safe state backs Z off and holds.
       if (machine_ != nullptr) {
-        machine_->raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, ctx.release,
-                         source_, "short circuit: too many retracts within the window",
-                         static_cast<double>(budget_.count())});
+        guard_.raise_alarm(*machine_, ctx.release, source_);
       } else {
         safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
       }
-    } else {
-      short_retracts.set(short_retracts.get() + 1);
-    }
+      break;
   }
   if (active || retract_.v_scale.get() < 1.0) {
     short_time_s.set(short_time_s.get() + ctx.dt_s);

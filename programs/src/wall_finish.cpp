@@ -33,18 +33,7 @@ void WallFinishParams::visit(rt::ParamVisitor& v) {
           {.unit = "s",
            .description = "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
            .range = rt::kNonNegative});
-  v.param("short_ratio_limit", short_ratio_limit,
-          {.unit = "",
-           .description = "the Td window reads short at this fraction of shorted pulses",
-           .range = rt::open_closed(0.0, 1.0)});
-  v.param("short_retracts_max", short_retracts_max,
-          {.unit = "",
-           .description = "retracts without progress allowed within the window; one more: alarm 150",
-           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
-  v.param("short_retracts_window", short_retracts_window,
-          {.unit = "s",
-           .description = "the time over which short retracts are counted",
-           .range = rt::kPositive});
+  shorts.visit(v);
 }
 
 WallFinish::WallFinish()
@@ -175,8 +164,7 @@ void WallFinish::activate_self() noexcept {
   gap_short.set(false);
   retract_enable.set(false);
   short_retracts.set(0);
-  last_retracts_ = 0;
-  budget_.reset();
+  guard_.reset();
   set_state(State::kIdle);
 }
 
@@ -212,26 +200,24 @@ void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexce
 
 bool WallFinish::handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept {
   retract_enable.set(true);
-  gap_short.set(td_.valid.get() && td_.short_ratio.get() >= params_.short_ratio_limit);
+  gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
   status = rt::worst(status, step(retract_, ctx));
-  const std::int64_t started = retract_.retracts.get();
-  if (started != last_retracts_) {  // a retract began this cycle
-    last_retracts_ = started;
-    if (budget_.exceeded(ctx.release, retract_.tries.get(), params_.short_retracts_max,
-                         params_.short_retracts_window)) {
+  switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
+    case ShortGuard::Event::kNone:
+      break;
+    case ShortGuard::Event::kRetract:
+      short_retracts.set(short_retracts.get() + 1);
+      break;
+    case ShortGuard::Event::kBudgetSpent:
       // Alarm 150: the machine goes to FAULT and the safe state stops the orbit (without a
       // machine, as in unit tests, this block stops it itself and reports a fault).
       if (machine_ != nullptr) {
-        machine_->raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, ctx.release,
-                         source_.c_str(), "short circuit: too many retracts within the window",
-                         static_cast<double>(budget_.count())});
+        guard_.raise_alarm(*machine_, ctx.release, source_.c_str());
       } else {
         safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
         status = rt::BlockStatus::kFault;
       }
-    } else {
-      short_retracts.set(short_retracts.get() + 1);
-    }
+      break;
   }
   return retract_.active.get();
 }

@@ -110,7 +110,7 @@ TEST(DeepHoleDrillShort, APersistentContactGivesNRetractsThenHoldsBackedOff) {
   for (int k = 0; k < 300; ++k) run.cycle();
   ASSERT_EQ(run.rig.state(), 2);
   run.contact_z = run.rig.z_mm.get() - 0.005;
-  const auto n = run.rig.drill.params().short_retracts_max;
+  const auto n = run.rig.drill.params().shorts.short_retracts_max;
   double z_alarm = 0.0;
   for (int k = 0; k < 60000 && run.rig.state() == 2; ++k) {
     z_alarm = run.rig.z_mm.get();

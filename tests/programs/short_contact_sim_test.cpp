@@ -133,7 +133,7 @@ TEST_P(ContactSeeds, APersistentContactGivesNRetractsThenAlarm150GeneratorOffZBa
   const ContactOutcome o = run(GetParam(), kPersistent);
   EXPECT_EQ(o.violations, 0);
   ASSERT_TRUE(o.alarm150) << "retracts " << o.retracts;
-  EXPECT_EQ(o.retracts, programs::DeepHoleDrillParams{}.short_retracts_max) << "exactly N";
+  EXPECT_EQ(o.retracts, programs::DeepHoleDrillParams{}.shorts.short_retracts_max) << "exactly N";
   EXPECT_FALSE(o.done);
   EXPECT_FALSE(o.gen_on_end);
   EXPECT_EQ(o.vz_end, 0.0);
@@ -170,7 +170,7 @@ TEST(ShortFigures, TwentySeeds) {
     err_hit.push_back((hit.depth_mm - 20.0) * 1000.0);
     tries.push_back(static_cast<double>(stuck.retracts));
     if (stuck.alarm150 &&
-        stuck.retracts == programs::DeepHoleDrillParams{}.short_retracts_max) {
+        stuck.retracts == programs::DeepHoleDrillParams{}.shorts.short_retracts_max) {
       ++alarms_exact;
     }
     EXPECT_LE(hit.latency, 2) << "seed " << seed;
@@ -185,7 +185,7 @@ TEST(ShortFigures, TwentySeeds) {
       "[shorts]   persistent contact: alarm 150 after exactly N = %lld retracts on %d/20 seeds\n"
       "[shorts]   cycles fed toward the work while reading short: %d\n",
       max_latency, mean(lost), sd(lost), mean(err_plain), sd(err_plain), mean(err_hit),
-      sd(err_hit), static_cast<long long>(programs::DeepHoleDrillParams{}.short_retracts_max),
+      sd(err_hit), static_cast<long long>(programs::DeepHoleDrillParams{}.shorts.short_retracts_max),
       alarms_exact, violations);
   EXPECT_EQ(violations, 0);
   EXPECT_EQ(alarms_exact, 20);

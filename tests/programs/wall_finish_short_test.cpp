@@ -118,7 +118,7 @@ TEST(WallFinishShort, APersistentShortIsAFaultAfterNRetracts) {
   bool faulted = false;
   for (int k = 0; k < 60000 && !faulted; ++k) faulted = rig.step() == rt::BlockStatus::kFault;
   EXPECT_TRUE(faulted);
-  EXPECT_EQ(rig.out<std::int64_t>("short_retracts"), rig.block.params().short_retracts_max);
+  EXPECT_EQ(rig.out<std::int64_t>("short_retracts"), rig.block.params().shorts.short_retracts_max);
 }
 
 }  // namespace

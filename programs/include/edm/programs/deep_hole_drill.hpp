@@ -89,7 +89,7 @@
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
 #include "edm/blocks/wear_compensator.hpp"
-#include "edm/programs/retract_budget.hpp"
+#include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 
@@ -105,9 +105,7 @@ struct DeepHoleDrillParams {
   double breakthrough_min_mm{0.5};        // [mm] no breakthrough before this depth
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
   // Short circuits (seed 004: a short reads as feedback ≈ 0, so it must back the electrode off).
-  double short_ratio_limit{0.9};           // the Td window reads short at this fraction of shorts
-  std::int64_t short_retracts_max{3};      // N: retracts allowed within short_retracts_window
-  rt::Duration short_retracts_window{std::chrono::seconds(10)};  // T
+  ShortLimits shorts{};  // short_ratio_limit, short_retracts_max, short_retracts_window
   double short_backoff_mm{1.0};  // [mm] Z backs off this far on alarm 150, then holds
 
   void visit(rt::ParamVisitor& v);
@@ -184,9 +182,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   double target_depth_mm_{0.0};
   double retract_to_z_mm_{0.0};
   bool safe_retract_{false};  // the running retract was started by the safe state
-  std::int64_t last_retracts_{0};  // retract.retracts seen last cycle
   double last_z_sp_mm_{0.0};
-  RetractBudget budget_;
+  ShortGuard guard_;
 };
 
 }  // namespace edm::programs

@@ -60,7 +60,7 @@
 #include "edm/blocks/position_loop.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
-#include "edm/programs/retract_budget.hpp"
+#include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 
@@ -74,12 +74,9 @@ struct WallFinishParams {
   // ORBIT without a single ignited or shorted pulse for this long (outside spark-out) is a fault:
   // no work, no generator, a wrong offset. 0 s: off.
   rt::Duration no_spark_timeout{std::chrono::seconds(30)};
-  // Short circuits in the orbit (as DeepHoleDrill's): the window reads short at this fraction
-  // of shorted pulses; more than short_retracts_max retracts without progress within
-  // short_retracts_window raise alarm 150.
-  double short_ratio_limit{0.9};
-  std::int64_t short_retracts_max{3};
-  rt::Duration short_retracts_window{std::chrono::seconds(10)};
+  // Short circuits in the orbit (as DeepHoleDrill's): short_ratio_limit, short_retracts_max,
+  // short_retracts_window.
+  ShortLimits shorts{};
 
   void visit(rt::ParamVisitor& v);
 };
@@ -140,8 +137,7 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   blocks::ShortRetract& retract_;
   rt::Machine* machine_{nullptr};
   std::string source_;  // this block's instance name, for alarm 150
-  RetractBudget budget_;
-  std::int64_t last_retracts_{0};
+  ShortGuard guard_;
 
   State state_value_{State::kIdle};
   bool prev_start_{false};

@@ -1,0 +1,106 @@
+#pragma once
+// The short-circuit handling DeepHoleDrill and WallFinish share (issue 19):
+//   ShortLimits  their parameters: when the Td window reads short, and the retract budget;
+//   ShortGuard   per cycle: reads the window, counts the retract child's retracts against the
+//                budget, raises alarm 150 when it is spent.
+//
+// RetractBudget: how many short retracts a cycle may make before alarm 150. A retract that
+// follows progress (the retract child's tries back at 1: the hole or orbit advanced
+// retract.progress_mm since the last one) starts the count again; more than `max` retracts
+// without progress within `window` means a contact the retracts cannot clear.
+// RT-safe (fixed storage, no allocation). Not thread-safe: the owning task.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "edm/blocks/short_retract.hpp"
+#include "edm/blocks/td_detector.hpp"
+#include "edm/runtime/machine.hpp"
+#include "edm/runtime/param.hpp"
+#include "edm/runtime/time.hpp"
+
+namespace edm::programs {
+
+class RetractBudget {
+ public:
+  static constexpr std::int64_t kMaxRetracts = 16;
+
+  /// A retract began at `now`; `tries` is the retract child's count since the last progress.
+  /// True when this is one more than `max` (≤ kMaxRetracts) within `window`.
+  bool exceeded(rt::TimePoint now, std::int64_t tries, std::int64_t max,
+                rt::Duration window) noexcept {
+    if (tries <= 1) {
+      n_ = 0;
+    }
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < n_; ++k) {
+      if (now - starts_[k] <= window) {
+        starts_[kept++] = starts_[k];
+      }
+    }
+    if (kept == starts_.size()) {  // full: forget the oldest (the count stays past any max)
+      for (std::size_t k = 1; k < kept; ++k) {
+        starts_[k - 1] = starts_[k];
+      }
+      --kept;
+    }
+    starts_[kept++] = now;
+    n_ = kept;
+    return static_cast<std::int64_t>(kept) > max;
+  }
+  [[nodiscard]] std::size_t count() const noexcept { return n_; }
+  void reset() noexcept { n_ = 0; }
+
+ private:
+  std::array<rt::TimePoint, kMaxRetracts + 1> starts_{};
+  std::size_t n_{0};
+};
+
+struct ShortLimits {
+  double short_ratio_limit{0.9};  // the Td window reads short at this fraction of shorts
+  std::int64_t short_retracts_max{3};  // retracts without progress allowed within the window
+  rt::Duration short_retracts_window{std::chrono::seconds(10)};
+
+  /// Declares the three parameters under their own names (a Params struct calls it).
+  void visit(rt::ParamVisitor& v);
+};
+
+class ShortGuard {
+ public:
+  enum class Event : std::uint8_t { kNone, kRetract, kBudgetSpent };
+
+  /// The window reads short: it holds a measurement and enough of it is shorts. RT-safe.
+  [[nodiscard]] static bool reads_short(const blocks::TdDetector& td,
+                                        const ShortLimits& p) noexcept {
+    return td.valid.get() && td.short_ratio.get() >= p.short_ratio_limit;
+  }
+  /// After the retract child's step: did a retract begin, and is the budget spent? RT-safe.
+  Event after_retract_step(rt::TimePoint now, const blocks::ShortRetract& r,
+                           const ShortLimits& p) noexcept {
+    const std::int64_t started = r.retracts.get();
+    if (started == last_retracts_) {
+      return Event::kNone;
+    }
+    last_retracts_ = started;  // a retract began this cycle (also from RESUME)
+    return budget_.exceeded(now, r.tries.get(), p.short_retracts_max, p.short_retracts_window)
+               ? Event::kBudgetSpent
+               : Event::kRetract;
+  }
+  /// Alarm 150 (a fault) from `source`. RT-safe.
+  void raise_alarm(rt::Machine& m, rt::TimePoint now, const char* source) const noexcept {
+    m.raise({rt::AlarmCode::kShortCircuit, rt::AlarmSeverity::kFault, now, source,
+             "short circuit: too many retracts within the window",
+             static_cast<double>(budget_.count())});
+  }
+  void reset() noexcept {
+    budget_.reset();
+    last_retracts_ = 0;
+  }
+
+ private:
+  RetractBudget budget_;
+  std::int64_t last_retracts_{0};
+};
+
+}  // namespace edm::programs

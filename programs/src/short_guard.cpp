@@ -1,0 +1,20 @@
+#include "edm/programs/short_guard.hpp"
+
+namespace edm::programs {
+
+void ShortLimits::visit(rt::ParamVisitor& v) {
+  v.param("short_ratio_limit", short_ratio_limit,
+          {.unit = "",
+           .description = "the Td window reads short at this fraction of shorted pulses",
+           .range = rt::open_closed(0.0, 1.0)});
+  v.param("short_retracts_max", short_retracts_max,
+          {.unit = "",
+           .description = "retracts without progress allowed within the window; one more: alarm 150",
+           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
+  v.param("short_retracts_window", short_retracts_window,
+          {.unit = "s",
+           .description = "the time over which short retracts are counted",
+           .range = rt::kPositive});
+}
+
+}  // namespace edm::programs
