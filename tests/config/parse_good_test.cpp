@@ -41,6 +41,16 @@ class FullConfigTest : public ::testing::Test {
   Config cfg_;
 };
 
+// Axis `name` with limits `min_mm`..`max_mm`, v_max and a_max as given.
+void expect_axis(const AxisSpec& a, char name, double min_mm, double max_mm, double v_max_mm_s,
+                 double a_max_mm_s2) {
+  EXPECT_EQ(a.name, name);
+  EXPECT_DOUBLE_EQ(a.min_mm, min_mm);
+  EXPECT_DOUBLE_EQ(a.max_mm, max_mm);
+  EXPECT_DOUBLE_EQ(a.v_max_mm_s, v_max_mm_s);
+  EXPECT_DOUBLE_EQ(a.a_max_mm_s2, a_max_mm_s2);
+}
+
 TEST_F(FullConfigTest, machine_io_and_axes) {
   EXPECT_EQ(cfg_.path, kFullPath);
   EXPECT_EQ(cfg_.version, 1);
@@ -69,18 +79,9 @@ TEST_F(FullConfigTest, machine_io_and_axes) {
   EXPECT_FALSE(find_param(params, "invert")->quoted);
 
   ASSERT_EQ(cfg_.machine.axes.size(), 2u);
-  const AxisSpec& x = cfg_.machine.axes[0];
-  EXPECT_EQ(x.name, 'X');
-  EXPECT_DOUBLE_EQ(x.min_mm, -100.0);
-  EXPECT_DOUBLE_EQ(x.max_mm, 100.0);
-  EXPECT_DOUBLE_EQ(x.v_max_mm_s, 20.0);
-  EXPECT_DOUBLE_EQ(x.a_max_mm_s2, 800.0);
+  expect_axis(cfg_.machine.axes[0], 'X', -100.0, 100.0, 20.0, 800.0);
   const AxisSpec& z = cfg_.machine.axes[1];
-  EXPECT_EQ(z.name, 'Z');
-  EXPECT_DOUBLE_EQ(z.min_mm, -50.0);
-  EXPECT_DOUBLE_EQ(z.max_mm, 5.5);
-  EXPECT_DOUBLE_EQ(z.v_max_mm_s, 10.0);
-  EXPECT_DOUBLE_EQ(z.a_max_mm_s2, 500.0);
+  expect_axis(z, 'Z', -50.0, 5.5, 10.0, 500.0);
   EXPECT_EQ(z.loc.line, 12);
   EXPECT_EQ(z.loc.col, 7);
 }
