@@ -68,6 +68,12 @@ def err(reply):
     return (reply or {}).get("error", {}).get("code")
 
 
+def hello(port, token):
+    """A new session and the reply to its hello with `token`."""
+    s = Session(port)
+    return s, s.request("hello", protocol=1, token=token)
+
+
 def block_record(b):
     t = b.get("target", [0.0, 0.0, 0.0])
     c = b.get("centre", [0.0, 0.0, 0.0])
@@ -84,22 +90,19 @@ def main():
     port, op_token, viewer_token = int(sys.argv[1]), sys.argv[2], sys.argv[3]
 
     # 1. A bad token is unauthorized.
-    s = Session(port)
-    r = s.request("hello", protocol=1, token="not-the-token")
+    s, r = hello(port, "not-the-token")
     check(err(r) == "unauthorized", "bad token -> unauthorized", r)
     s.close()
 
     # 2. A viewer may look but not start a cycle.
-    v = Session(port)
-    r = v.request("hello", protocol=1, token=viewer_token)
+    v, r = hello(port, viewer_token)
     check(r and r.get("ok") and r.get("role") == "viewer", "viewer hello", r)
     r = v.request("cycle.start")
     check(err(r) == "forbidden", "viewer cycle.start -> forbidden", r)
     v.close()
 
     # 3. The operator: status.
-    s = Session(port)
-    r = s.request("hello", protocol=1, token=op_token)
+    s, r = hello(port, op_token)
     check(r and r.get("ok") and r.get("role") == "operator", "operator hello", r)
     r = s.request("status")
     check(r and r.get("ok") and r.get("state") in ("READY", "RUNNING", "HOLD"), "status", r)
@@ -152,8 +155,7 @@ def main():
     r = s.reply(None)
     if r is None:
         print("ok: 2 MiB line -> clean close", flush=True)
-        s = Session(port)
-        s.request("hello", protocol=1, token=op_token)
+        s, _ = hello(port, op_token)
     else:
         check(err(r) == "too_large", "2 MiB line -> too_large", r)
     r = s.request("ping")
