@@ -58,12 +58,6 @@ TEST(ControllerBench, B7SameSeedGivesIdenticalFiguresAnotherSeedDoesNot) {
   }
 }
 
-}  // namespace
-}  // namespace edm::bench
-
-namespace edm::bench {
-namespace {
-
 // B1 at full depth (30 mm), seed 1: seed 004's P gap controller reaches the depth; a constant
 // feed of 0.75 mm/s (faster than the hole can be eroded once debris slows it past h/d ≈ 15)
 // jams the electrode into the work: most pulses are shorts and the depth is never reached.
@@ -82,12 +76,6 @@ TEST(ControllerBench, B1PGapControllerReachesDepthConstantFeedJamsInShorts) {
   EXPECT_GT(oc.short_pct, 50.0);
   EXPECT_LT(oc.depth_mm, 30.0 - 1.0);
 }
-
-}  // namespace
-}  // namespace edm::bench
-
-namespace edm::bench {
-namespace {
 
 const Scenario& scenario(const std::vector<Scenario>& all, const std::string& id) {
   for (const Scenario& s : all) {
@@ -128,12 +116,6 @@ TEST(ControllerBench, B4CalibratedWallFinishHitsTheRadiusRoundly) {
   EXPECT_LT(o.circularity_um, 5.0);
   EXPECT_LE(std::abs(o.wall_worst_um), 5.0);
 }
-
-}  // namespace
-}  // namespace edm::bench
-
-namespace edm::bench {
-namespace {
 
 // B5 (quick, 15 s = 10 jump cycles), seed 1: seed 002's ILC, its cycle driven by the bench's
 // forced jump, holds the z-jitter of the last cycles well below the voltage servo's at a
@@ -199,12 +181,6 @@ TEST(ControllerBench, B5IlcLearningFromTheIntegralControllerLowersItsJitterOverT
   EXPECT_LE(jw[4], jw[3] * 1.05) << "falling, not jumping";
   EXPECT_GT(warm.mrr_mm3_min, 0.8 * servo.mrr_mm3_min);
 }
-
-}  // namespace
-}  // namespace edm::bench
-
-namespace edm::bench {
-namespace {
 
 // B6, seed 000's four cases at full length (120 s; case 4 240 s), and B6e (flushing lost under
 // the nozzle, then back), on one seed that is not among the 20 benchmark seeds: without

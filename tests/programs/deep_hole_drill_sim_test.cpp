@@ -152,12 +152,6 @@ TEST(DrillHold, HoldMidHoleFreezesAndResumesToTheSameDepth) {
   EXPECT_NEAR(read("io.depth_mm"), 20.0, 0.02);
 }
 
-}  // namespace
-}  // namespace edm::test
-
-namespace edm::test {
-namespace {
-
 // A through hole in a 3 mm plate: sparks stop when the front leaves the work; with `through` set
 // DeepHoleDrill sees the breakthrough, feeds on overtravel_mm, retracts and ends DONE well before
 // the 10 mm it was asked for. The same plate without `through` keeps feeding (a blind-hole cycle

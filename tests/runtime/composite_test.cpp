@@ -85,12 +85,6 @@ TEST(CompositeBlock, ParameterErrorsAreLocatedAtTheComposite) {
   EXPECT_NE(d.message.find("target must be > 0"), std::string::npos) << d.str();
 }
 
-}  // namespace
-}  // namespace edm::test
-
-namespace edm::test {
-namespace {
-
 TEST(CompositeBlock, ChildParametersAreVariablesSetUnderTheCompositesParams) {
   const std::string base =
       std::string(kProgramP) + R"(      - {name: seq, type: TwoStep, params: )";
