@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "controllers/bench.hpp"
@@ -117,16 +118,22 @@ TEST(ControllerBench, B4CalibratedWallFinishHitsTheRadiusRoundly) {
   EXPECT_LE(std::abs(o.wall_worst_um), 5.0);
 }
 
+// B5 quick (15 s = 10 jump cycles), seed 1: the outcomes of the voltage servo (variant 0) and of
+// variant `v`, whose config names `tag`.
+std::pair<Outcome, Outcome> b5_servo_and(std::size_t v, const std::string& tag) {
+  const auto all = make_scenarios(/*quick=*/true);
+  const Scenario& b5 = scenario(all, "B5");
+  EXPECT_EQ(b5.variants.size(), 4U);
+  const RunSpec& spec = b5.variants.at(v).spec;
+  EXPECT_NE(spec.config.find(tag), std::string::npos) << tag;
+  return {run(kRoot, b5.variants.at(0).spec), run(kRoot, spec)};
+}
+
 // B5 (quick, 15 s = 10 jump cycles), seed 1: seed 002's ILC, its cycle driven by the bench's
 // forced jump, holds the z-jitter of the last cycles well below the voltage servo's at a
 // comparable removal rate (issue 7: "z-jitter falls … compared with the P/integral controller").
 TEST(ControllerBench, B5IlcJitterBelowTheVoltageServo) {
-  const auto all = make_scenarios(/*quick=*/true);
-  const Scenario& b5 = scenario(all, "B5");
-  ASSERT_EQ(b5.variants.size(), 4U);
-  ASSERT_NE(b5.variants[2].spec.config.find("sink-ilc"), std::string::npos);
-  const Outcome servo = run(kRoot, b5.variants[0].spec);
-  const Outcome ilc = run(kRoot, b5.variants[2].spec);
+  const auto [servo, ilc] = b5_servo_and(2, "sink-ilc");
   ASSERT_EQ(ilc.jitter_per_cycle_um.size(), servo.jitter_per_cycle_um.size());
   EXPECT_LT(ilc.jitter_last_um, 0.5 * servo.jitter_last_um)
       << "ILC " << ilc.jitter_last_um << " µm, servo " << servo.jitter_last_um << " µm";
@@ -138,11 +145,7 @@ TEST(ControllerBench, B5IlcJitterBelowTheVoltageServo) {
 // Seed 001's claims on B5: the main loop's y_v tracks its reference and arcs stay suppressed
 // (here: stable arcs at the voltage servo's level, transient arcs within 1.5x of it).
 TEST(ControllerBench, B5StrTracksItsReferenceAndKeepsArcsAtTheBaselinesLevel) {
-  const auto all = make_scenarios(/*quick=*/true);
-  const Scenario& b5 = scenario(all, "B5");
-  ASSERT_NE(b5.variants[1].spec.config.find("sink-str"), std::string::npos);
-  const Outcome servo = run(kRoot, b5.variants[0].spec);
-  const Outcome str = run(kRoot, b5.variants[1].spec);
+  const auto [servo, str] = b5_servo_and(1, "sink-str");
   EXPECT_TRUE(std::isnan(servo.loop_err_rms)) << "the servo has no y_v loop";
   ASSERT_FALSE(std::isnan(str.loop_err_rms));
   EXPECT_NEAR(str.loop_y_mean, str.loop_ref_mean, 0.04) << "no bias from the approach";
@@ -160,12 +163,7 @@ TEST(ControllerBench, B5StrTracksItsReferenceAndKeepsArcsAtTheBaselinesLevel) {
 // servo) it replaces. Until the ILC takes over the machine is the servo's, bit for bit; then
 // the ILC's z-jitter falls over the cycles while the servo's stays where it was.
 TEST(ControllerBench, B5IlcLearningFromTheIntegralControllerLowersItsJitterOverTheCycles) {
-  const auto all = make_scenarios(/*quick=*/true);
-  const Scenario& b5 = scenario(all, "B5");
-  ASSERT_EQ(b5.variants.size(), 4U);
-  ASSERT_NE(b5.variants[3].spec.config.find("sink-ilc-warm"), std::string::npos);
-  const Outcome servo = run(kRoot, b5.variants[0].spec);
-  const Outcome warm = run(kRoot, b5.variants[3].spec);
+  const auto [servo, warm] = b5_servo_and(3, "sink-ilc-warm");
   const auto& js = servo.jitter_per_cycle_um;
   const auto& jw = warm.jitter_per_cycle_um;
   ASSERT_EQ(jw.size(), js.size());
