@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 namespace edm::machining {
 namespace {
@@ -91,13 +92,13 @@ TEST(MachineConfig, MalformedConditions) {
       "  - {E: 1, polarity: plus, wear_ratio: 11}\n"
       "  - {E: 1, name: again}\n"
       "  - {name: no-number, E: 2, E: 3}\n");
-  ASSERT_EQ(e.size(), 5u);
-  EXPECT_EQ(e[0], "m.yaml:3:9: conditions[0].E: must be in 1..2147483647 (got 0)");
-  EXPECT_EQ(e[1],
-            "m.yaml:4:22: conditions[1].polarity: must be one of negative, positive (got 'plus')");
-  EXPECT_EQ(e[2], "m.yaml:4:40: conditions[1].wear_ratio: must be in 0..10 (got 11)");
-  EXPECT_EQ(e[3], "m.yaml:5:9: conditions[2].E: duplicate condition E1 (first at line 4)");
-  EXPECT_EQ(e[4], "m.yaml:6:29: conditions[3]: duplicate key 'E' (first at line 6)");
+  const std::vector<std::string> expected{
+      "m.yaml:3:9: conditions[0].E: must be in 1..2147483647 (got 0)",
+      "m.yaml:4:22: conditions[1].polarity: must be one of negative, positive (got 'plus')",
+      "m.yaml:4:40: conditions[1].wear_ratio: must be in 0..10 (got 11)",
+      "m.yaml:5:9: conditions[2].E: duplicate condition E1 (first at line 4)",
+      "m.yaml:6:29: conditions[3]: duplicate key 'E' (first at line 6)"};
+  EXPECT_EQ(e, expected);
 }
 
 TEST(MachineConfig, SyntaxAndShapeErrors) {
