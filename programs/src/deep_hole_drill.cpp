@@ -77,10 +77,7 @@ DeepHoleDrill::DeepHoleDrill()
 }
 
 void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
-  v.input("td_sum_ns", td_sum_ns, "ns");
-  v.input("td_count", td_count);
-  v.input("n_open", n_open);
-  v.input("n_short", n_short);
+  pulses.visit(v);
   v.input("z_mm", z_mm, "mm");
   v.input("start", start);
   v.input("depth_mm", depth_mm, "mm");
@@ -115,10 +112,7 @@ std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& 
 }
 
 void DeepHoleDrill::bind_self() {
-  td_.td_sum_ns.follow(td_sum_ns);
-  td_.td_count.follow(td_count);
-  td_.n_open.follow(n_open);
-  td_.n_short.follow(n_short);
+  pulses.feed(td_);
   gap_.td_us.connect(td_.td_us);
   gap_.valid.connect(td_.valid);
   gap_.tdr_us.follow(tdr_us);
@@ -274,7 +268,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
   if (state_value_ == State::kApproach) {
     status = rt::worst(status, step(td_, ctx));  // fills the Td window before the gap loop starts
     td_stepped = true;
-    spark_cycles_ = td_count.get() > 0 ? spark_cycles_ + 1 : 0;
+    spark_cycles_ = pulses.td_count.get() > 0 ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
       touch_z_mm.set(z);
       reset_wear.set(true);  // the wear estimate starts at the touch
@@ -318,7 +312,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     const double depth = (touch_z_mm.get() - z) - wear_now;
     depth_reached_mm.set(depth);
     wear_mm.set(wear_now);
-    dark_cycles_ = td_count.get() > 0 ? 0 : dark_cycles_ + 1;
+    dark_cycles_ = pulses.td_count.get() > 0 ? 0 : dark_cycles_ + 1;
     if (depth >= target_depth_mm_) {
       begin_retract(touch_z_mm.get() + params_.clearance_mm);
     } else if (through.get() && depth >= params_.breakthrough_min_mm &&

@@ -44,10 +44,7 @@ EdmJob::EdmJob()
       pz_(add_child<blocks::PositionLoop>("pz")) {}
 
 void EdmJob::visit_own_pins(rt::PinVisitor& v) {
-  v.input("td_sum_ns", td_sum_ns, "ns");
-  v.input("td_count", td_count);
-  v.input("n_open", n_open);
-  v.input("n_short", n_short);
+  pulses.visit(v);
   v.input("n_normal", n_normal);
   v.input("n_transient_arc", n_transient_arc);
   v.input("n_stable_arc", n_stable_arc);
@@ -129,14 +126,8 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
 }
 
 void EdmJob::bind_self() {
-  drill_.td_sum_ns.follow(td_sum_ns);
-  drill_.td_count.follow(td_count);
-  drill_.n_open.follow(n_open);
-  drill_.n_short.follow(n_short);
-  finish_.td_sum_ns.follow(td_sum_ns);
-  finish_.td_count.follow(td_count);
-  finish_.n_open.follow(n_open);
-  finish_.n_short.follow(n_short);
+  pulses.feed(drill_.pulses);
+  pulses.feed(finish_.pulses);
   drill_.z_mm.follow(z_mm);
   drill_.start.connect(drill_start);
   drill_.depth_mm.connect(drill_depth_mm);
@@ -453,8 +444,8 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
 
   loop_enable.set(!rt::is_safe_state(ms));
   if (state_value_ == State::kRun) {
-    figures_.count(ctx.release, {n_open.get(), n_normal.get(), n_transient_arc.get(),
-                                 n_stable_arc.get(), n_short.get()});
+    figures_.count(ctx.release, {pulses.n_open.get(), n_normal.get(), n_transient_arc.get(),
+                                 n_stable_arc.get(), pulses.n_short.get()});
     const MotionBlock* b = job_->rt_current();
     if (b == nullptr || b->kind == MotionKind::kEnd) {
       finish_job(rt::JobOutcome::kFinished);

@@ -67,10 +67,7 @@ WallFinish::WallFinish()
 }
 
 void WallFinish::visit_own_pins(rt::PinVisitor& v) {
-  v.input("td_sum_ns", td_sum_ns, "ns");
-  v.input("td_count", td_count);
-  v.input("n_open", n_open);
-  v.input("n_short", n_short);
+  pulses.visit(v);
   v.input("x_mm", x_mm, "mm");
   v.input("y_mm", y_mm, "mm");
   v.input("start", start);
@@ -117,10 +114,7 @@ std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& set
 void WallFinish::bind_self() {
   pol_.request_positive.connect(polarity_request);
   pol_.generator_on_request.connect(generator_request);
-  td_.td_sum_ns.follow(td_sum_ns);
-  td_.td_count.follow(td_count);
-  td_.n_open.follow(n_open);
-  td_.n_short.follow(n_short);
+  pulses.feed(td_);
   orbit_.start.connect(orbit_start);
   orbit_.r0_mm.connect(orbit_r0_mm);
   orbit_.final_radius_mm.connect(orbit_final_mm);
@@ -280,7 +274,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     rho_target = rho_;
   } else if (state_value_ == State::kOrbit) {
     status = rt::worst(status, step(td_, ctx));
-    dark_s_ = td_count.get() > 0 || n_short.get() > 0 ? 0.0 : dark_s_ + dt;
+    dark_s_ = pulses.td_count.get() > 0 || pulses.n_short.get() > 0 ? 0.0 : dark_s_ + dt;
     if (!spark_out_ && params_.no_spark_timeout > rt::Duration::zero() &&
         dark_s_ >= rt::to_seconds(params_.no_spark_timeout)) {
       no_spark.set(true);  // the task raises the block-fault alarm: safe state, job aborted

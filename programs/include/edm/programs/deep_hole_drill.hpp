@@ -89,6 +89,7 @@
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
 #include "edm/blocks/wear_compensator.hpp"
+#include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
@@ -125,7 +126,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   DeepHoleDrill();
 
   // Pins (named as in visit_own_pins).
-  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
   rt::Input<double> z_mm;
   rt::Input<bool> start;
   rt::Input<double> depth_mm;    // 0: use depth_default_mm

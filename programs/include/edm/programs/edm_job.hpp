@@ -60,6 +60,7 @@
 #include "edm/blocks/position_loop.hpp"
 #include "edm/machining/machine_tables.hpp"
 #include "edm/machining/motion_block.hpp"
+#include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/deep_hole_drill.hpp"
 #include "edm/programs/job_figures.hpp"
 #include "edm/programs/wall_finish.hpp"
@@ -85,7 +86,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   EdmJob();
 
   // Pins (named as in visit_own_pins).
-  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
   rt::Input<std::int64_t> n_normal, n_transient_arc, n_stable_arc;
   rt::Input<double> x_mm, y_mm, z_mm;
   rt::Output<double> vx_cmd_mm_s, vy_cmd_mm_s, vz_cmd_mm_s;

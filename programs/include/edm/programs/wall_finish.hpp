@@ -60,6 +60,7 @@
 #include "edm/blocks/position_loop.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
+#include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
@@ -88,7 +89,7 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   WallFinish();
 
   // Pins (named as in visit_own_pins).
-  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
   rt::Input<double> x_mm, y_mm;
   rt::Input<bool> start;
   rt::Input<double> start_offset_mm;
