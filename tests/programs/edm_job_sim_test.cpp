@@ -108,12 +108,15 @@ JobResult run_job(int seed, const std::vector<MotionBlock>& program, machining::
   rt::Task& motion = *r->tasks()[0];
   rt::Task& supervisor = *r->tasks()[1];
   std::ostringstream sink;
+  ShortFeedWatch no_feed_while_short(vars);
+  EXPECT_EQ(no_feed_while_short.watched(), 1u) << "cnc.job.drill";
   double shorts = 0.0, pulses = 0.0;
   std::int64_t k = 0;
   for (; k < 300'000; ++k) {
     const rt::TimePoint t{1ms * k};
     clock.advance_to(t);
     motion.run_cycle(t, clock);
+    no_feed_while_short.check(k);
     if (k % 10 == 0) supervisor.run_cycle(t, clock);
     if (k % 4096 == 0) r->trace().drain(sink), sink.str({});
     on_cycle(vars);

@@ -82,6 +82,52 @@ inline void replace_once(std::string& s, const std::string& from, const std::str
 // A machine built from config text and powered on, its first task run one 1 ms cycle at a time on
 // a virtual clock: `run_cycle(k)` runs cycle k (released at k ms), `cycle()` the next one. The
 // trace is drained every 4096 cycles so that it never fills.
+/// Seed 004's rule, asserted on every cycle it is shown (issue 19): while a drilling program's Td
+/// window reads short (`<program>.gap_short`), its Z command (`<program>.vz_cmd_mm_s`) and the
+/// machine's (`io.vz_cmd`) never point toward the work (down). Finds every such program of a
+/// built machine; a machine without one checks nothing.
+class ShortFeedWatch {
+ public:
+  explicit ShortFeedWatch(const rt::VariableRegistry& vars) {
+    const rt::Variable* io = vars.find("io.vz_cmd");
+    for (const rt::Variable& v : vars.all()) {
+      const std::string suffix = ".gap_short";
+      if (v.name.size() <= suffix.size() ||
+          v.name.compare(v.name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+        continue;
+      }
+      const std::string base = v.name.substr(0, v.name.size() - suffix.size());
+      const rt::Variable* vz = vars.find(base + ".vz_cmd_mm_s");
+      if (vz != nullptr && v.is_pin() && vz->is_pin()) {
+        watched_.push_back({base, v.pin, vz->pin, io != nullptr ? io->pin : vz->pin});
+      }
+    }
+  }
+  ShortFeedWatch(const ShortFeedWatch&) = delete;
+  ShortFeedWatch& operator=(const ShortFeedWatch&) = delete;
+  ~ShortFeedWatch() {
+    EXPECT_EQ(violations_, 0) << "fed toward the work while the gap read short: " << first_;
+  }
+  void check(std::int64_t cycle) {
+    for (const Watched& w : watched_) {
+      if (rt::read_pin_as_double(w.gap_short) == 0.0) continue;
+      if (rt::read_pin_as_double(w.vz) < 0.0 || rt::read_pin_as_double(w.io_vz) < 0.0) {
+        if (violations_++ == 0) first_ = w.program + " at cycle " + std::to_string(cycle);
+      }
+    }
+  }
+  [[nodiscard]] std::size_t watched() const noexcept { return watched_.size(); }
+
+ private:
+  struct Watched {
+    std::string program;
+    rt::PinRef gap_short, vz, io_vz;
+  };
+  std::vector<Watched> watched_;
+  std::int64_t violations_{0};
+  std::string first_;
+};
+
 struct SteppedMachine {
   std::unique_ptr<rt::Runtime> runtime;
   rt::VirtualClock clock;
@@ -90,16 +136,20 @@ struct SteppedMachine {
   std::int64_t next{0};  // the cycle cycle() runs
   std::ostringstream sink;
 
+  ShortFeedWatch no_feed_while_short;
+
   SteppedMachine(const std::string& text, const std::string& name)
       : runtime(build_sim_machine(rt::parse_config_text(text, name))),
         task(*runtime->tasks()[0]),
-        vars(runtime->variables()) {
+        vars(runtime->variables()),
+        no_feed_while_short(vars) {
     runtime->machine().command(rt::MachineCommand::kPowerOn);
   }
   void run_cycle(std::int64_t k) {
     const rt::TimePoint release{std::chrono::milliseconds(1) * k};
     clock.advance_to(release);
     task.run_cycle(release, clock);
+    no_feed_while_short.check(k);
     if (k % 4096 == 0) runtime->trace().drain(sink), sink.str({});
   }
   void cycle() { run_cycle(next++); }
