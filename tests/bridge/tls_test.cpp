@@ -40,12 +40,12 @@ TEST_F(Tls, a_client_verifying_the_ca_file_is_served_over_tls) {
   start(tls_options());
   ClientOptions c = tls_client();
   c.tls.ca_file = cert_;
+  EventSink sink;  // declared first: it must outlive the client's I/O thread
   Client client;
   ASSERT_EQ(client.connect(c), Role::kOperator);
   const Reply r = client.request("status");
   ASSERT_TRUE(r) << r.message;
   // Big replies and events cross TLS records intact.
-  EventSink sink;
   client.set_event_handler(sink.handler());
   ASSERT_TRUE(client.subscribe({"status"}, 100));
   EXPECT_EQ(sink.wait_for("status", 20).size(), 20u);
