@@ -41,7 +41,10 @@ struct TraceArgs {
 struct ServeArgs {
   std::string listen{"127.0.0.1:8080"};
   std::string web_root{EDM_DEFAULT_WEB_ROOT};
-  bool insecure{false};
+  bool insecure{false};       // --insecure-listen: plain HTTP off loopback (bridge without TLS)
+  std::string tls_cert;       // --tls-cert, else $EDM_WEB_TLS_CERT: HTTPS when set (with the key)
+  std::string tls_key;        // --tls-key, else $EDM_WEB_TLS_KEY
+  bool insecure_http{false};  // --insecure-http: plain HTTP anywhere, even when the bridge is TLS
 };
 
 /// Set by SIGINT / SIGTERM; loops poll it.

@@ -1,6 +1,7 @@
-// edmhmi serve [--listen HOST:PORT] [--web-root DIR] — the operator's screen in a browser
-// (docs/web.md): serves the built page and a WebSocket, owns one bridge session to edmplc and the
-// job, relays commands for logged-in browsers.
+// edmhmi serve [--listen HOST:PORT] [--web-root DIR] [--tls-cert F --tls-key F] — the operator's
+// screen in a browser (docs/web.md): serves the built page and a WebSocket (HTTPS/WSS with a
+// certificate), owns one bridge session to edmplc and the job, relays commands for logged-in
+// browsers.
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/signal_set.hpp>
@@ -10,6 +11,7 @@
 #include "cli.hpp"
 #include "edm/hmi/web_http.hpp"
 #include "edm/hmi/web_hub.hpp"
+#include "edm/hmi/web_tls.hpp"
 
 namespace edmhmi {
 
@@ -44,21 +46,63 @@ bool parse_listen(std::string_view text, boost::asio::ip::tcp::endpoint& out, st
   return true;
 }
 
+/// The page's transport against the bridge's (docs/security.md "The browser HMI"): plain HTTP
+/// when the bridge is TLS would put the operator's token in clear on the one hop left unprotected.
+/// On loopback it stays allowed with a warning (nothing leaves the host); elsewhere it needs
+/// --insecure-http. Plain HTTP off loopback needs --insecure-listen or --insecure-http anyway.
+/// Returns false after printing the one-line refusal.
+bool plain_http_allowed(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings,
+                        const boost::asio::ip::tcp::endpoint& endpoint) {
+  const bool bridge_tls = !settings.tls_ca_file.empty() || !settings.tls_fingerprint.empty();
+  const bool loopback = endpoint.address().is_loopback();
+  if (args.insecure_http) return true;
+  if (bridge_tls && !loopback) {
+    std::fprintf(stderr,
+                 "edmhmi serve: the bridge uses TLS but the page on %s would be plain HTTP: give "
+                 "--tls-cert and --tls-key (or --insecure-http to accept tokens in clear)\n",
+                 args.listen.c_str());
+    return false;
+  }
+  if (bridge_tls) {
+    std::fprintf(stderr,
+                 "edmhmi serve: warning: the bridge uses TLS but the page is plain HTTP on "
+                 "loopback %s (--tls-cert and --tls-key for HTTPS)\n",
+                 args.listen.c_str());
+    return true;
+  }
+  if (!loopback && !args.insecure) {
+    std::fprintf(stderr,
+                 "edmhmi serve: %s is not a loopback address: the page speaks plain HTTP and "
+                 "tokens would cross the network in clear. Give --tls-cert and --tls-key, use an "
+                 "SSH tunnel, or --insecure-listen on a network you trust (docs/web.md).\n",
+                 args.listen.c_str());
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings) {
   const std::string& listen = args.listen;
   const std::string& web_root = args.web_root;
-  const bool insecure = args.insecure;
   boost::asio::ip::tcp::endpoint endpoint;
   std::string why;
   if (!parse_listen(listen, endpoint, why)) return usage(why);
-  if (!endpoint.address().is_loopback() && !insecure) {
-    std::fprintf(stderr,
-                 "edmhmi serve: %s is not a loopback address: the page speaks plain HTTP and "
-                 "tokens would cross the network in clear. Use an SSH tunnel or a TLS proxy, or "
-                 "--insecure-listen on a network you trust (docs/web.md).\n",
-                 listen.c_str());
+  if (args.tls_cert.empty() != args.tls_key.empty()) {
+    return usage(args.tls_cert.empty() ? "--tls-key needs --tls-cert (or $EDM_WEB_TLS_CERT)"
+                                       : "--tls-cert needs --tls-key (or $EDM_WEB_TLS_KEY)");
+  }
+  // Every refusal comes before edmplc is contacted: a bad start-up never touches the machine.
+  std::shared_ptr<boost::asio::ssl::context> tls;
+  if (!args.tls_cert.empty()) {
+    try {
+      tls = edm::hmi::load_web_tls(args.tls_cert, args.tls_key);
+    } catch (const edm::hmi::WebTlsError& e) {
+      std::fprintf(stderr, "edmhmi serve: %s\n", e.what());
+      return kExitBadInput;
+    }
+  } else if (!plain_http_allowed(args, settings, endpoint)) {
     return kExitBadInput;
   }
   if (!std::filesystem::is_regular_file(std::filesystem::path(web_root) / "index.html")) {
@@ -81,7 +125,7 @@ int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& setting
   }
   std::shared_ptr<edm::hmi::WebListener> listener;
   try {
-    listener = std::make_shared<edm::hmi::WebListener>(ioc, endpoint, web_root, hub);
+    listener = std::make_shared<edm::hmi::WebListener>(ioc, endpoint, web_root, hub, tls);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "edmhmi serve: cannot listen on %s: %s\n", listen.c_str(), e.what());
     return kExitFailure;
@@ -90,10 +134,10 @@ int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& setting
   boost::asio::signal_set signals(ioc, SIGINT, SIGTERM);
   signals.async_wait([&ioc](boost::system::error_code, int) { ioc.stop(); });
   const auto ep = listener->local_endpoint();
-  std::printf("edmhmi serve: listening on http://%s:%u/ (edmplc at %s:%u as %s, page %s)\n",
-              ep.address().to_string().c_str(), unsigned{ep.port()}, settings.host.c_str(),
-              unsigned{settings.port}, std::string(edm::bridge::to_string(client.role())).c_str(),
-              web_root.c_str());
+  std::printf("edmhmi serve: listening on %s://%s:%u/ (edmplc at %s:%u as %s, page %s)\n",
+              tls ? "https" : "http", ep.address().to_string().c_str(), unsigned{ep.port()},
+              settings.host.c_str(), unsigned{settings.port},
+              std::string(edm::bridge::to_string(client.role())).c_str(), web_root.c_str());
   std::fflush(stdout);
   ioc.run();
   hub.stop();

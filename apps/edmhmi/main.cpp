@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <utility>
 
 #include "cli.hpp"
 
@@ -85,6 +86,12 @@ int run(int argc, char** argv) {
   s->add_option("--web-root", serve.web_root, "the built page")->capture_default_str();
   s->add_flag("--insecure-listen", serve.insecure,
               "allow a non-loopback address (plain HTTP: tokens in clear)");
+  s->add_option("--tls-cert", serve.tls_cert,
+                "serve HTTPS/WSS with this PEM certificate chain (else $EDM_WEB_TLS_CERT)");
+  s->add_option("--tls-key", serve.tls_key,
+                "the PEM private key of --tls-cert (else $EDM_WEB_TLS_KEY)");
+  s->add_flag("--insecure-http", serve.insecure_http,
+              "allow plain HTTP on any address even when the bridge uses TLS (tokens in clear)");
 
   if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
   const std::string command = app.get_subcommands().front()->get_name();
@@ -104,7 +111,14 @@ int run(int argc, char** argv) {
   if (command == "stats") return cmd_stats(settings);
   if (command == "watch") return cmd_watch(watch, settings);
   if (command == "trace") return cmd_trace(trace, settings);
-  if (command == "serve") return cmd_serve(serve, settings);
+  if (command == "serve") {
+    for (auto [value, name] : {std::pair{&serve.tls_cert, "EDM_WEB_TLS_CERT"},
+                               std::pair{&serve.tls_key, "EDM_WEB_TLS_KEY"}}) {
+      const char* env = std::getenv(name);
+      if (value->empty() && env != nullptr) *value = env;
+    }
+    return cmd_serve(serve, settings);
+  }
   return cmd_machine(command, settings);
 }
 

@@ -3,11 +3,13 @@
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket/rfc6455.hpp>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <type_traits>
 
 #include "edm/hmi/web_session.hpp"
 #include "edm/hmi/web_static.hpp"
@@ -28,7 +30,8 @@ constexpr const char* kCsp =
 
 void fail(beast::error_code ec, const char* what) {
   if (ec == asio::error::operation_aborted || ec == beast::error::timeout ||
-      ec == http::error::end_of_stream || ec == asio::error::eof) {
+      ec == http::error::end_of_stream || ec == asio::error::eof ||
+      ec == asio::ssl::error::stream_truncated) {  // a browser closing TLS without close_notify
     return;
   }
   std::fprintf(stderr, "edmhmi serve: %s: %s\n", what, ec.message().c_str());
@@ -40,24 +43,49 @@ std::string_view origin_host(std::string_view origin) {
   return p == std::string_view::npos ? origin : origin.substr(p + 3);
 }
 
-class HttpSession : public std::enable_shared_from_this<HttpSession> {
+using TlsStream = beast::ssl_stream<beast::tcp_stream>;
+
+/// One connection: plain HTTP (`beast::tcp_stream`) or HTTPS (`TlsStream`, handshake first).
+template <class Stream>
+class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
+  static constexpr bool kTls = std::is_same_v<Stream, TlsStream>;
+
  public:
-  HttpSession(tcp::socket socket, const std::filesystem::path& root, WebHub& hub)
-      : stream_(std::move(socket)), root_(root), hub_(hub) {}
+  HttpSession(tcp::socket socket, const std::filesystem::path& root, WebHub& hub,
+              asio::ssl::context* tls)
+      : stream_(make_stream(std::move(socket), tls)), root_(root), hub_(hub) {}
 
   void run() {
-    asio::dispatch(stream_.get_executor(),
-                   beast::bind_front_handler(&HttpSession::do_read, shared_from_this()));
+    asio::dispatch(stream_.get_executor(), [self = this->shared_from_this()] {
+      if constexpr (kTls) {
+        // The handshake has the same deadline as a request: a silent peer holds nothing.
+        beast::get_lowest_layer(self->stream_).expires_after(kRequestTimeout);
+        self->stream_.async_handshake(asio::ssl::stream_base::server, [self](beast::error_code ec) {
+          if (ec) return fail(ec, "tls handshake");
+          self->do_read();
+        });
+      } else {
+        self->do_read();
+      }
+    });
   }
 
  private:
+  static Stream make_stream(tcp::socket socket, asio::ssl::context* tls) {
+    if constexpr (kTls) {
+      return Stream(std::move(socket), *tls);
+    } else {
+      return Stream(std::move(socket));
+    }
+  }
+
   void do_read() {
     parser_.emplace();
     parser_->header_limit(kMaxHttpHeaderBytes);
     parser_->body_limit(kMaxHttpBodyBytes);
-    stream_.expires_after(kRequestTimeout);
+    beast::get_lowest_layer(stream_).expires_after(kRequestTimeout);
     http::async_read(stream_, buffer_, *parser_,
-                     beast::bind_front_handler(&HttpSession::on_read, shared_from_this()));
+                     beast::bind_front_handler(&HttpSession::on_read, this->shared_from_this()));
   }
 
   void on_read(beast::error_code ec, std::size_t) {
@@ -76,7 +104,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       if (!origin.empty() && origin_host(origin) != host) {
         return send(simple(http::status::forbidden, "cross-origin WebSocket refused\n"), true);
       }
-      stream_.expires_never();
+      beast::get_lowest_layer(stream_).expires_never();
       return start_web_socket(std::move(stream_), std::move(req), hub_);
     }
     handle(req);
@@ -131,9 +159,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void send(http::response<http::string_body> res, bool close) {
     res_ = std::make_shared<http::response<http::string_body>>(std::move(res));
     if (close) res_->keep_alive(false);
-    stream_.expires_after(kRequestTimeout);
+    beast::get_lowest_layer(stream_).expires_after(kRequestTimeout);
     http::async_write(stream_, *res_,
-                      [self = shared_from_this(), close](beast::error_code ec, std::size_t) {
+                      [self = this->shared_from_this(), close](beast::error_code ec, std::size_t) {
                         self->on_write(ec, close);
                       });
   }
@@ -141,14 +169,19 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void on_write(beast::error_code ec, bool close) {
     if (ec) return fail(ec, "http write");
     if (close) {
-      stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+      if constexpr (kTls) {
+        beast::get_lowest_layer(stream_).expires_after(kRequestTimeout);
+        stream_.async_shutdown([self = this->shared_from_this()](beast::error_code) {});
+      } else {
+        stream_.socket().shutdown(tcp::socket::shutdown_send, ec);
+      }
       return;
     }
     res_.reset();
     do_read();
   }
 
-  beast::tcp_stream stream_;
+  Stream stream_;
   beast::flat_buffer buffer_{kMaxHttpHeaderBytes + kMaxHttpBodyBytes};
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<http::response<http::string_body>> res_;
@@ -159,8 +192,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 }  // namespace
 
 WebListener::WebListener(asio::io_context& ioc, const tcp::endpoint& endpoint,
-                         std::filesystem::path web_root, WebHub& hub)
-    : ioc_(ioc), acceptor_(ioc), web_root_(std::move(web_root)), hub_(hub) {
+                         std::filesystem::path web_root, WebHub& hub,
+                         std::shared_ptr<asio::ssl::context> tls)
+    : ioc_(ioc), acceptor_(ioc), web_root_(std::move(web_root)), hub_(hub), tls_(std::move(tls)) {
   acceptor_.open(endpoint.protocol());
   acceptor_.set_option(asio::socket_base::reuse_address(true));
   acceptor_.bind(endpoint);
@@ -172,15 +206,21 @@ void WebListener::run() { do_accept(); }
 tcp::endpoint WebListener::local_endpoint() const { return acceptor_.local_endpoint(); }
 
 void WebListener::do_accept() {
-  acceptor_.async_accept(asio::make_strand(ioc_), [self = shared_from_this()](beast::error_code ec,
-                                                                              tcp::socket socket) {
-    if (ec) {
-      fail(ec, "accept");
-    } else {
-      std::make_shared<HttpSession>(std::move(socket), self->web_root_, self->hub_)->run();
-    }
-    if (self->acceptor_.is_open()) self->do_accept();
-  });
+  acceptor_.async_accept(asio::make_strand(ioc_),
+                         [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
+                           if (ec) {
+                             fail(ec, "accept");
+                           } else if (self->tls_) {
+                             std::make_shared<HttpSession<TlsStream>>(
+                                 std::move(socket), self->web_root_, self->hub_, self->tls_.get())
+                                 ->run();
+                           } else {
+                             std::make_shared<HttpSession<beast::tcp_stream>>(
+                                 std::move(socket), self->web_root_, self->hub_, nullptr)
+                                 ->run();
+                           }
+                           if (self->acceptor_.is_open()) self->do_accept();
+                         });
 }
 
 }  // namespace edm::hmi

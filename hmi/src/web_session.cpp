@@ -2,7 +2,9 @@
 
 #include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 #include <cstdio>
 #include <deque>
 #include <set>
@@ -35,9 +37,15 @@ Json reply_json(const bridge::Reply& r) {
   return j;
 }
 
-class WsSession : public WebSink, public std::enable_shared_from_this<WsSession> {
+/// `Stream`: beast::tcp_stream (WS) or beast::ssl_stream<beast::tcp_stream> (WSS), after the HTTP
+/// session has read the upgrade request.
+template <class Stream>
+class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<Stream>> {
+  using std::enable_shared_from_this<WsSession<Stream>>::shared_from_this;
+  using std::enable_shared_from_this<WsSession<Stream>>::weak_from_this;
+
  public:
-  WsSession(beast::tcp_stream stream, WebHub& hub)
+  WsSession(Stream stream, WebHub& hub)
       : ws_(std::move(stream)), hub_(hub), login_timer_(ws_.get_executor()) {}
 
   ~WsSession() override { hub_.detach(this); }
@@ -242,7 +250,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession>
     ws_.async_close(*close_reason_, [self = shared_from_this()](beast::error_code) {});
   }
 
-  websocket::stream<beast::tcp_stream> ws_;
+  websocket::stream<Stream> ws_;
   WebHub& hub_;
   asio::steady_timer login_timer_;
   beast::flat_buffer buffer_;
@@ -259,7 +267,13 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession>
 
 void start_web_socket(beast::tcp_stream stream,
                       beast::http::request<beast::http::string_body> request, WebHub& hub) {
-  std::make_shared<WsSession>(std::move(stream), hub)->run(std::move(request));
+  std::make_shared<WsSession<beast::tcp_stream>>(std::move(stream), hub)->run(std::move(request));
+}
+
+void start_web_socket(beast::ssl_stream<beast::tcp_stream> stream,
+                      beast::http::request<beast::http::string_body> request, WebHub& hub) {
+  std::make_shared<WsSession<beast::ssl_stream<beast::tcp_stream>>>(std::move(stream), hub)
+      ->run(std::move(request));
 }
 
 }  // namespace edm::hmi

@@ -16,6 +16,7 @@
 #include <boost/beast/core/tcp_stream.hpp>
 #include <boost/beast/http/message.hpp>
 #include <boost/beast/http/string_body.hpp>
+#include <boost/beast/ssl/ssl_stream.hpp>
 #include <memory>
 
 #include "edm/hmi/web_hub.hpp"
@@ -28,8 +29,12 @@ inline constexpr int kMaxInFlight = 8;
 inline constexpr auto kStallTimeout = std::chrono::seconds(5);
 inline constexpr auto kLoginTimeout = std::chrono::seconds(10);
 
-/// Starts a WebSocket session on an accepted upgrade request.
+/// Starts a WebSocket session on an accepted upgrade request: WS over plain HTTP, WSS over HTTPS
+/// (the TLS handshake already done by the HTTP session).
 void start_web_socket(boost::beast::tcp_stream stream,
+                      boost::beast::http::request<boost::beast::http::string_body> request,
+                      WebHub& hub);
+void start_web_socket(boost::beast::ssl_stream<boost::beast::tcp_stream> stream,
                       boost::beast::http::request<boost::beast::http::string_body> request,
                       WebHub& hub);
 
