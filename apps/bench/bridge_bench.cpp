@@ -123,10 +123,9 @@ int main(int argc, char** argv) {
   co.timeout = 10s;
 
   // 1a. Idle: bridge up, nobody connected.
-  edm::apps::Process plc =
-      spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out", tmp + "-idle.json",
-             "--bridge-port", std::to_string(o.port)},
-            tmp + "-idle.log");
+  edm::apps::Process plc = spawn({o.edmplc, "--config", cfg, "--run-for", run_for, "--stats-out",
+                                  tmp + "-idle.json", "--bridge-port", std::to_string(o.port)},
+                                 tmp + "-idle.log");
   if (plc.wait() != 0) {
     fmt::print(stderr, "edmplc (idle) failed; see {}-idle.log\n", tmp);
     return 1;

@@ -67,7 +67,9 @@ int main(int argc, char** argv) {
   app.add_option("--first-seed", first_seed, "the first seed (the benchmark's are 1 ... N)")
       ->check(edm::apps::kPositive)
       ->capture_default_str();
-  app.add_option("--jobs", jobs, "parallel runs")->check(edm::apps::kPositive)->capture_default_str();
+  app.add_option("--jobs", jobs, "parallel runs")
+      ->check(edm::apps::kPositive)
+      ->capture_default_str();
   app.add_option("--root", root, "the source tree")->capture_default_str();
   app.add_option("--out", out_dir, "output directory (default ROOT/out/bench/controllers)");
   app.add_option_function<std::string>(

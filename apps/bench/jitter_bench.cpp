@@ -23,9 +23,9 @@
 #include <string_view>
 #include <vector>
 
-#include "jitter_parse.hpp"
-#include "edm/apps/cli.hpp"
 #include "bench_util.hpp"
+#include "edm/apps/cli.hpp"
+#include "jitter_parse.hpp"
 
 namespace fs = std::filesystem;
 using edm::bench::child_failure;
@@ -169,9 +169,10 @@ std::string ratio_text(double num, double den, double target, const char* what) 
 }
 
 int parse_args(int argc, char** argv, Options& opt) {
-  CLI::App app("edm-bench-jitter: release jitter of edmplc against cyclictest "
-               "(docs/benchmarks.md)",
-               "edm-bench-jitter");
+  CLI::App app(
+      "edm-bench-jitter: release jitter of edmplc against cyclictest "
+      "(docs/benchmarks.md)",
+      "edm-bench-jitter");
   app.footer(
       "edm-bench-jitter --parse cyclictest|edmplc FILE: print the stats parsed from a recorded "
       "cyclictest -h output or edmplc --stats-out file");

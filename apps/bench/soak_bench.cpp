@@ -23,11 +23,11 @@
 #include <sstream>
 #include <thread>
 
+#include "bench_util.hpp"
+#include "edm/apps/cli.hpp"
 #include "soak_hostile.hpp"
 #include "soak_job.hpp"
-#include "edm/apps/cli.hpp"
 #include "soak_plc.hpp"
-#include "bench_util.hpp"
 
 namespace {
 
@@ -433,15 +433,17 @@ void write_samples(const fs::path& path, const Phase& ph) {
 
 int main(int argc, char** argv) {
   Options o;
-  CLI::App app("edm-bench-soak: the demo job in a loop with 16 hostile raw-socket clients "
-               "(docs/benchmarks.md, Soak)",
-               "edm-bench-soak");
+  CLI::App app(
+      "edm-bench-soak: the demo job in a loop with 16 hostile raw-socket clients "
+      "(docs/benchmarks.md, Soak)",
+      "edm-bench-soak");
   app.footer(
       "KIND: read_only subscribe unsubscribe trace_start trace_stop stall drain garbage_bytes "
       "bad_json deep_nesting long_line pipelined half_line close rst blank_line no_hello "
       "wrong_token");
   app.add_option("--root", o.root, "the source tree")->capture_default_str();
-  app.add_option("--minutes", o.minutes, "soak length")->check(edm::apps::kPositive)
+  app.add_option("--minutes", o.minutes, "soak length")
+      ->check(edm::apps::kPositive)
       ->capture_default_str();
   app.add_option("--baseline-minutes", o.baseline_minutes,
                  "idle baseline length (default: the soak's, at most 5)")

@@ -24,9 +24,10 @@ std::atomic<bool> g_interrupted{false};
 extern "C" void on_signal(int /*sig*/) { g_interrupted.store(true); }
 
 int run(int argc, char** argv) {
-  CLI::App app("edmhmi: the HMI of edmplc (docs/hmi.md). Exit 0 ok, 1 runtime failure or alarm, "
-               "2 bad input.",
-               "edmhmi");
+  CLI::App app(
+      "edmhmi: the HMI of edmplc (docs/hmi.md). Exit 0 ok, 1 runtime failure or alarm, "
+      "2 bad input.",
+      "edmhmi");
   app.require_subcommand(1);
   edm::hmi::ConnectionFlags flags;
   app.add_option("--host", flags.host, "edmplc's host (else $EDM_HOST, else 127.0.0.1)");
@@ -39,8 +40,9 @@ int run(int argc, char** argv) {
                  "TLS, the server certificate's SHA-256 pinned (else $EDM_TLS_FINGERPRINT)");
 
   CheckArgs check;
-  CLI::App* c = app.add_subcommand("check", "interpret PART.nc offline against a machine's "
-                                            "conditions and soft limits; nothing is sent");
+  CLI::App* c = app.add_subcommand("check",
+                                   "interpret PART.nc offline against a machine's "
+                                   "conditions and soft limits; nothing is sent");
   c->add_option("--machine", check.machine, "the machine config")->capture_default_str();
   c->add_option("PART.nc", check.part, "the part program")->required();
 

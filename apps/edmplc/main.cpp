@@ -80,9 +80,10 @@ std::optional<std::uint64_t> parse_u64(std::string_view s) {
 /// The options, or the exit code when the program ends here (--help, bad arguments).
 std::variant<Options, int> parse_args(int argc, char** argv) {
   Options o;
-  CLI::App app("the edmplc runtime: runs a machine config's tasks until SIGINT/SIGTERM or "
-               "--run-for (docs/runtime.md)",
-               "edmplc");
+  CLI::App app(
+      "the edmplc runtime: runs a machine config's tasks until SIGINT/SIGTERM or "
+      "--run-for (docs/runtime.md)",
+      "edmplc");
   app.add_option("--config", o.config, "the machine config (YAML)")->required();
   app.add_option_function<std::string>(
       "--clock",

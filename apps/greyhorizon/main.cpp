@@ -105,15 +105,16 @@ int main(int argc, char** argv) {
   std::int64_t max_p = 60;
   std::int64_t window = 5;
   std::int64_t warmup = 300;
-  std::string config =
-      std::string(EDM_SOURCE_DIR) + "/config/bench/controllers/wire-horizon.yaml";
+  std::string config = std::string(EDM_SOURCE_DIR) + "/config/bench/controllers/wire-horizon.yaml";
   std::string csv;
   std::string raw;
   std::string io_extra;
-  CLI::App app("edm-greyhorizon: the grey-model horizon p for each Wn (seed 000 Table 2) on "
-               "the Rab recorded from the wire simulator",
-               "edm-greyhorizon");
-  app.add_option("--seed", seed, "simulator seed")->check(CLI::Range(std::int64_t{0}, INT64_MAX))
+  CLI::App app(
+      "edm-greyhorizon: the grey-model horizon p for each Wn (seed 000 Table 2) on "
+      "the Rab recorded from the wire simulator",
+      "edm-greyhorizon");
+  app.add_option("--seed", seed, "simulator seed")
+      ->check(CLI::Range(std::int64_t{0}, INT64_MAX))
       ->capture_default_str();
   app.add_option("--samples", samples, "Rab samples at 40 ms (default 3000 = 120 s)")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));

@@ -63,9 +63,10 @@ int main(int argc, char** argv) {
   std::string law_name = "drill";
   std::optional<double> gap_um, debris, kd, tau_v_ms, wn, zeta, tau_m_ms, tdr_us, kg_eval;
 
-  CLI::App app("edm-kgdesign: the ISE-optimal Kg of the P gap controller Vz = Kg*(Tdr - Td) "
-               "(seed 004 eq. 1-3, docs/blocks.md)",
-               "edm-kgdesign");
+  CLI::App app(
+      "edm-kgdesign: the ISE-optimal Kg of the P gap controller Vz = Kg*(Tdr - Td) "
+      "(seed 004 eq. 1-3, docs/blocks.md)",
+      "edm-kgdesign");
   app.add_option_function<std::string>(
       "--law",
       [&](const std::string& v) {

@@ -67,13 +67,16 @@ Cell measure(const edm::sim::SimParams& params, std::uint64_t seed, double arc_o
 
 int main(int argc, char** argv) {
   double thickness = 50.0, open_v = 110.0, settle_s = 20.0, measure_s = 20.0, seed = 1.0;
-  CLI::App app("edm-wiremap: the wire plant's static map, steady Rab and cut speed over arc-off "
-               "time x servo reference voltage (docs/simulator.md)",
-               "edm-wiremap");
+  CLI::App app(
+      "edm-wiremap: the wire plant's static map, steady Rab and cut speed over arc-off "
+      "time x servo reference voltage (docs/simulator.md)",
+      "edm-wiremap");
   app.add_option("--thickness-mm", thickness, "part thickness H [mm] (seed 000's case 1)")
       ->check(edm::apps::kFinite)
       ->capture_default_str();
-  app.add_option("--seed", seed, "simulator seed")->check(edm::apps::kFinite)->capture_default_str();
+  app.add_option("--seed", seed, "simulator seed")
+      ->check(edm::apps::kFinite)
+      ->capture_default_str();
   app.add_option("--open-voltage-v", open_v, "ignition voltage [V] (seed 000's machine)")
       ->check(edm::apps::kFinite)
       ->capture_default_str();

@@ -67,8 +67,8 @@ DeepHoleDrill::DeepHoleDrill()
   wp.wear_ratio_default = 0.6;
   wear_.set_params(wp);
   blocks::ShortRetractParams rp;
-  rp.short_cycles = 5;   // with td.window: the detection window
-  rp.max_tries = 1000;   // the retract budget is this program's (short_retracts_max in a window)
+  rp.short_cycles = 5;  // with td.window: the detection window
+  rp.max_tries = 1000;  // the retract budget is this program's (short_retracts_max in a window)
   retract_.set_params(rp);
   blocks::PositionLoopParams zp;
   zp.kv = 50.0;

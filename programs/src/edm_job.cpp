@@ -113,9 +113,8 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
     return errs;
   }
   const double v_needed = kLoopSpeedMargin * params_.rapid_speed_mm_s;
-  for (auto [loop, name] : {std::pair<blocks::PositionLoop*, const char*>{&px_, "px"},
-                            {&py_, "py"},
-                            {&pz_, "pz"}}) {
+  for (auto [loop, name] :
+       {std::pair<blocks::PositionLoop*, const char*>{&px_, "px"}, {&py_, "py"}, {&pz_, "pz"}}) {
     if (loop->params().v_max_mm_s < v_needed) {
       errs.push_back({std::string(name) + ".v_max_mm_s",
                       "must be >= 1.5 x rapid_speed_mm_s (" + std::to_string(v_needed) +
@@ -240,8 +239,7 @@ bool EdmJob::in_position() const noexcept {
   return px_.in_position.get() && py_.in_position.get() && pz_.in_position.get();
 }
 
-void EdmJob::set_reference(double x, double y, double z, double vx, double vy,
-                           double vz) noexcept {
+void EdmJob::set_reference(double x, double y, double z, double vx, double vy, double vz) noexcept {
   x_ref_mm.set(x);
   y_ref_mm.set(y);
   z_ref_mm.set(z);
@@ -313,8 +311,8 @@ bool EdmJob::run_arc(const MotionBlock& b, const rt::CycleContext& ctx, bool hol
   }
   arc_hold.set(hold);
   status = rt::worst(status, step(arc_, ctx));
-  set_reference(arc_.rx_mm.get(), arc_.ry_mm.get(), hold_z_, arc_.vx_mm_s.get(),
-                arc_.vy_mm_s.get(), 0.0);
+  set_reference(arc_.rx_mm.get(), arc_.ry_mm.get(), hold_z_, arc_.vx_mm_s.get(), arc_.vy_mm_s.get(),
+                0.0);
   hold_x_ = arc_.rx_mm.get();
   hold_y_ = arc_.ry_mm.get();
   return step_ == Step::kBusy && arc_.done.get() && !arc_start.get() && in_position();

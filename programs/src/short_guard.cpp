@@ -7,10 +7,11 @@ void ShortLimits::visit(rt::ParamVisitor& v) {
           {.unit = "",
            .description = "the Td window reads short at this fraction of shorted pulses",
            .range = rt::open_closed(0.0, 1.0)});
-  v.param("short_retracts_max", short_retracts_max,
-          {.unit = "",
-           .description = "retracts without progress allowed within the window; one more: alarm 150",
-           .range = rt::closed(1, RetractBudget::kMaxRetracts)});
+  v.param(
+      "short_retracts_max", short_retracts_max,
+      {.unit = "",
+       .description = "retracts without progress allowed within the window; one more: alarm 150",
+       .range = rt::closed(1, RetractBudget::kMaxRetracts)});
   v.param("short_retracts_window", short_retracts_window,
           {.unit = "s",
            .description = "the time over which short retracts are counted",

@@ -27,12 +27,14 @@ void WallFinishParams::visit(rt::ParamVisitor& v) {
           {.unit = "",
            .description = "revolutions at the final radius before returning to the centre",
            .range = rt::kNonNegative});
-  v.param("centre_tol_mm", centre_tol_mm,
-          {.unit = "mm", .description = "BACK ends within this of the centre", .range = rt::kPositive});
-  v.param("no_spark_timeout", no_spark_timeout,
-          {.unit = "s",
-           .description = "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
-           .range = rt::kNonNegative});
+  v.param(
+      "centre_tol_mm", centre_tol_mm,
+      {.unit = "mm", .description = "BACK ends within this of the centre", .range = rt::kPositive});
+  v.param(
+      "no_spark_timeout", no_spark_timeout,
+      {.unit = "s",
+       .description = "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
+       .range = rt::kNonNegative});
   shorts.visit(v);
 }
 
@@ -58,10 +60,10 @@ WallFinish::WallFinish()
     l->set_params(lp);
   }
   blocks::ShortRetractParams rp;
-  rp.short_cycles = 5;             // with td.window: the detection window
-  rp.max_tries = 1000;             // the retract budget is this program's
-  rp.retract_distance_mm = 0.2;    // along the contour
-  rp.retract_speed_mm_s = 2.0;     // within the loops' 5 mm/s
+  rp.short_cycles = 5;           // with td.window: the detection window
+  rp.max_tries = 1000;           // the retract budget is this program's
+  rp.retract_distance_mm = 0.2;  // along the contour
+  rp.retract_speed_mm_s = 2.0;   // within the loops' 5 mm/s
   rp.resume_speed_mm_s = 1.0;
   retract_.set_params(rp);
 }
@@ -331,8 +333,8 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     } else {
       // Slew the reference radius toward its target, then place the reference point.
       const double slew = params_.radial_speed_mm_s * dt;
-      rho_ = rho_ < rho_target ? std::min(rho_ + slew, rho_target)
-                               : std::max(rho_ - slew, rho_target);
+      rho_ =
+          rho_ < rho_target ? std::min(rho_ + slew, rho_target) : std::max(rho_ - slew, rho_target);
       xr = x0_ + rho_ * std::cos(theta_);
       yr = y0_ + rho_ * std::sin(theta_);
     }

@@ -22,8 +22,7 @@ class PrefixedPins final : public PinVisitor {
 // Forwards a child's parameters with "<child>." in front of each name (non-RT).
 class PrefixedParams final : public ParamVisitor {
  public:
-  PrefixedParams(const std::string& prefix, ParamVisitor& inner)
-      : prefix_(prefix), inner_(inner) {}
+  PrefixedParams(const std::string& prefix, ParamVisitor& inner) : prefix_(prefix), inner_(inner) {}
 
  protected:
   void on_param(std::string_view name, ParamRef ref, ParamSpec spec) override {

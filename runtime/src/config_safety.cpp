@@ -30,10 +30,9 @@ void Parser::parse_safety_axis(const Value& v, const MachineSpec& machine, Safet
   }
   if (const Field* f = r_.require(*m, "name")) {
     if (auto s = r_.string(f->value)) {
-      const bool known = s->size() == 1 && std::any_of(machine.axes.begin(), machine.axes.end(),
-                                                       [&](const AxisSpec& a) {
-                                                         return a.name == (*s)[0];
-                                                       });
+      const bool known =
+          s->size() == 1 && std::any_of(machine.axes.begin(), machine.axes.end(),
+                                        [&](const AxisSpec& a) { return a.name == (*s)[0]; });
       if (!known) {
         std::string names;
         for (const AxisSpec& a : machine.axes) {

@@ -225,15 +225,15 @@ void Parser::parse_params_under(const Value& v, const std::string& prefix, int d
       parse_params_under(f.value, key + ".", depth + 1, out);
       continue;
     }
-    if (!r_.scalar(f.value, "a scalar (number, true/false, duration or string), or a map of a "
-                            "child's parameters")) {
+    if (!r_.scalar(f.value,
+                   "a scalar (number, true/false, duration or string), or a map of a "
+                   "child's parameters")) {
       continue;
     }
     const auto same = [&](const ParamSetting& s) { return s.key == key; };
     if (const auto it = std::find_if(out.begin(), out.end(), same); it != out.end()) {
       r_.error(f.key_loc, v.path,
-               "parameter '" + key + "' is set twice (first at line " +
-                   line_of(it->key_loc) + ")");
+               "parameter '" + key + "' is set twice (first at line " + line_of(it->key_loc) + ")");
       continue;
     }
     out.push_back(

@@ -508,8 +508,7 @@ class RuntimeBuilder {
     VariableRegistry& reg = rt_->variables_;
     for (const NameRef& n : rs.variables) {
       if (auto t = retainable(n)) {
-        vars.push_back({n.name, t->second,
-                        [&reg, var = t->first, type = t->second]() {
+        vars.push_back({n.name, t->second, [&reg, var = t->first, type = t->second]() {
                           return read_retained(reg, *var, type);
                         }});
       }

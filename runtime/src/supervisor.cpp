@@ -55,10 +55,10 @@ void Supervisor::condition(bool active, bool& raised, const Alarm& alarm) noexce
 void Supervisor::check_machine(TimePoint now) noexcept {
   if (electrode_mm_ != nullptr) {
     const double left = electrode_mm_->get();
-    condition(!(left > electrode_margin_mm_), electrode_raised_,
-              make_alarm(AlarmCode::kElectrodeUsedUp, AlarmSeverity::kFault, now,
-                         "safety.electrode", "electrode used up: its length left is at the margin",
-                         left));
+    condition(
+        !(left > electrode_margin_mm_), electrode_raised_,
+        make_alarm(AlarmCode::kElectrodeUsedUp, AlarmSeverity::kFault, now, "safety.electrode",
+                   "electrode used up: its length left is at the margin", left));
   }
   if (wire_broken_ != nullptr) {
     condition(wire_broken_->get(), wire_raised_,
@@ -101,8 +101,8 @@ void Supervisor::check_axis(Axis& a, TimePoint now, bool track) noexcept {
   const bool outside = is_outside(a, x);
   if (outside) {
     a.limit_raised = true;
-    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now,
-                              a.source.c_str(), "soft limit: the axis is outside its range", x));
+    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now, a.source.c_str(),
+                              "soft limit: the axis is outside its range", x));
   }
 }
 
@@ -117,8 +117,7 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
     v = std::clamp(v, -lim.v_max_mm_s, lim.v_max_mm_s);
   }
   condition(too_fast, a.speed_raised,
-            make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kWarning, now,
-                       a.speed_source.c_str(),
+            make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kWarning, now, a.speed_source.c_str(),
                        "soft limit: velocity command above v_max_mm_s clamped", requested));
 
   // A command the axis could not stop from inside the range is cut to one it can.
@@ -130,8 +129,7 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
   }
   const bool outside = is_outside(a, x);
   if (refused) {
-    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now,
-                              a.source.c_str(),
+    machine_.raise(make_alarm(AlarmCode::kSoftLimit, AlarmSeverity::kFault, now, a.source.c_str(),
                               "soft limit: a velocity command beyond the range was refused",
                               requested));
     a.limit_raised = true;

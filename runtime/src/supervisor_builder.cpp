@@ -67,8 +67,8 @@ std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
         typed_pin<bool>(resolve(n), PinDir::kOutput, n, "wire_break", diag));
   }
   for (const NameRef& n : spec.generator) {
-    setup.generator.push_back(
-        static_cast<Input<bool>*>(typed_pin<bool>(resolve(n), PinDir::kInput, n, "generator", diag)));
+    setup.generator.push_back(static_cast<Input<bool>*>(
+        typed_pin<bool>(resolve(n), PinDir::kInput, n, "generator", diag)));
   }
   if (diag.diagnostics().size() != errors_before) {
     return nullptr;

@@ -24,8 +24,8 @@ std::string list_row(const Variable& v) {
                     std::string(v.type_name()) + "\t" + or_dash(v.unit) + "\t" +
                     (v.owner != nullptr ? v.owner->name() : std::string("-"));
   if (v.kind == VarKind::kParam) {
-    row += "\t" + or_dash(v.range) + "\t" + (v.load_time_only ? "load-time" : "runtime") +
-           "\t" + or_dash(v.description);
+    row += "\t" + or_dash(v.range) + "\t" + (v.load_time_only ? "load-time" : "runtime") + "\t" +
+           or_dash(v.description);
   }
   return row;
 }

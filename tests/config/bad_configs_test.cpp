@@ -108,15 +108,14 @@ TEST_P(BadConfigCheck, edmplc_check_reports_it_and_exits_2) {
   const BadCase& c = GetParam();
   ASSERT_GT(c.line, 0) << c.path;
   // A hang is a failure ("no exit after 20 s"), not a stuck test run.
-  const edm::apps::RunResult r = edm::apps::run(
-      {EDM_EDMPLC_PATH, "--check", "--config", c.path}, {}, std::chrono::seconds(20));
+  const edm::apps::RunResult r = edm::apps::run({EDM_EDMPLC_PATH, "--check", "--config", c.path},
+                                                {}, std::chrono::seconds(20));
   EXPECT_EQ(r.exit_code, 2) << r.error << r.out;  // r.out: stdout and stderr together
   const std::string where =
       c.path + ":" + std::to_string(c.line) + ":" + std::to_string(c.col) + ":";
-  EXPECT_NE(r.out.find(where), std::string::npos) << "expected '" << where << "' in:\n"
-                                                     << r.out;
+  EXPECT_NE(r.out.find(where), std::string::npos) << "expected '" << where << "' in:\n" << r.out;
   EXPECT_NE(r.out.find(c.message), std::string::npos) << "expected '" << c.message << "' in:\n"
-                                                         << r.out;
+                                                      << r.out;
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, BadConfigCheck, ::testing::ValuesIn(cases()), case_name);

@@ -35,8 +35,7 @@ struct ContactRun {
   std::int64_t run_length{0};
   std::int64_t first_retract_cycle{-1};
 
-  std::int64_t short_cycles{
-      rig.drill.read_param(param_index(rig.drill, "retract.short_cycles")).i};
+  std::int64_t short_cycles{rig.drill.read_param(param_index(rig.drill, "retract.short_cycles")).i};
 
   ContactRun() {
     rig.comp.set(false);
@@ -61,8 +60,7 @@ struct ContactRun {
     rig.ctx.release += 1ms;
     const bool reads_short = rig.out<bool>("gap_short");
     if (reads_short) {
-      EXPECT_GE(rig.vz(), 0.0) << "fed toward the work while the gap reads short, cycle "
-                               << cycles;
+      EXPECT_GE(rig.vz(), 0.0) << "fed toward the work while the gap reads short, cycle " << cycles;
       if (++run_length == short_cycles && first_short_cycle < 0) first_short_cycle = cycles;
     } else {
       run_length = 0;

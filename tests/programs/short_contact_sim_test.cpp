@@ -37,12 +37,12 @@ std::string slurp(const std::string& p) {
 struct ContactOutcome {
   bool done{false};
   bool alarm150{false};
-  double depth_mm{0.0};         // io.depth_mm at the end
-  std::int64_t retracts{0};     // cycle.drill.short_retracts
-  double lost_s{0.0};           // cycle.drill.short_time_s
-  std::int64_t latency{-1};     // cycles from the detection to the retract (first contact)
-  std::int64_t short_cycles{0}; // cycles with gap_short
-  std::int64_t violations{0};   // cycles fed toward the work while the gap read short
+  double depth_mm{0.0};          // io.depth_mm at the end
+  std::int64_t retracts{0};      // cycle.drill.short_retracts
+  double lost_s{0.0};            // cycle.drill.short_time_s
+  std::int64_t latency{-1};      // cycles from the detection to the retract (first contact)
+  std::int64_t short_cycles{0};  // cycles with gap_short
+  std::int64_t violations{0};    // cycles fed toward the work while the gap read short
   double z_alarm{0.0}, z_end{0.0};
   bool gen_on_end{true};
   double vz_end{1.0};
@@ -69,7 +69,8 @@ ContactOutcome run(int seed, const std::string& sim_extra, double limit_s = 200.
   ContactOutcome o;
   std::int64_t detected = -1;  // gap_short for retract.short_cycles consecutive cycles
   std::int64_t run_length = 0;
-  const auto needed = static_cast<std::int64_t>(vars.read("cycle.drill.retract.short_cycles").value());
+  const auto needed =
+      static_cast<std::int64_t>(vars.read("cycle.drill.retract.short_cycles").value());
   const auto cycles = static_cast<std::int64_t>(limit_s * 1000.0);
   for (std::int64_t k = 0; k < cycles; ++k) {
     const rt::TimePoint release{1ms * k};
@@ -109,8 +110,9 @@ ContactOutcome run(int seed, const std::string& sim_extra, double limit_s = 200.
 }
 
 const std::string kTransient = ", contact_at_depth_mm: 8, contact_clear_um: 20";
-const std::string kPersistent = ", contact_at_depth_mm: 8, contact_clear_um: 20, "
-                                "contact_persistent: true";
+const std::string kPersistent =
+    ", contact_at_depth_mm: 8, contact_clear_um: 20, "
+    "contact_persistent: true";
 
 class ContactSeeds : public ::testing::TestWithParam<int> {};
 
@@ -184,8 +186,8 @@ TEST(ShortFigures, TwentySeeds) {
       "[shorts]   depth error without contact %+.1f +- %.1f um, with %+.1f +- %.1f um\n"
       "[shorts]   persistent contact: alarm 150 after exactly N = %lld retracts on %d/20 seeds\n"
       "[shorts]   cycles fed toward the work while reading short: %d\n",
-      max_latency, mean(lost), sd(lost), mean(err_plain), sd(err_plain), mean(err_hit),
-      sd(err_hit), static_cast<long long>(programs::DeepHoleDrillParams{}.shorts.short_retracts_max),
+      max_latency, mean(lost), sd(lost), mean(err_plain), sd(err_plain), mean(err_hit), sd(err_hit),
+      static_cast<long long>(programs::DeepHoleDrillParams{}.shorts.short_retracts_max),
       alarms_exact, violations);
   EXPECT_EQ(violations, 0);
   EXPECT_EQ(alarms_exact, 20);

@@ -51,11 +51,11 @@ TEST(RetainCrc, a_file_written_by_the_hand_written_crc_still_loads) {
   const TempDir dir;
   const std::string path = dir.file("old.retain");
   write_file(path,
-              "edmplc-retain 1\n"
-              "drill.counter.holes LINT 17\n"
-              "drill.electrode.length_left LREAL 123.456\n"
-              "drill.seq.done BOOL 1\n"
-              "end 5ad6925c\n");
+             "edmplc-retain 1\n"
+             "drill.counter.holes LINT 17\n"
+             "drill.electrode.length_left LREAL 123.456\n"
+             "drill.seq.done BOOL 1\n"
+             "end 5ad6925c\n");
   const RetainLoadResult r = load_retain_file(path);
   EXPECT_EQ(r.status, RetainLoadStatus::kLoaded) << r.warning;
   EXPECT_EQ(r.values, sample_map());

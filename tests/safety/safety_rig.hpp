@@ -60,8 +60,8 @@ struct SafetyRig {
       sim::register_sim_driver(r.second);
       return r;
     }();
-    runtime = rt::Runtime::build(rt::parse_config_text(yaml, path), registries.first,
-                                 registries.second);
+    runtime =
+        rt::Runtime::build(rt::parse_config_text(yaml, path), registries.first, registries.second);
     runtime->machine().command(rt::MachineCommand::kPowerOn);
     std::vector<rt::Task*> tasks(runtime->tasks().size());
     std::transform(runtime->tasks().begin(), runtime->tasks().end(), tasks.begin(),

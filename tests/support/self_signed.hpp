@@ -24,8 +24,9 @@ inline std::string make_self_signed(const std::string& key, const std::string& c
   if (!made.failure("openssl").empty()) return {};
   namespace fs = std::filesystem;
   fs::permissions(key, fs::perms::owner_read | fs::perms::owner_write, fs::perm_options::replace);
-  const auto fp = edm::apps::run({"openssl", "x509", "-in", cert, "-noout", "-fingerprint", "-sha256"},
-                                 quiet, std::chrono::seconds(60));
+  const auto fp =
+      edm::apps::run({"openssl", "x509", "-in", cert, "-noout", "-fingerprint", "-sha256"}, quiet,
+                     std::chrono::seconds(60));
   const auto eq = fp.out.find('=');
   if (!fp.failure("openssl").empty() || eq == std::string::npos) return {};
   std::string fingerprint = fp.out.substr(eq + 1);

@@ -201,8 +201,8 @@ void Process::start(const std::vector<std::string>* argv, const std::function<vo
     ok = (err_fd = open_file(o.err_file)) >= 0;
   }
   const auto close_all = [&] {
-    for (int* fd : {&in_pipe[0], &in_pipe[1], &out_pipe[0], &out_pipe[1], &exec_pipe[0],
-                    &exec_pipe[1]}) {
+    for (int* fd :
+         {&in_pipe[0], &in_pipe[1], &out_pipe[0], &out_pipe[1], &exec_pipe[0], &exec_pipe[1]}) {
       close_fd(*fd);
     }
     if (o.in == Stream::kNull) close_fd(in_fd);

@@ -151,7 +151,6 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   rt::Output<bool> hold;
 
  private:
-
   WindowRing<PathPoint> history_;  // allocated in configure(); at(0) is the oldest point
   double dt_s_{0.0};
   State state_{State::kIdle};

@@ -106,7 +106,7 @@ struct DeepHoleDrillParams {
   double breakthrough_min_mm{0.5};        // [mm] no breakthrough before this depth
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
   // Short circuits (seed 004: a short reads as feedback ≈ 0, so it must back the electrode off).
-  ShortLimits shorts{};  // short_ratio_limit, short_retracts_max, short_retracts_window
+  ShortLimits shorts{};          // short_ratio_limit, short_retracts_max, short_retracts_window
   double short_backoff_mm{1.0};  // [mm] Z backs off this far on alarm 150, then holds
 
   void visit(rt::ParamVisitor& v);
@@ -144,9 +144,9 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<bool> breakthrough;
   rt::Output<bool> reset_wear;
   rt::Output<double> vz_servo_cmd_mm_s;
-  rt::Output<bool> gap_short;           // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable;      // the short retract records and acts (DRILL only)
-  rt::Output<double> retract_vff_mm_s;  // feed-forward of the retract setpoint into zloop
+  rt::Output<bool> gap_short;               // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable;          // the short retract records and acts (DRILL only)
+  rt::Output<double> retract_vff_mm_s;      // feed-forward of the retract setpoint into zloop
   rt::Output<std::int64_t> short_retracts;  // retracts in this hole
   rt::Output<double> short_time_s;          // time spent retracting and resuming in this hole
 

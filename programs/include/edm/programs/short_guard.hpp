@@ -58,7 +58,7 @@ class RetractBudget {
 };
 
 struct ShortLimits {
-  double short_ratio_limit{0.9};  // the Td window reads short at this fraction of shorts
+  double short_ratio_limit{0.9};       // the Td window reads short at this fraction of shorts
   std::int64_t short_retracts_max{3};  // retracts without progress allowed within the window
   rt::Duration short_retracts_window{std::chrono::seconds(10)};
 

@@ -110,8 +110,8 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<double> orbit_r0_mm, orbit_final_mm;
   rt::Output<double> x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s;
   rt::Output<bool> loop_enable;
-  rt::Output<bool> gap_short;       // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable;  // the short retract records the contour (ORBIT only)
+  rt::Output<bool> gap_short;               // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable;          // the short retract records the contour (ORBIT only)
   rt::Output<std::int64_t> short_retracts;  // retracts in this cycle
 
  protected:

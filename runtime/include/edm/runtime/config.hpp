@@ -99,7 +99,7 @@ enum class RetractDirection : std::int8_t { kMinus = -1, kNone = 0, kPlus = 1 };
 /// `machine.safety.axes[i]`: an axis of `machine.axes` whose process-image command the
 /// supervisor checks (docs/config.md, docs/safety.md).
 struct SafetyAxisSpec {
-  char name{'\0'};  // 'X', 'Y' or 'Z'; '\0' until read
+  char name{'\0'};                      // 'X', 'Y' or 'Z'; '\0' until read
   NameRef velocity;                     // io.<LREAL input>, mm/s
   NameRef position;                     // io.<LREAL output>, mm
   std::optional<double> ferror_mm;      // following-error limit at v_max; absent: not checked

@@ -39,7 +39,8 @@ struct JobProgress {
   std::size_t block_index{0};  // index of the block being executed (= count when finished)
   std::size_t block_count{0};  // blocks in the loaded program
   std::int32_t line{0};        // G-code line of the block being executed
-  std::uint32_t program_id{0};  // the id the program was loaded under (bridge: its CRC-32); 0 = none
+  std::uint32_t program_id{
+      0};  // the id the program was loaded under (bridge: its CRC-32); 0 = none
 };
 
 class JobStore {

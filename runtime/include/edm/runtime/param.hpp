@@ -101,9 +101,9 @@ inline constexpr Range kNonNegative = at_least(0.0);
 struct ParamSpec {
   std::string_view unit{};         // "mm/s", "us", "" (dimensionless)
   std::string_view description{};  // one line, for listings and docs/blocks.md
-  Range range{};                 // checked for INT, REAL and TIME (seconds) fields
-  bool finite{true};             // REAL: NaN and ±inf are refused
-  bool load_time_only{false};    // a runtime write is refused (sizes buffers, precomputed)
+  Range range{};                   // checked for INT, REAL and TIME (seconds) fields
+  bool finite{true};               // REAL: NaN and ±inf are refused
+  bool load_time_only{false};      // a runtime write is refused (sizes buffers, precomputed)
 };
 using ParamInfo = ParamSpec;  // the older name, kept for visitors outside the runtime
 

@@ -20,8 +20,8 @@
 // above a force: get() returns the supervised value, then the forced one, then the wire.
 // requested() is what the input would read without the supervisor.
 //
-// RT-safe: get(), set(). Non-RT: connect(), follow(), set_constant(). force()/unforce() may be called from
-// any thread. Pins are neither copyable nor movable (wires point at them).
+// RT-safe: get(), set(). Non-RT: connect(), follow(), set_constant(). force()/unforce() may be
+// called from any thread. Pins are neither copyable nor movable (wires point at them).
 
 #include <atomic>
 #include <cstdint>

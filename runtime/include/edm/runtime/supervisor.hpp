@@ -47,8 +47,8 @@ namespace edm::rt {
 
 /// One supervised axis, resolved to the driver's pins by the runtime builder.
 struct SupervisedAxis {
-  machining::AxisLimits limits;      // range, v_max, a_max
-  Input<double>* velocity{nullptr};  // %Q: the command, mm/s
+  machining::AxisLimits limits;             // range, v_max, a_max
+  Input<double>* velocity{nullptr};         // %Q: the command, mm/s
   const Output<double>* position{nullptr};  // %I: the actual position, mm
   double ferror_mm{0.0};                    // 0: no following-error check
   double min_ferror_mm{0.0};
@@ -108,7 +108,7 @@ class Supervisor {
   void condition(bool active, bool& raised, const Alarm& alarm) noexcept;
 
   Machine& machine_;
-  std::vector<Axis> axes_;  // sized once in the constructor: sources stay put
+  std::vector<Axis> axes_;       // sized once in the constructor: sources stay put
   std::vector<double> command_;  // per axis, this cycle (preallocated)
   const Output<double>* electrode_mm_;
   double electrode_margin_mm_;

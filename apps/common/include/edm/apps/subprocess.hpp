@@ -35,7 +35,7 @@ struct SpawnOptions {
   Stream err{Stream::kStdout};
   std::filesystem::path out_file;
   std::filesystem::path err_file;
-  std::vector<std::string> unset_env;                        // removed from the inherited environment
+  std::vector<std::string> unset_env;  // removed from the inherited environment
   std::vector<std::pair<std::string, std::string>> set_env;  // then set
   std::optional<int> cpu;  // pin the child (and every thread it starts) to this CPU before exec
 };
