@@ -22,11 +22,6 @@ ButterworthLowPass::Coefficients ButterworthLowPass::design(double wn) noexcept 
   return c;
 }
 
-void ButterworthLowPass::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-}
-
 std::vector<rt::ParamError> ButterworthLowPass::configure(const rt::BlockSetup& /*setup*/) {
   c_ = design(params_.cutoff);
   return {};

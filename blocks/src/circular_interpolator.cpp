@@ -9,31 +9,6 @@ namespace {
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 }  // namespace
 
-void CircularInterpolator::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start);
-  v.input("cw", cw);
-  v.input("i_mm", i_mm, "mm");
-  v.input("j_mm", j_mm, "mm");
-  v.input("full_circle", full_circle);
-  v.input("turns", turns);
-  v.input("ex_mm", ex_mm, "mm");
-  v.input("ey_mm", ey_mm, "mm");
-  v.input("feed_mm_min", feed_mm_min, "mm/min");
-  v.input("override", feed_override);
-  v.input("hold", hold);
-  v.input("load", load);
-  v.input("load_x_mm", load_x_mm, "mm");
-  v.input("load_y_mm", load_y_mm, "mm");
-  v.output("rx_mm", rx_mm, "mm");
-  v.output("ry_mm", ry_mm, "mm");
-  v.output("vx_mm_s", vx_mm_s, "mm/s");
-  v.output("vy_mm_s", vy_mm_s, "mm/s");
-  v.output("angle_rad", angle_rad, "rad");
-  v.output("swept_rad", swept_rad, "rad");
-  v.output("busy", busy);
-  v.output("done", done);
-}
-
 void CircularInterpolator::activate() noexcept {
   x_ = params_.x0_mm;
   y_ = params_.y0_mm;

@@ -13,19 +13,6 @@ constexpr std::int64_t spread(std::int64_t i, std::int64_t a, std::int64_t total
 
 }  // namespace
 
-void DischargeStateCounter::visit_pins(rt::PinVisitor& v) {
-  v.input("n_open", n_open_, "pulses");
-  v.input("n_normal", n_normal_, "pulses");
-  v.input("n_short", n_short_, "pulses");
-  v.input("n_transient_arc", n_transient_arc_, "pulses");
-  v.input("n_stable_arc", n_stable_arc_, "pulses");
-  v.output("open_count", open_count_, "pulses");
-  v.output("normal_count", normal_count_, "pulses");
-  v.output("short_count", short_count_, "pulses");
-  v.output("latches", latches_);
-  v.output("data_ready", data_ready_);
-}
-
 void DischargeStateCounter::activate() noexcept {
   reg_[0] = reg_[1] = reg_[2] = 0;
   since_latch_ = 0;

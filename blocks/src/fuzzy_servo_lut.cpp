@@ -11,12 +11,6 @@ constexpr int kWindow = 32;  // pulses in the seed-003 shift registers
 
 }  // namespace
 
-void FuzzyServoLUT::visit_pins(rt::PinVisitor& v) {
-  v.input("open_count", open_count_, "pulses");
-  v.input("short_count", short_count_, "pulses");
-  v.output("v_mm_s", v_mm_s_, "mm/s");
-}
-
 std::vector<rt::ParamError> FuzzyServoLUT::configure(const rt::BlockSetup& /*setup*/) {
   std::vector<rt::ParamError> errs = rt::validate_params(params_);
   if (!errs.empty()) {

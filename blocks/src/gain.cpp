@@ -4,11 +4,6 @@
 
 namespace edm::blocks {
 
-void Gain::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-}
-
 rt::BlockStatus Gain::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double y = params_.k * in_.get() + params_.offset;
   // One check covers a non-finite input and an overflowing product.

@@ -15,17 +15,6 @@ std::vector<rt::ParamError> GapControllerPParams::validate() const {
   return errs;
 }
 
-void GapControllerP::visit_pins(rt::PinVisitor& v) {
-  v.input("td_us", td_us, "us");
-  v.input("valid", valid);
-  v.input("enable", enable);
-  v.input("hold", hold);
-  v.input("retract", retract);
-  v.input("tdr_us", tdr_us, "us");
-  v.output("vz_mm_s", vz_mm_s, "mm/s");
-  v.output("saturated", saturated);
-}
-
 void GapControllerP::activate() noexcept {
   vz_mm_s.set(0.0);
   saturated.set(false);

@@ -69,14 +69,6 @@ GreyPredictorGM11::Fit GreyPredictorGM11::predict(const double* x, std::size_t n
   return f;
 }
 
-void GreyPredictorGM11::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-  v.output("c", c_, "1");
-  v.output("b", b_);
-  v.output("valid", valid_);
-}
-
 std::vector<rt::ParamError> GreyPredictorGM11::configure(const rt::BlockSetup& /*setup*/) {
   return configure_checked(params_, [this] {
     window_.allocate(static_cast<std::size_t>(params_.window));

@@ -13,12 +13,6 @@ std::vector<rt::ParamError> IntegratorParams::validate() const {
   return errs;
 }
 
-void Integrator::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.input("reset", reset_);
-  v.output("out", out_);
-}
-
 std::vector<rt::ParamError> Integrator::configure(const rt::BlockSetup& setup) {
   dt_s_ = rt::to_seconds(setup.period);
   compute_gain();

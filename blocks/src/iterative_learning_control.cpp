@@ -31,23 +31,6 @@ IterativeLearningControl::Gains IterativeLearningControl::gains(
   return g;
 }
 
-void IterativeLearningControl::visit_pins(rt::PinVisitor& v) {
-  v.input("y", y_);
-  v.input("y_ref", y_ref_);
-  v.input("cycle_start", cycle_start_);
-  v.input("track", track_, "position unit");
-  v.input("enable", enable_);
-  v.output("u", u_out_);
-  v.output("mean_error", mean_error_);
-  v.output("x", x_out_);
-  v.output("l1", l1_);
-  v.output("l2", l2_);
-  v.output("l3", l3_);
-  v.output("sample", sample_, "samples");
-  v.output("cycles", cycles_);
-  v.output("active", active_);
-}
-
 std::vector<rt::ParamError> IterativeLearningControl::configure(const rt::BlockSetup& /*setup*/) {
   return configure_checked(params_, [this] {
     u_.assign(static_cast<std::size_t>(params_.n_samples), params_.u_initial);

@@ -29,19 +29,6 @@ std::vector<rt::ParamError> JumpCycleParams::validate() const {
   return errs;
 }
 
-void JumpCycle::visit_pins(rt::PinVisitor& v) {
-  v.input("vz_in_mm_s", vz_in_, "mm/s");
-  v.input("z_mm", z_mm_, "mm");
-  v.input("enable", enable_);
-  v.output("vz_out_mm_s", vz_out_, "mm/s");
-  v.output("z_hold_mm", z_hold_, "mm");
-  v.output("jumping", jumping_);
-  v.output("settling", settling_);
-  v.output("servo_part", servo_part_);
-  v.output("cycle_start", cycle_start_);
-  v.output("jumps", jumps_);
-}
-
 std::vector<rt::ParamError> JumpCycle::configure(const rt::BlockSetup& setup) {
   task_period_ = setup.period;
   params_changed();

@@ -13,12 +13,6 @@ std::vector<rt::ParamError> LimiterParams::validate() const {
   return errs;
 }
 
-void Limiter::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-  v.output("limited", limited_);
-}
-
 std::vector<rt::ParamError> Limiter::configure(const rt::BlockSetup& setup) {
   dt_s_ = rt::to_seconds(setup.period);
   compute_step();

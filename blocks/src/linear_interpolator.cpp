@@ -4,28 +4,6 @@
 
 namespace edm::blocks {
 
-void LinearInterpolator::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start);
-  v.input("lx_mm", lx_mm, "mm");
-  v.input("ly_mm", ly_mm, "mm");
-  v.input("lz_mm", lz_mm, "mm");
-  v.input("feed_mm_min", feed_mm_min, "mm/min");
-  v.input("override", feed_override);
-  v.input("hold", hold);
-  v.input("load", load);
-  v.input("load_x_mm", load_x_mm, "mm");
-  v.input("load_y_mm", load_y_mm, "mm");
-  v.input("load_z_mm", load_z_mm, "mm");
-  v.output("rx_mm", rx_mm, "mm");
-  v.output("ry_mm", ry_mm, "mm");
-  v.output("rz_mm", rz_mm, "mm");
-  v.output("vx_mm_s", vx_mm_s, "mm/s");
-  v.output("vy_mm_s", vy_mm_s, "mm/s");
-  v.output("vz_mm_s", vz_mm_s, "mm/s");
-  v.output("busy", busy);
-  v.output("done", done);
-}
-
 void LinearInterpolator::activate() noexcept {
   pos_ = {params_.x0_mm, params_.y0_mm, params_.z0_mm};
   p0_ = pos_;

@@ -6,11 +6,6 @@
 
 namespace edm::blocks {
 
-void LowPass::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-}
-
 std::vector<rt::ParamError> LowPass::configure(const rt::BlockSetup& setup) {
   period_ = setup.period;
   compute_alpha();

@@ -15,12 +15,6 @@ void MovingAverage::CompensatedSum::add(double x) noexcept {
   lo += e;
 }
 
-void MovingAverage::visit_pins(rt::PinVisitor& v) {
-  v.input("in", in_);
-  v.output("out", out_);
-  v.output("full", full_);
-}
-
 std::vector<rt::ParamError> MovingAverage::configure(const rt::BlockSetup& /*setup*/) {
   return configure_checked(params_, [this] {
     window_.allocate(static_cast<std::size_t>(params_.window));

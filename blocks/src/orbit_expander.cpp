@@ -5,22 +5,6 @@
 
 namespace edm::blocks {
 
-void OrbitExpander::visit_pins(rt::PinVisitor& v) {
-  v.input("start", start);
-  v.input("r0_mm", r0_mm, "mm");
-  v.input("final_radius_mm", final_radius_mm, "mm");
-  v.input("enable", enable);
-  v.input("td_us", td_us, "us");
-  v.input("valid", valid);
-  v.input("rev_pulse", rev_pulse);
-  v.output("radius_mm", radius_mm, "mm");
-  v.output("dr_mm", dr_mm, "mm");
-  v.output("tdm_us", tdm_us, "us");
-  v.output("revolutions", revolutions);
-  v.output("busy", busy);
-  v.output("done", done);
-}
-
 void OrbitExpander::activate() noexcept {
   radius_mm_ = 0.0;
   final_mm_ = 0.0;

@@ -4,14 +4,6 @@
 
 namespace edm::blocks {
 
-void PolaritySwitch::visit_pins(rt::PinVisitor& v) {
-  v.input("request_positive", request_positive);
-  v.input("generator_on_request", generator_on_request);
-  v.output("polarity_positive", polarity_positive);
-  v.output("generator_on", generator_on);
-  v.output("switching", switching);
-}
-
 void PolaritySwitch::activate() noexcept {
   polarity_ = params_.initial_positive;
   gen_on_ = false;

@@ -7,19 +7,6 @@
 
 namespace edm::blocks {
 
-void PositionLoop::visit_pins(rt::PinVisitor& v) {
-  v.input("x_ref_mm", x_ref_mm, "mm");
-  v.input("v_ff_mm_s", v_ff_mm_s, "mm/s");
-  v.input("x_mm", x_mm, "mm");
-  v.input("enable", enable);
-  v.input("reset", reset);
-  v.output("v_cmd_mm_s", v_cmd_mm_s, "mm/s");
-  v.output("error_mm", error_mm, "mm");
-  v.output("in_position", in_position);
-  v.output("following_error_fault", following_error_fault);
-  v.output("saturated", saturated);
-}
-
 std::vector<rt::ParamError> PositionLoop::configure(const rt::BlockSetup& setup) {
   dt_s_ = rt::to_seconds(setup.period);
   activate();

@@ -7,16 +7,6 @@
 
 namespace edm::blocks {
 
-void Select::visit_pins(rt::PinVisitor& v) {
-  v.input("g", g_);
-  v.input("in0", in0_);
-  v.input("in1", in1_);
-  v.output("out", out_);
-  v.output("active0", active0_);
-  v.output("active1", active1_);
-  v.output("transferring", transferring_);
-}
-
 std::vector<rt::ParamError> Select::configure(const rt::BlockSetup& setup) {
   dt_s_ = rt::to_seconds(setup.period);
   return task_period_errors(setup.period);

@@ -50,22 +50,6 @@ double SelfTuningFuzzyPI::rule_output(double e_scaled, double ce_scaled) noexcep
   return den > 0.0 ? num / den : 0.0;  // den > 0 always: the terms cover [−3, 3]
 }
 
-void SelfTuningFuzzyPI::visit_pins(rt::PinVisitor& v) {
-  v.input("rab_p", rab_p_, "1");
-  v.input("rab_f", rab_f_, "1");
-  v.input("rab_ref", rab_ref_, "1");
-  v.input("enable", enable_);
-  v.input("track_arc_off_time_us", track_u_, "us");
-  v.input("track_servo_ref_v", track_v_, "V");
-  v.output("arc_off_time_us", arc_off_time_us_, "us");
-  v.output("servo_ref_v", servo_ref_v_, "V");
-  v.output("du", du_, "1");
-  v.output("phi", phi_, "1");
-  v.output("psi", psi_, "1");
-  v.output("error", error_, "1");
-  v.output("saturated", saturated_);
-}
-
 void SelfTuningFuzzyPI::activate() noexcept {
   const auto& p = params_;
   u_ = std::min(std::max(p.u_initial_us, p.u_min_us), p.u_max_us);

@@ -22,28 +22,6 @@ std::vector<rt::ParamError> SelfTuningRegulatorParams::validate() const {
   return errs;
 }
 
-void SelfTuningRegulator::visit_pins(rt::PinVisitor& v) {
-  v.input("ratio_normal", ratio_normal_, "1");
-  v.input("ratio_transient_arc", ratio_transient_arc_, "1");
-  v.input("ratio_stable_arc", ratio_stable_arc_, "1");
-  v.input("ratio_short", ratio_short_, "1");
-  v.input("y_rv_ref", y_rv_ref_, "1");
-  v.input("y_rt_ref", y_rt_ref_, "1");
-  v.input("enable", enable_);
-  v.output("servo_ref_v", servo_ref_v_, "V");
-  v.output("off_time_us", off_time_us_, "us");
-  v.output("u_v", u_v_out_, "1");
-  v.output("y_v", y_v_out_, "1");
-  v.output("y_t", y_t_out_, "1");
-  v.output("y_rv", y_rv_out_, "1");
-  v.output("y_rt", y_rt_out_, "1");
-  v.output("beta01", beta01_, "1");
-  v.output("beta0c", beta0c_, "1");
-  v.output("beta1c", beta1c_, "1");
-  v.output("k1", k1_, "1");
-  v.output("saturated", saturated_);
-}
-
 void SelfTuningRegulator::activate() noexcept {
   const auto& p = params_;
   const double main_init[2] = {p.beta01_init, p.beta0c_init};

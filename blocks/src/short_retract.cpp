@@ -17,24 +17,6 @@ double distance(double ax, double ay, double az, double bx, double by, double bz
 
 }  // namespace
 
-void ShortRetract::visit_pins(rt::PinVisitor& v) {
-  v.input("x_mm", x_mm, "mm");
-  v.input("y_mm", y_mm, "mm");
-  v.input("z_mm", z_mm, "mm");
-  v.input("short_detected", short_detected);
-  v.input("enable", enable);
-  v.input("reset", reset);
-  v.output("active", active);
-  v.output("x_sp_mm", x_sp_mm, "mm");
-  v.output("y_sp_mm", y_sp_mm, "mm");
-  v.output("z_sp_mm", z_sp_mm, "mm");
-  v.output("v_scale", v_scale);
-  v.output("tries", tries);
-  v.output("retracts", retracts);
-  v.output("alarm", alarm);
-  v.output("hold", hold);
-}
-
 std::vector<rt::ParamError> ShortRetract::configure(const rt::BlockSetup& setup) {
   return configure_checked(params_, setup.period, [&] {
     dt_s_ = rt::to_seconds(setup.period);

@@ -11,19 +11,6 @@ constexpr double kNsPerUs = 1000.0;
 
 }  // namespace
 
-void TdDetector::visit_pins(rt::PinVisitor& v) {
-  v.input("td_sum_ns", td_sum_ns, "ns");
-  v.input("td_count", td_count);
-  v.input("n_open", n_open);
-  v.input("n_short", n_short);
-  v.input("n_total", n_total);
-  v.output("td_us", td_us, "us");
-  v.output("td_raw_us", td_raw_us, "us");
-  v.output("open_ratio", open_ratio, "1");
-  v.output("short_ratio", short_ratio, "1");
-  v.output("valid", valid);
-}
-
 std::vector<rt::ParamError> TdDetector::configure(const rt::BlockSetup& /*setup*/) {
   return configure_checked(params_, [this] {
     window_.allocate(static_cast<std::size_t>(params_.window));

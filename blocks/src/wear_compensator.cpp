@@ -14,16 +14,6 @@ std::vector<rt::ParamError> WearCompensatorParams::validate() const {
   return errs;
 }
 
-void WearCompensator::visit_pins(rt::PinVisitor& v) {
-  v.input("vz_in_mm_s", vz_in_mm_s, "mm/s");
-  v.input("wear_ratio", wear_ratio);
-  v.input("enable", enable);
-  v.input("reset_wear", reset_wear);
-  v.output("vz_out_mm_s", vz_out_mm_s, "mm/s");
-  v.output("vd_mm_s", vd_mm_s, "mm/s");
-  v.output("wear_mm", wear_mm, "mm");
-}
-
 std::vector<rt::ParamError> WearCompensator::configure(const rt::BlockSetup& setup) {
   std::vector<rt::ParamError> errs;
   require_task_period(errs, setup.period);

@@ -76,34 +76,6 @@ DeepHoleDrill::DeepHoleDrill()
   zloop_.set_params(zp);
 }
 
-void DeepHoleDrill::visit_own_pins(rt::PinVisitor& v) {
-  pulses.visit(v);
-  v.input("z_mm", z_mm, "mm");
-  v.input("start", start);
-  v.input("depth_mm", depth_mm, "mm");
-  v.input("wear_ratio", wear_ratio);
-  v.input("enable_wear_comp", enable_wear_comp);
-  v.input("tdr_us", tdr_us, "us");
-  v.input("through", through);
-  v.input("hold", hold);
-  v.input("vz_servo_mm_s", vz_servo_mm_s, "mm/s");
-  v.output("vz_cmd_mm_s", vz_cmd_mm_s, "mm/s");
-  v.output("gen_on", gen_on);
-  v.output("state", state);
-  v.output("depth_reached_mm", depth_reached_mm, "mm");
-  v.output("touch_z_mm", touch_z_mm, "mm");
-  v.output("wear_mm", wear_mm, "mm");
-  v.output("done", done);
-  v.output("breakthrough", breakthrough);
-  v.output("reset_wear", reset_wear);
-  v.output("vz_servo_cmd_mm_s", vz_servo_cmd_mm_s, "mm/s");
-  v.output("gap_short", gap_short);
-  v.output("retract_enable", retract_enable);
-  v.output("retract_vff_mm_s", retract_vff_mm_s, "mm/s");
-  v.output("short_retracts", short_retracts);
-  v.output("short_time_s", short_time_s, "s");
-}
-
 std::vector<rt::ParamError> DeepHoleDrill::configure_self(const rt::BlockSetup& setup) {
   machine_ = setup.machine;
   source_name_ = std::string(setup.instance);

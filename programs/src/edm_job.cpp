@@ -43,65 +43,6 @@ EdmJob::EdmJob()
       py_(add_child<blocks::PositionLoop>("py")),
       pz_(add_child<blocks::PositionLoop>("pz")) {}
 
-void EdmJob::visit_own_pins(rt::PinVisitor& v) {
-  pulses.visit(v);
-  v.input("n_normal", n_normal);
-  v.input("n_transient_arc", n_transient_arc);
-  v.input("n_stable_arc", n_stable_arc);
-  v.input("x_mm", x_mm, "mm");
-  v.input("y_mm", y_mm, "mm");
-  v.input("z_mm", z_mm, "mm");
-  v.output("vx_cmd_mm_s", vx_cmd_mm_s, "mm/s");
-  v.output("vy_cmd_mm_s", vy_cmd_mm_s, "mm/s");
-  v.output("vz_cmd_mm_s", vz_cmd_mm_s, "mm/s");
-  v.output("gen_arm", gen_arm);
-  v.output("gen_on", gen_on);
-  v.output("polarity_positive", polarity_positive);
-  v.output("flushing_on", flushing_on);
-  v.output("rotation_on", rotation_on);
-  v.output("on_time_us", on_time_us, "us");
-  v.output("off_time_us", off_time_us, "us");
-  v.output("servo_ref_v", servo_ref_v, "V");
-  v.output("state", state);
-  v.output("block_index", block_index);
-  v.output("line", line);
-  v.output("jobs_finished", jobs_finished);
-  figures_.visit(v);
-  v.output("drill_start", drill_start);
-  v.output("drill_depth_mm", drill_depth_mm, "mm");
-  v.output("wear_ratio", wear_ratio);
-  v.output("tdr_us", tdr_us, "us");
-  v.output("feed_hold", feed_hold);
-  v.output("finish_start", finish_start);
-  v.output("finish_final_offset_mm", finish_final_offset_mm, "mm");
-  v.output("finish_start_offset_mm", finish_start_offset_mm, "mm");
-  v.output("lin_start", lin_start);
-  v.output("lin_hold", lin_hold);
-  v.output("lin_load", lin_load);
-  v.output("lin_lx_mm", lin_lx_mm, "mm");
-  v.output("lin_ly_mm", lin_ly_mm, "mm");
-  v.output("lin_lz_mm", lin_lz_mm, "mm");
-  v.output("lin_feed_mm_min", lin_feed_mm_min, "mm/min");
-  v.output("arc_start", arc_start);
-  v.output("arc_hold", arc_hold);
-  v.output("arc_load", arc_load);
-  v.output("arc_cw", arc_cw);
-  v.output("arc_full_circle", arc_full_circle);
-  v.output("arc_turns", arc_turns);
-  v.output("arc_i_mm", arc_i_mm, "mm");
-  v.output("arc_j_mm", arc_j_mm, "mm");
-  v.output("arc_ex_mm", arc_ex_mm, "mm");
-  v.output("arc_ey_mm", arc_ey_mm, "mm");
-  v.output("arc_feed_mm_min", arc_feed_mm_min, "mm/min");
-  v.output("x_ref_mm", x_ref_mm, "mm");
-  v.output("y_ref_mm", y_ref_mm, "mm");
-  v.output("z_ref_mm", z_ref_mm, "mm");
-  v.output("vx_ff_mm_s", vx_ff_mm_s, "mm/s");
-  v.output("vy_ff_mm_s", vy_ff_mm_s, "mm/s");
-  v.output("vz_ff_mm_s", vz_ff_mm_s, "mm/s");
-  v.output("loop_enable", loop_enable);
-}
-
 std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) {
   std::vector<rt::ParamError> errs;
   machine_ = setup.machine;

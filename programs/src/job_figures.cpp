@@ -5,15 +5,6 @@
 
 namespace edm::programs {
 
-void JobFigures::visit(rt::PinVisitor& v) {
-  v.output("job_time_s", job_time_s, "s");
-  v.output("job_pulses", job_pulses);
-  v.output("job_shorts", job_shorts);
-  v.output("job_arcs", job_arcs);
-  v.output("job_depth_mm", job_depth_mm, "mm");
-  v.output("job_wear_mm", job_wear_mm, "mm");
-}
-
 void JobFigures::begin(rt::TimePoint start) noexcept {
   start_ = start;
   wear_before_block_ = 0.0;

@@ -68,41 +68,6 @@ WallFinish::WallFinish()
   retract_.set_params(rp);
 }
 
-void WallFinish::visit_own_pins(rt::PinVisitor& v) {
-  pulses.visit(v);
-  v.input("x_mm", x_mm, "mm");
-  v.input("y_mm", y_mm, "mm");
-  v.input("start", start);
-  v.input("start_offset_mm", start_offset_mm, "mm");
-  v.input("final_offset_mm", final_offset_mm, "mm");
-  v.input("hold", hold);
-  v.output("no_spark", no_spark);
-  v.output("vx_cmd_mm_s", vx_cmd_mm_s, "mm/s");
-  v.output("vy_cmd_mm_s", vy_cmd_mm_s, "mm/s");
-  v.output("gen_on", gen_on);
-  v.output("polarity_positive", polarity_positive);
-  v.output("state", state);
-  v.output("offset_mm", offset_mm, "mm");
-  v.output("rho_mm", rho_mm, "mm");
-  v.output("revolutions", revolutions);
-  v.output("done", done);
-  v.output("polarity_request", polarity_request);
-  v.output("generator_request", generator_request);
-  v.output("orbit_start", orbit_start);
-  v.output("orbit_enable", orbit_enable);
-  v.output("rev_pulse", rev_pulse);
-  v.output("orbit_r0_mm", orbit_r0_mm, "mm");
-  v.output("orbit_final_mm", orbit_final_mm, "mm");
-  v.output("x_ref_mm", x_ref_mm, "mm");
-  v.output("y_ref_mm", y_ref_mm, "mm");
-  v.output("vx_ff_mm_s", vx_ff_mm_s, "mm/s");
-  v.output("vy_ff_mm_s", vy_ff_mm_s, "mm/s");
-  v.output("loop_enable", loop_enable);
-  v.output("gap_short", gap_short);
-  v.output("retract_enable", retract_enable);
-  v.output("short_retracts", short_retracts);
-}
-
 std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& setup) {
   machine_ = setup.machine;
   source_ = std::string(setup.instance);

@@ -52,8 +52,6 @@ class ButterworthLowPass final : public rt::BlockWithParams<ButterworthLowPassPa
   };
   /// The coefficients for Wn (formulas above). Pure; Wn outside (0, 1) gives a pass-through.
   static Coefficients design(double wn) noexcept;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Computes the coefficients.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. State and out = initial.
@@ -69,8 +67,8 @@ class ButterworthLowPass final : public rt::BlockWithParams<ButterworthLowPassPa
  private:
   void set_state(double v) noexcept;
 
-  rt::Input<double> in_;
-  rt::Output<double> out_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
   Coefficients c_;
   double x1_{0.0}, x2_{0.0}, y1_{0.0}, y2_{0.0};
   bool primed_{false};

@@ -55,28 +55,26 @@ struct CircularInterpolatorParams {
 class CircularInterpolator final : public MoveInterpolator<CircularInterpolatorParams> {
  public:
   static constexpr std::int64_t kMaxTurns = 1'000'000;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Position = (x0, y0), idle.
   void activate() noexcept override;
 
-  // Pins (named as in visit_pins; start, feed_mm_min, override, hold, load, busy and done are
+  // Pins (listed in declaration order; start, feed_mm_min, override, hold, load, busy and done are
   // MoveInterpolator's): a C++ PROGRAM connects them by member.
-  rt::Input<bool> cw;
-  rt::Input<double> i_mm;
-  rt::Input<double> j_mm;
-  rt::Input<bool> full_circle;
-  rt::Input<std::int64_t> turns{1};
-  rt::Input<double> ex_mm;
-  rt::Input<double> ey_mm;
-  rt::Input<double> load_x_mm;
-  rt::Input<double> load_y_mm;
-  rt::Output<double> rx_mm;
-  rt::Output<double> ry_mm;
-  rt::Output<double> vx_mm_s;
-  rt::Output<double> vy_mm_s;
-  rt::Output<double> angle_rad;
-  rt::Output<double> swept_rad;
+  rt::Input<bool> cw{pins_, "cw"};
+  rt::Input<double> i_mm{pins_, "i_mm", "mm"};
+  rt::Input<double> j_mm{pins_, "j_mm", "mm"};
+  rt::Input<bool> full_circle{pins_, "full_circle"};
+  rt::Input<std::int64_t> turns{pins_, "turns", "", 1};
+  rt::Input<double> ex_mm{pins_, "ex_mm", "mm"};
+  rt::Input<double> ey_mm{pins_, "ey_mm", "mm"};
+  rt::Input<double> load_x_mm{pins_, "load_x_mm", "mm"};
+  rt::Input<double> load_y_mm{pins_, "load_y_mm", "mm"};
+  rt::Output<double> rx_mm{pins_, "rx_mm", "mm"};
+  rt::Output<double> ry_mm{pins_, "ry_mm", "mm"};
+  rt::Output<double> vx_mm_s{pins_, "vx_mm_s", "mm/s"};
+  rt::Output<double> vy_mm_s{pins_, "vy_mm_s", "mm/s"};
+  rt::Output<double> angle_rad{pins_, "angle_rad", "rad"};
+  rt::Output<double> swept_rad{pins_, "swept_rad", "rad"};
 
  private:
   [[nodiscard]] bool load_position() noexcept override;

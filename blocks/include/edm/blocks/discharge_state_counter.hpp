@@ -67,8 +67,6 @@ class DischargeStateCounter final : public rt::BlockWithParams<DischargeStateCou
   static constexpr std::int64_t kMaxCount = std::int64_t{1} << 28;
 
   enum class PulseClass : std::uint8_t { kOpen, kNormal, kShort };
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Clears the registers and the outputs.
   void activate() noexcept override;
   /// RT-safe. kOk, or kFault (nothing shifted, outputs held) on a broken counter.
@@ -92,9 +90,16 @@ class DischargeStateCounter final : public rt::BlockWithParams<DischargeStateCou
   static Regs shifted(const Regs& before, std::int64_t j, std::int64_t o, std::int64_t n,
                       std::int64_t s) noexcept;
 
-  rt::Input<std::int64_t> n_open_, n_normal_, n_short_, n_transient_arc_, n_stable_arc_;
-  rt::Output<std::int64_t> open_count_, normal_count_, short_count_, latches_;
-  rt::Output<bool> data_ready_;
+  rt::Input<std::int64_t> n_open_{pins_, "n_open", "pulses"};
+  rt::Input<std::int64_t> n_normal_{pins_, "n_normal", "pulses"};
+  rt::Input<std::int64_t> n_short_{pins_, "n_short", "pulses"};
+  rt::Input<std::int64_t> n_transient_arc_{pins_, "n_transient_arc", "pulses"};
+  rt::Input<std::int64_t> n_stable_arc_{pins_, "n_stable_arc", "pulses"};
+  rt::Output<std::int64_t> open_count_{pins_, "open_count", "pulses"};
+  rt::Output<std::int64_t> normal_count_{pins_, "normal_count", "pulses"};
+  rt::Output<std::int64_t> short_count_{pins_, "short_count", "pulses"};
+  rt::Output<std::int64_t> latches_{pins_, "latches"};
+  rt::Output<bool> data_ready_{pins_, "data_ready"};
   std::uint32_t reg_[3]{0, 0, 0};
   std::int64_t since_latch_{0};  // pulses since the last latch, < interval
 };

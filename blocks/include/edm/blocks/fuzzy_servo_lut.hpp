@@ -98,8 +98,6 @@ struct FuzzyServoLUTParams {
 class FuzzyServoLUT final : public rt::BlockWithParams<FuzzyServoLUTParams> {
  public:
   static constexpr int kCounts = 33;  // counts 0…32
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Parses terms and rules, builds the engine and fills the table.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. v_mm_s = table value at (0, 0) · v_max.
@@ -115,8 +113,9 @@ class FuzzyServoLUT final : public rt::BlockWithParams<FuzzyServoLUTParams> {
   [[nodiscard]] const fuzzy::MamdaniEngine* engine() const noexcept { return engine_.get(); }
 
  private:
-  rt::Input<std::int64_t> open_count_, short_count_;
-  rt::Output<double> v_mm_s_;
+  rt::Input<std::int64_t> open_count_{pins_, "open_count", "pulses"};
+  rt::Input<std::int64_t> short_count_{pins_, "short_count", "pulses"};
+  rt::Output<double> v_mm_s_{pins_, "v_mm_s", "mm/s"};
   std::array<double, static_cast<std::size_t>(kCounts* kCounts)> table_{};
   std::unique_ptr<fuzzy::MamdaniEngine> engine_;
 };

@@ -27,13 +27,12 @@ struct GainParams {
 
 class Gain final : public rt::BlockWithParams<GainParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// RT-safe. kOk, or kFault (out held) on a non-finite input or result.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<double> in_;
-  rt::Output<double> out_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
 };
 
 }  // namespace edm::blocks

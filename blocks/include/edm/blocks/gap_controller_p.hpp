@@ -64,22 +64,21 @@ struct GapControllerPParams {
 
 class GapControllerP final : public rt::BlockWithParams<GapControllerPParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. vz_mm_s = 0, saturated = false.
   void activate() noexcept override;
   /// RT-safe. kOk, kSaturated (clamped), or kFault (broken Td or Tdr while the P law runs).
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<double> td_us;
-  rt::Input<bool> valid{true};
-  rt::Input<bool> enable{true};
-  rt::Input<bool> hold;
-  rt::Input<bool> retract;
-  rt::Input<double> tdr_us;  // 0 (unwired): use the parameter
-  rt::Output<double> vz_mm_s;
-  rt::Output<bool> saturated;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<double> td_us{pins_, "td_us", "us"};
+  rt::Input<bool> valid{pins_, "valid", "", true};
+  rt::Input<bool> enable{pins_, "enable", "", true};
+  rt::Input<bool> hold{pins_, "hold"};
+  rt::Input<bool> retract{pins_, "retract"};
+  rt::Input<double> tdr_us{pins_, "tdr_us", "us"};  // 0 (unwired): use the parameter
+  rt::Output<double> vz_mm_s{pins_, "vz_mm_s", "mm/s"};
+  rt::Output<bool> saturated{pins_, "saturated"};
 
  private:
 };

@@ -82,8 +82,6 @@ class GreyPredictorGM11 final : public rt::BlockWithParams<GreyPredictorGM11Para
     bool valid{false};
   };
   static Fit predict(const double* x, std::size_t n, std::int64_t horizon, bool paper_exp) noexcept;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Allocates the ring and the work buffer (window samples each).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Empties the window; out = c = b = 0, valid = false.
@@ -92,9 +90,11 @@ class GreyPredictorGM11 final : public rt::BlockWithParams<GreyPredictorGM11Para
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<double> in_;
-  rt::Output<double> out_, c_, b_;
-  rt::Output<bool> valid_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
+  rt::Output<double> c_{pins_, "c", "1"};
+  rt::Output<double> b_{pins_, "b"};
+  rt::Output<bool> valid_{pins_, "valid"};
   WindowRing<double> window_;  // allocated in configure(); its capacity is n
   std::vector<double> work_;   // the window in chronological order
 };

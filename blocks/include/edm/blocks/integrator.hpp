@@ -42,7 +42,6 @@ struct IntegratorParams {
 
 class Integrator final : public rt::BlockWithParams<IntegratorParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0. Sets out = clamp(initial, min, max).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// RT-safe. kOk, kSaturated (clamped) or kFault (non-finite input or state).
@@ -55,9 +54,9 @@ class Integrator final : public rt::BlockWithParams<IntegratorParams> {
   void compute_gain() noexcept;
   [[nodiscard]] double reset_value() const noexcept;
 
-  rt::Input<double> in_;
-  rt::Input<bool> reset_;
-  rt::Output<double> out_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Input<bool> reset_{pins_, "reset"};
+  rt::Output<double> out_{pins_, "out"};
   double dt_s_{0.0};
   double k_dt_{0.0};  // k·dt [out unit / in unit]
 };

@@ -121,8 +121,6 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   };
   /// Eq. (1) of the paper. Pure, RT-safe.
   static Gains gains(const IterativeLearningControlParams& p) noexcept;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Allocates u and e (N samples each).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. u = u_initial everywhere, x = 0, waiting for the first cycle edge.
@@ -136,11 +134,20 @@ class IterativeLearningControl final : public rt::BlockWithParams<IterativeLearn
   /// End of a warm-up cycle: counts it; after the last one, learns from it and takes over.
   void end_warm_cycle() noexcept;
 
-  rt::Input<double> y_, y_ref_, track_;
-  rt::Input<bool> cycle_start_, enable_{true};
-  rt::Output<double> u_out_, mean_error_, x_out_, l1_, l2_, l3_;
-  rt::Output<std::int64_t> sample_, cycles_;
-  rt::Output<bool> active_;
+  rt::Input<double> y_{pins_, "y"};
+  rt::Input<double> y_ref_{pins_, "y_ref"};
+  rt::Input<double> track_{pins_, "track", "position unit"};
+  rt::Input<bool> cycle_start_{pins_, "cycle_start"};
+  rt::Input<bool> enable_{pins_, "enable", "", true};
+  rt::Output<double> u_out_{pins_, "u"};
+  rt::Output<double> mean_error_{pins_, "mean_error"};
+  rt::Output<double> x_out_{pins_, "x"};
+  rt::Output<double> l1_{pins_, "l1"};
+  rt::Output<double> l2_{pins_, "l2"};
+  rt::Output<double> l3_{pins_, "l3"};
+  rt::Output<std::int64_t> sample_{pins_, "sample", "samples"};
+  rt::Output<std::int64_t> cycles_{pins_, "cycles"};
+  rt::Output<bool> active_{pins_, "active"};
   std::vector<double> u_;
   std::vector<double> e_;
   std::int64_t idx_{-1};  // sample output last update; −1 before the first cycle

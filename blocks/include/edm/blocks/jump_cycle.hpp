@@ -69,7 +69,6 @@ struct JumpCycleParams {
 
 class JumpCycle final : public rt::BlockWithParams<JumpCycleParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Converts the times to task cycles (at least 1 each); needs a task period > 0.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. n = 0, no jump, vz_out = vz_in.
@@ -85,11 +84,16 @@ class JumpCycle final : public rt::BlockWithParams<JumpCycleParams> {
  private:
   void reset() noexcept;
 
-  rt::Input<double> vz_in_, z_mm_;
-  rt::Input<bool> enable_{true};
-  rt::Output<double> vz_out_, z_hold_;
-  rt::Output<bool> jumping_, settling_, servo_part_, cycle_start_;
-  rt::Output<std::int64_t> jumps_;
+  rt::Input<double> vz_in_{pins_, "vz_in_mm_s", "mm/s"};
+  rt::Input<double> z_mm_{pins_, "z_mm", "mm"};
+  rt::Input<bool> enable_{pins_, "enable", "", true};
+  rt::Output<double> vz_out_{pins_, "vz_out_mm_s", "mm/s"};
+  rt::Output<double> z_hold_{pins_, "z_hold_mm", "mm"};
+  rt::Output<bool> jumping_{pins_, "jumping"};
+  rt::Output<bool> settling_{pins_, "settling"};
+  rt::Output<bool> servo_part_{pins_, "servo_part"};
+  rt::Output<bool> cycle_start_{pins_, "cycle_start"};
+  rt::Output<std::int64_t> jumps_{pins_, "jumps"};
   rt::Duration task_period_{};
   std::int64_t period_n_{1}, up_n_{1}, down_n_{1}, settle_n_{0};
   std::int64_t settle_left_{0};  // cycles of `settling` left after the last jump

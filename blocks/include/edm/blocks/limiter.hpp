@@ -42,7 +42,6 @@ struct LimiterParams {
 
 class Limiter final : public rt::BlockWithParams<LimiterParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0 (for the slew-rate step).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Forgets the previous output: the next cycle starts from the input.
@@ -56,9 +55,9 @@ class Limiter final : public rt::BlockWithParams<LimiterParams> {
  private:
   void compute_step() noexcept;
 
-  rt::Input<double> in_;
-  rt::Output<double> out_;
-  rt::Output<bool> limited_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
+  rt::Output<bool> limited_{pins_, "limited"};
   double dt_s_{0.0};
   double max_step_{0.0};  // rate·dt [signal unit per cycle]; 0 = unlimited
   double y_{0.0};

@@ -44,24 +44,23 @@ struct LinearInterpolatorParams {
 
 class LinearInterpolator final : public MoveInterpolator<LinearInterpolatorParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Position = (x0, y0, z0), idle.
   void activate() noexcept override;
 
-  // Pins (named as in visit_pins; start, feed_mm_min, override, hold, load, busy and done are
+  // Pins (listed in declaration order; start, feed_mm_min, override, hold, load, busy and done are
   // MoveInterpolator's): a C++ PROGRAM connects them by member.
-  rt::Input<double> lx_mm;
-  rt::Input<double> ly_mm;
-  rt::Input<double> lz_mm;
-  rt::Input<double> load_x_mm;
-  rt::Input<double> load_y_mm;
-  rt::Input<double> load_z_mm;
-  rt::Output<double> rx_mm;
-  rt::Output<double> ry_mm;
-  rt::Output<double> rz_mm;
-  rt::Output<double> vx_mm_s;
-  rt::Output<double> vy_mm_s;
-  rt::Output<double> vz_mm_s;
+  rt::Input<double> lx_mm{pins_, "lx_mm", "mm"};
+  rt::Input<double> ly_mm{pins_, "ly_mm", "mm"};
+  rt::Input<double> lz_mm{pins_, "lz_mm", "mm"};
+  rt::Input<double> load_x_mm{pins_, "load_x_mm", "mm"};
+  rt::Input<double> load_y_mm{pins_, "load_y_mm", "mm"};
+  rt::Input<double> load_z_mm{pins_, "load_z_mm", "mm"};
+  rt::Output<double> rx_mm{pins_, "rx_mm", "mm"};
+  rt::Output<double> ry_mm{pins_, "ry_mm", "mm"};
+  rt::Output<double> rz_mm{pins_, "rz_mm", "mm"};
+  rt::Output<double> vx_mm_s{pins_, "vx_mm_s", "mm/s"};
+  rt::Output<double> vy_mm_s{pins_, "vy_mm_s", "mm/s"};
+  rt::Output<double> vz_mm_s{pins_, "vz_mm_s", "mm/s"};
 
  private:
   using Vec3 = std::array<double, 3>;

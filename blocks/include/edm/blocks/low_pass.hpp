@@ -32,7 +32,6 @@ struct LowPassParams {
 
 class LowPass final : public rt::BlockWithParams<LowPassParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0; computes α.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. y = out = initial.
@@ -49,8 +48,8 @@ class LowPass final : public rt::BlockWithParams<LowPassParams> {
  private:
   void compute_alpha() noexcept;
 
-  rt::Input<double> in_;
-  rt::Output<double> out_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
   rt::Duration period_{};
   double alpha_{1.0};
   double y_{0.0};

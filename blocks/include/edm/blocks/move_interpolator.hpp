@@ -84,14 +84,14 @@ class MoveInterpolator : public rt::BlockWithParams<Params> {
     publish_at_rest();
   }
 
-  // Pins every move has (the block names them in its visit_pins, in its own order).
-  rt::Input<bool> start;
-  rt::Input<double> feed_mm_min;
-  rt::Input<double> feed_override{1.0};
-  rt::Input<bool> hold;
-  rt::Input<bool> load;
-  rt::Output<bool> busy;
-  rt::Output<bool> done;
+  // Pins every move has, listed before the block's own.
+  rt::Input<bool> start{this->pins_, "start"};
+  rt::Input<double> feed_mm_min{this->pins_, "feed_mm_min", "mm/min"};
+  rt::Input<double> feed_override{this->pins_, "override", "", 1.0};
+  rt::Input<bool> hold{this->pins_, "hold"};
+  rt::Input<bool> load{this->pins_, "load"};
+  rt::Output<bool> busy{this->pins_, "busy"};
+  rt::Output<bool> done{this->pins_, "done"};
 
  protected:
   /// Non-RT, for the block's activate(): idle, no feed, no start edge seen.

@@ -42,7 +42,6 @@ struct MovingAverageParams {
 
 class MovingAverage final : public rt::BlockWithParams<MovingAverageParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Allocates the ring buffer (window samples).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Empties the window: out = 0, full = false.
@@ -59,9 +58,9 @@ class MovingAverage final : public rt::BlockWithParams<MovingAverageParams> {
     [[nodiscard]] double value() const noexcept { return hi + lo; }
   };
 
-  rt::Input<double> in_;
-  rt::Output<double> out_;
-  rt::Output<bool> full_;
+  rt::Input<double> in_{pins_, "in"};
+  rt::Output<double> out_{pins_, "out"};
+  rt::Output<bool> full_{pins_, "full"};
   WindowRing<double> window_;  // allocated in configure(); its capacity is the window in use
   CompensatedSum sum_;         // running sum of the window
   CompensatedSum pass_sum_;    // sum of the samples pushed since the ring was last at slot 0

@@ -58,8 +58,6 @@ struct OrbitExpanderParams {
 class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
  public:
   static constexpr std::int64_t kMaxSamplesPerRev = OrbitExpanderParams::kMaxSamplesPerRev;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Idle, radius 0.
   void activate() noexcept override;
   /// RT-safe. kOk, kSaturated (Δr clamped to dr_max_mm) or kFault (see the file comment).
@@ -71,20 +69,20 @@ class OrbitExpander final : public rt::BlockWithParams<OrbitExpanderParams> {
   void clear_progress() noexcept;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<bool> start;
-  rt::Input<double> r0_mm;
-  rt::Input<double> final_radius_mm;
-  rt::Input<bool> enable{true};
-  rt::Input<double> td_us;
-  rt::Input<bool> valid;
-  rt::Input<bool> rev_pulse;
-  rt::Output<double> radius_mm;
-  rt::Output<double> dr_mm;
-  rt::Output<double> tdm_us;
-  rt::Output<std::int64_t> revolutions;
-  rt::Output<bool> busy;
-  rt::Output<bool> done;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<bool> start{pins_, "start"};
+  rt::Input<double> r0_mm{pins_, "r0_mm", "mm"};
+  rt::Input<double> final_radius_mm{pins_, "final_radius_mm", "mm"};
+  rt::Input<bool> enable{pins_, "enable", "", true};
+  rt::Input<double> td_us{pins_, "td_us", "us"};
+  rt::Input<bool> valid{pins_, "valid"};
+  rt::Input<bool> rev_pulse{pins_, "rev_pulse"};
+  rt::Output<double> radius_mm{pins_, "radius_mm", "mm"};
+  rt::Output<double> dr_mm{pins_, "dr_mm", "mm"};
+  rt::Output<double> tdm_us{pins_, "tdm_us", "us"};
+  rt::Output<std::int64_t> revolutions{pins_, "revolutions"};
+  rt::Output<bool> busy{pins_, "busy"};
+  rt::Output<bool> done{pins_, "done"};
 
  private:
   double radius_mm_{0.0};

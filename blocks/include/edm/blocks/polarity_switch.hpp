@@ -46,7 +46,6 @@ struct PolaritySwitchParams {
 
 class PolaritySwitch final : public rt::BlockWithParams<PolaritySwitchParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. polarity_positive = initial_positive, generator off, switching = true until the
   /// first `settle` has passed.
   void activate() noexcept override;
@@ -54,12 +53,12 @@ class PolaritySwitch final : public rt::BlockWithParams<PolaritySwitchParams> {
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<bool> request_positive;
-  rt::Input<bool> generator_on_request;
-  rt::Output<bool> polarity_positive;
-  rt::Output<bool> generator_on;
-  rt::Output<bool> switching;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<bool> request_positive{pins_, "request_positive"};
+  rt::Input<bool> generator_on_request{pins_, "generator_on_request"};
+  rt::Output<bool> polarity_positive{pins_, "polarity_positive"};
+  rt::Output<bool> generator_on{pins_, "generator_on"};
+  rt::Output<bool> switching{pins_, "switching"};
 
  private:
   bool polarity_{false};         // polarity_positive as last output

@@ -61,7 +61,6 @@ struct PositionLoopParams {
 
 class PositionLoop final : public rt::BlockWithParams<PositionLoopParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Clears the integral, the in-position count and the fault latch; v_cmd = 0.
@@ -73,17 +72,17 @@ class PositionLoop final : public rt::BlockWithParams<PositionLoopParams> {
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<double> x_ref_mm;
-  rt::Input<double> v_ff_mm_s;
-  rt::Input<double> x_mm;
-  rt::Input<bool> enable{true};
-  rt::Input<bool> reset;
-  rt::Output<double> v_cmd_mm_s;
-  rt::Output<double> error_mm;
-  rt::Output<bool> in_position;
-  rt::Output<bool> following_error_fault;
-  rt::Output<bool> saturated;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
+  rt::Input<double> v_ff_mm_s{pins_, "v_ff_mm_s", "mm/s"};
+  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
+  rt::Input<bool> enable{pins_, "enable", "", true};
+  rt::Input<bool> reset{pins_, "reset"};
+  rt::Output<double> v_cmd_mm_s{pins_, "v_cmd_mm_s", "mm/s"};
+  rt::Output<double> error_mm{pins_, "error_mm", "mm"};
+  rt::Output<bool> in_position{pins_, "in_position"};
+  rt::Output<bool> following_error_fault{pins_, "following_error_fault"};
+  rt::Output<bool> saturated{pins_, "saturated"};
 
  private:
   double dt_s_{0.0};

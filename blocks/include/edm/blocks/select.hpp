@@ -48,7 +48,6 @@ struct SelectParams {
 
 class Select final : public rt::BlockWithParams<SelectParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0 (for the ramp).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. The next cycle takes the selected input as is; active0/1 show `select` until then.
@@ -57,10 +56,13 @@ class Select final : public rt::BlockWithParams<SelectParams> {
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<bool> g_;
-  rt::Input<double> in0_, in1_;
-  rt::Output<double> out_;
-  rt::Output<bool> active0_, active1_, transferring_;
+  rt::Input<bool> g_{pins_, "g"};
+  rt::Input<double> in0_{pins_, "in0"};
+  rt::Input<double> in1_{pins_, "in1"};
+  rt::Output<double> out_{pins_, "out"};
+  rt::Output<bool> active0_{pins_, "active0"};
+  rt::Output<bool> active1_{pins_, "active1"};
+  rt::Output<bool> transferring_{pins_, "transferring"};
   double dt_s_{0.0};
   bool has_prev_{false};
   bool sel_{false};

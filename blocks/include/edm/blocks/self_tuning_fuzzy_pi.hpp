@@ -129,19 +129,26 @@ class SelfTuningFuzzyPI final : public rt::BlockWithParams<SelfTuningFuzzyPIPara
  public:
   /// Crisp dU of the rule base for E and CE (height defuzzification, see above). Pure, RT-safe.
   static double rule_output(double e_scaled, double ce_scaled) noexcept;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. u = u_initial_us, v = v_initial_v (clamped), du = 0, phi = psi = 1.
   void activate() noexcept override;
   /// RT-safe. kOk, kSaturated (an actuator limit cut the step) or kFault (non-finite input).
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
  private:
-  rt::Input<double> rab_p_, rab_f_, rab_ref_;
-  rt::Input<double> track_u_, track_v_;  // bumpless transfer: the commands applied while idle
-  rt::Input<bool> enable_{true};
-  rt::Output<double> arc_off_time_us_, servo_ref_v_, du_, phi_, psi_, error_;
-  rt::Output<bool> saturated_;
+  rt::Input<double> rab_p_{pins_, "rab_p", "1"};
+  rt::Input<double> rab_f_{pins_, "rab_f", "1"};
+  rt::Input<double> rab_ref_{pins_, "rab_ref", "1"};
+  rt::Input<double> track_u_{pins_, "track_arc_off_time_us", "us"};
+  rt::Input<double> track_v_{pins_, "track_servo_ref_v",
+                             "V"};  // bumpless transfer: the commands applied while idle
+  rt::Input<bool> enable_{pins_, "enable", "", true};
+  rt::Output<double> arc_off_time_us_{pins_, "arc_off_time_us", "us"};
+  rt::Output<double> servo_ref_v_{pins_, "servo_ref_v", "V"};
+  rt::Output<double> du_{pins_, "du", "1"};
+  rt::Output<double> phi_{pins_, "phi", "1"};
+  rt::Output<double> psi_{pins_, "psi", "1"};
+  rt::Output<double> error_{pins_, "error", "1"};
+  rt::Output<bool> saturated_{pins_, "saturated"};
   double u_{0.0};
   double v_{0.0};
   double prev_p_{0.0};

@@ -147,7 +147,6 @@ struct SelfTuningRegulatorParams {
 
 class SelfTuningRegulator final : public rt::BlockWithParams<SelfTuningRegulatorParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. u_v, u_t at their initial values (also as regressor history), RLS reset.
   void activate() noexcept override;
   /// RT-safe. One sample of both loops.
@@ -156,12 +155,25 @@ class SelfTuningRegulator final : public rt::BlockWithParams<SelfTuningRegulator
  private:
   void publish() noexcept;
 
-  rt::Input<double> ratio_normal_, ratio_transient_arc_, ratio_stable_arc_, ratio_short_;
-  rt::Input<double> y_rv_ref_, y_rt_ref_;
-  rt::Input<bool> enable_{true};
-  rt::Output<double> servo_ref_v_, off_time_us_, u_v_out_, y_v_out_, y_t_out_, y_rv_out_, y_rt_out_,
-      beta01_, beta0c_, beta1c_, k1_;
-  rt::Output<bool> saturated_;
+  rt::Input<double> ratio_normal_{pins_, "ratio_normal", "1"};
+  rt::Input<double> ratio_transient_arc_{pins_, "ratio_transient_arc", "1"};
+  rt::Input<double> ratio_stable_arc_{pins_, "ratio_stable_arc", "1"};
+  rt::Input<double> ratio_short_{pins_, "ratio_short", "1"};
+  rt::Input<double> y_rv_ref_{pins_, "y_rv_ref", "1"};
+  rt::Input<double> y_rt_ref_{pins_, "y_rt_ref", "1"};
+  rt::Input<bool> enable_{pins_, "enable", "", true};
+  rt::Output<double> servo_ref_v_{pins_, "servo_ref_v", "V"};
+  rt::Output<double> off_time_us_{pins_, "off_time_us", "us"};
+  rt::Output<double> u_v_out_{pins_, "u_v", "1"};
+  rt::Output<double> y_v_out_{pins_, "y_v", "1"};
+  rt::Output<double> y_t_out_{pins_, "y_t", "1"};
+  rt::Output<double> y_rv_out_{pins_, "y_rv", "1"};
+  rt::Output<double> y_rt_out_{pins_, "y_rt", "1"};
+  rt::Output<double> beta01_{pins_, "beta01", "1"};
+  rt::Output<double> beta0c_{pins_, "beta0c", "1"};
+  rt::Output<double> beta1c_{pins_, "beta1c", "1"};
+  rt::Output<double> k1_{pins_, "k1", "1"};
+  rt::Output<bool> saturated_{pins_, "saturated"};
   RlsCore main_;
   RlsCore aux_;
   std::array<double, SelfTuningRegulatorParams::kMaxDelay + 2> hist_v_{};  // u_v(k−1−i)

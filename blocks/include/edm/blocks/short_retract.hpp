@@ -102,8 +102,6 @@ struct ShortRetractParams {
 class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
  public:
   enum class State : std::uint8_t { kIdle, kRetract, kResume, kRamp, kHold };
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0. Allocates the path ring (history_capacity points).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Empties the history; IDLE, tries 0, alarm cleared.
@@ -133,22 +131,23 @@ class ShortRetract final : public rt::BlockWithParams<ShortRetractParams> {
   void compute_ramp() noexcept;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<double> x_mm;
-  rt::Input<double> y_mm;
-  rt::Input<double> z_mm;
-  rt::Input<bool> short_detected;
-  rt::Input<bool> enable{true};
-  rt::Input<bool> reset;
-  rt::Output<bool> active;
-  rt::Output<double> x_sp_mm;
-  rt::Output<double> y_sp_mm;
-  rt::Output<double> z_sp_mm;
-  rt::Output<double> v_scale{1.0};
-  rt::Output<std::int64_t> tries;
-  rt::Output<std::int64_t> retracts;  // retracts started since activate() (progress never resets)
-  rt::Output<bool> alarm;
-  rt::Output<bool> hold;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
+  rt::Input<double> y_mm{pins_, "y_mm", "mm"};
+  rt::Input<double> z_mm{pins_, "z_mm", "mm"};
+  rt::Input<bool> short_detected{pins_, "short_detected"};
+  rt::Input<bool> enable{pins_, "enable", "", true};
+  rt::Input<bool> reset{pins_, "reset"};
+  rt::Output<bool> active{pins_, "active"};
+  rt::Output<double> x_sp_mm{pins_, "x_sp_mm", "mm"};
+  rt::Output<double> y_sp_mm{pins_, "y_sp_mm", "mm"};
+  rt::Output<double> z_sp_mm{pins_, "z_sp_mm", "mm"};
+  rt::Output<double> v_scale{pins_, "v_scale", "", 1.0};
+  rt::Output<std::int64_t> tries{pins_, "tries"};
+  rt::Output<std::int64_t> retracts{
+      pins_, "retracts"};  // retracts started since activate() (progress never resets)
+  rt::Output<bool> alarm{pins_, "alarm"};
+  rt::Output<bool> hold{pins_, "hold"};
 
  private:
   WindowRing<PathPoint> history_;  // allocated in configure(); at(0) is the oldest point

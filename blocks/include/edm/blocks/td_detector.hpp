@@ -72,8 +72,6 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
   /// Per-cycle counters above this are treated as a broken signal (keeps the window sums far
   /// from int64 overflow: kMaxWindow · kMaxCount < 2^63).
   static constexpr std::int64_t kMaxCount = std::int64_t{1} << 46;
-
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Allocates the ring (window cycles).
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// Non-RT. Empties the window: td_us = td_raw_us = empty_td_us, ratios 0, valid false.
@@ -91,10 +89,17 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
   };
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short, n_total;
-  rt::Output<double> td_us, td_raw_us, open_ratio, short_ratio;
-  rt::Output<bool> valid;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<std::int64_t> td_sum_ns{pins_, "td_sum_ns", "ns"};
+  rt::Input<std::int64_t> td_count{pins_, "td_count"};
+  rt::Input<std::int64_t> n_open{pins_, "n_open"};
+  rt::Input<std::int64_t> n_short{pins_, "n_short"};
+  rt::Input<std::int64_t> n_total{pins_, "n_total"};
+  rt::Output<double> td_us{pins_, "td_us", "us"};
+  rt::Output<double> td_raw_us{pins_, "td_raw_us", "us"};
+  rt::Output<double> open_ratio{pins_, "open_ratio", "1"};
+  rt::Output<double> short_ratio{pins_, "short_ratio", "1"};
+  rt::Output<bool> valid{pins_, "valid"};
 
  private:
   WindowRing<Counts> window_;  // allocated in configure(); its capacity is the window in use

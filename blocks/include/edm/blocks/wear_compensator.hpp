@@ -71,7 +71,6 @@ struct WearCompensatorParams {
 
 class WearCompensator final : public rt::BlockWithParams<WearCompensatorParams> {
  public:
-  void visit_pins(rt::PinVisitor& v) override;
   /// Non-RT. Needs a task period > 0. Sets wear_mm = 0.
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
   /// RT-safe. kOk, kSaturated (wear_ratio clamped) or kFault (non-finite input or state).
@@ -84,14 +83,14 @@ class WearCompensator final : public rt::BlockWithParams<WearCompensatorParams> 
   void compute_ratio() noexcept;
 
  public:
-  // Pins (named as in visit_pins): a C++ PROGRAM connects them by member.
-  rt::Input<double> vz_in_mm_s;
-  rt::Input<double> wear_ratio;
-  rt::Input<bool> enable{true};
-  rt::Input<bool> reset_wear;
-  rt::Output<double> vz_out_mm_s;
-  rt::Output<double> vd_mm_s;
-  rt::Output<double> wear_mm;
+  // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
+  rt::Input<double> vz_in_mm_s{pins_, "vz_in_mm_s", "mm/s"};
+  rt::Input<double> wear_ratio{pins_, "wear_ratio"};
+  rt::Input<bool> enable{pins_, "enable", "", true};
+  rt::Input<bool> reset_wear{pins_, "reset_wear"};
+  rt::Output<double> vz_out_mm_s{pins_, "vz_out_mm_s", "mm/s"};
+  rt::Output<double> vd_mm_s{pins_, "vd_mm_s", "mm/s"};
+  rt::Output<double> wear_mm{pins_, "wear_mm", "mm"};
 
  private:
   double dt_s_{0.0};

@@ -125,33 +125,40 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
 
   DeepHoleDrill();
 
-  // Pins (named as in visit_own_pins).
-  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
-  rt::Input<double> z_mm;
-  rt::Input<bool> start;
-  rt::Input<double> depth_mm;    // 0: use depth_default_mm
-  rt::Input<double> wear_ratio;  // ≤ 0 (unwired): the wear child's wear_ratio_default
-  rt::Input<bool> enable_wear_comp{true};
-  rt::Input<double> tdr_us;  // ≤ 0 (unwired): the gap child's tdr_default_us
-  rt::Input<bool> through;   // a through hole: detect the breakthrough
-  rt::Input<bool> hold;
-  rt::Input<double> vz_servo_mm_s;  // wired: an external gap servo replaces gap's Vz in DRILL
-  rt::Output<double> vz_cmd_mm_s;
-  rt::Output<bool> gen_on;
-  rt::Output<std::int64_t> state;
-  rt::Output<double> depth_reached_mm, touch_z_mm, wear_mm;
-  rt::Output<bool> done;
-  rt::Output<bool> breakthrough;
-  rt::Output<bool> reset_wear;
-  rt::Output<double> vz_servo_cmd_mm_s;
-  rt::Output<bool> gap_short;               // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable;          // the short retract records and acts (DRILL only)
-  rt::Output<double> retract_vff_mm_s;      // feed-forward of the retract setpoint into zloop
-  rt::Output<std::int64_t> short_retracts;  // retracts in this hole
-  rt::Output<double> short_time_s;          // time spent retracting and resuming in this hole
+  // Pins, listed in declaration order.
+  PulseInputs pulses{pins_};  // td_sum_ns, td_count, n_open, n_short
+  rt::Input<double> z_mm{pins_, "z_mm", "mm"};
+  rt::Input<bool> start{pins_, "start"};
+  rt::Input<double> depth_mm{pins_, "depth_mm", "mm"};  // 0: use depth_default_mm
+  rt::Input<double> wear_ratio{pins_,
+                               "wear_ratio"};  // ≤ 0 (unwired): the wear child's wear_ratio_default
+  rt::Input<bool> enable_wear_comp{pins_, "enable_wear_comp", "", true};
+  rt::Input<double> tdr_us{pins_, "tdr_us", "us"};  // ≤ 0 (unwired): the gap child's tdr_default_us
+  rt::Input<bool> through{pins_, "through"};        // a through hole: detect the breakthrough
+  rt::Input<bool> hold{pins_, "hold"};
+  rt::Input<double> vz_servo_mm_s{
+      pins_, "vz_servo_mm_s", "mm/s"};  // wired: an external gap servo replaces gap's Vz in DRILL
+  rt::Output<double> vz_cmd_mm_s{pins_, "vz_cmd_mm_s", "mm/s"};
+  rt::Output<bool> gen_on{pins_, "gen_on"};
+  rt::Output<std::int64_t> state{pins_, "state"};
+  rt::Output<double> depth_reached_mm{pins_, "depth_reached_mm", "mm"};
+  rt::Output<double> touch_z_mm{pins_, "touch_z_mm", "mm"};
+  rt::Output<double> wear_mm{pins_, "wear_mm", "mm"};
+  rt::Output<bool> done{pins_, "done"};
+  rt::Output<bool> breakthrough{pins_, "breakthrough"};
+  rt::Output<bool> reset_wear{pins_, "reset_wear"};
+  rt::Output<double> vz_servo_cmd_mm_s{pins_, "vz_servo_cmd_mm_s", "mm/s"};
+  rt::Output<bool> gap_short{pins_,
+                             "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable{
+      pins_, "retract_enable"};  // the short retract records and acts (DRILL only)
+  rt::Output<double> retract_vff_mm_s{pins_, "retract_vff_mm_s",
+                                      "mm/s"};  // feed-forward of the retract setpoint into zloop
+  rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this hole
+  rt::Output<double> short_time_s{pins_, "short_time_s",
+                                  "s"};  // time spent retracting and resuming in this hole
 
  protected:
-  void visit_own_pins(rt::PinVisitor& v) override;
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
   void bind_self() override;
   void activate_self() noexcept override;

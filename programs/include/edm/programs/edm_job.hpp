@@ -85,28 +85,65 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
 
   EdmJob();
 
-  // Pins (named as in visit_own_pins).
-  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
-  rt::Input<std::int64_t> n_normal, n_transient_arc, n_stable_arc;
-  rt::Input<double> x_mm, y_mm, z_mm;
-  rt::Output<double> vx_cmd_mm_s, vy_cmd_mm_s, vz_cmd_mm_s;
-  rt::Output<bool> gen_arm, gen_on, polarity_positive, flushing_on, rotation_on;
-  rt::Output<double> on_time_us, off_time_us, servo_ref_v;
-  rt::Output<std::int64_t> state, block_index, line, jobs_finished;
+  // Pins, listed in declaration order.
+  PulseInputs pulses{pins_};  // td_sum_ns, td_count, n_open, n_short
+  rt::Input<std::int64_t> n_normal{pins_, "n_normal"};
+  rt::Input<std::int64_t> n_transient_arc{pins_, "n_transient_arc"};
+  rt::Input<std::int64_t> n_stable_arc{pins_, "n_stable_arc"};
+  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
+  rt::Input<double> y_mm{pins_, "y_mm", "mm"};
+  rt::Input<double> z_mm{pins_, "z_mm", "mm"};
+  rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
+  rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
+  rt::Output<double> vz_cmd_mm_s{pins_, "vz_cmd_mm_s", "mm/s"};
+  rt::Output<bool> gen_arm{pins_, "gen_arm"};
+  rt::Output<bool> gen_on{pins_, "gen_on"};
+  rt::Output<bool> polarity_positive{pins_, "polarity_positive"};
+  rt::Output<bool> flushing_on{pins_, "flushing_on"};
+  rt::Output<bool> rotation_on{pins_, "rotation_on"};
+  rt::Output<double> on_time_us{pins_, "on_time_us", "us"};
+  rt::Output<double> off_time_us{pins_, "off_time_us", "us"};
+  rt::Output<double> servo_ref_v{pins_, "servo_ref_v", "V"};
+  rt::Output<std::int64_t> state{pins_, "state"};
+  rt::Output<std::int64_t> block_index{pins_, "block_index"};
+  rt::Output<std::int64_t> line{pins_, "line"};
+  rt::Output<std::int64_t> jobs_finished{pins_, "jobs_finished"};
   // The signals the sequence gives its children.
-  rt::Output<bool> drill_start, finish_start, feed_hold;
-  rt::Output<double> drill_depth_mm, wear_ratio, tdr_us, finish_final_offset_mm,
-      finish_start_offset_mm;
-  rt::Output<bool> lin_start, lin_hold, lin_load;
-  rt::Output<double> lin_lx_mm, lin_ly_mm, lin_lz_mm, lin_feed_mm_min;
-  rt::Output<bool> arc_start, arc_hold, arc_load, arc_cw, arc_full_circle;
-  rt::Output<std::int64_t> arc_turns;
-  rt::Output<double> arc_i_mm, arc_j_mm, arc_ex_mm, arc_ey_mm, arc_feed_mm_min;
-  rt::Output<double> x_ref_mm, y_ref_mm, z_ref_mm, vx_ff_mm_s, vy_ff_mm_s, vz_ff_mm_s;
-  rt::Output<bool> loop_enable;
+  rt::Output<bool> drill_start{pins_, "drill_start"};
+  rt::Output<bool> finish_start{pins_, "finish_start"};
+  rt::Output<bool> feed_hold{pins_, "feed_hold"};
+  rt::Output<double> drill_depth_mm{pins_, "drill_depth_mm", "mm"};
+  rt::Output<double> wear_ratio{pins_, "wear_ratio"};
+  rt::Output<double> tdr_us{pins_, "tdr_us", "us"};
+  rt::Output<double> finish_final_offset_mm{pins_, "finish_final_offset_mm", "mm"};
+  rt::Output<double> finish_start_offset_mm{pins_, "finish_start_offset_mm", "mm"};
+  rt::Output<bool> lin_start{pins_, "lin_start"};
+  rt::Output<bool> lin_hold{pins_, "lin_hold"};
+  rt::Output<bool> lin_load{pins_, "lin_load"};
+  rt::Output<double> lin_lx_mm{pins_, "lin_lx_mm", "mm"};
+  rt::Output<double> lin_ly_mm{pins_, "lin_ly_mm", "mm"};
+  rt::Output<double> lin_lz_mm{pins_, "lin_lz_mm", "mm"};
+  rt::Output<double> lin_feed_mm_min{pins_, "lin_feed_mm_min", "mm/min"};
+  rt::Output<bool> arc_start{pins_, "arc_start"};
+  rt::Output<bool> arc_hold{pins_, "arc_hold"};
+  rt::Output<bool> arc_load{pins_, "arc_load"};
+  rt::Output<bool> arc_cw{pins_, "arc_cw"};
+  rt::Output<bool> arc_full_circle{pins_, "arc_full_circle"};
+  rt::Output<std::int64_t> arc_turns{pins_, "arc_turns"};
+  rt::Output<double> arc_i_mm{pins_, "arc_i_mm", "mm"};
+  rt::Output<double> arc_j_mm{pins_, "arc_j_mm", "mm"};
+  rt::Output<double> arc_ex_mm{pins_, "arc_ex_mm", "mm"};
+  rt::Output<double> arc_ey_mm{pins_, "arc_ey_mm", "mm"};
+  rt::Output<double> arc_feed_mm_min{pins_, "arc_feed_mm_min", "mm/min"};
+  rt::Output<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
+  rt::Output<double> y_ref_mm{pins_, "y_ref_mm", "mm"};
+  rt::Output<double> z_ref_mm{pins_, "z_ref_mm", "mm"};
+  rt::Output<double> vx_ff_mm_s{pins_, "vx_ff_mm_s", "mm/s"};
+  rt::Output<double> vy_ff_mm_s{pins_, "vy_ff_mm_s", "mm/s"};
+  rt::Output<double> vz_ff_mm_s{pins_, "vz_ff_mm_s", "mm/s"};
+  rt::Output<bool> loop_enable{pins_, "loop_enable"};
 
  protected:
-  void visit_own_pins(rt::PinVisitor& v) override;
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
   void bind_self() override;
   void activate_self() noexcept override;
@@ -143,7 +180,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Machine* machine_{nullptr};
   rt::JobStore* job_{nullptr};
   const machining::MachineTables* tables_{nullptr};
-  JobFigures figures_;
+  JobFigures figures_{pins_};
 
   State state_value_{State::kIdle};
   Step step_{Step::kEnter};

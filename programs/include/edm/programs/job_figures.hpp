@@ -6,7 +6,8 @@
 //   job_shorts   Σ n_short;   job_arcs  Σ n_transient_arc + n_stable_arc
 //   job_depth_mm deepest depth_reached_mm of the job's drilling blocks
 //   job_wear_mm  estimated electrode wear (seed 004 eq. 8), summed over the drilling blocks
-// RT-safety: every member but visit() is RT-safe. Not thread-safe: the owning task calls them.
+// The outputs are listed in the owner's pin table. RT-safety: every member but the constructor
+// is RT-safe. Not thread-safe: the owning task calls them.
 
 #include <cstdint>
 
@@ -26,11 +27,21 @@ class JobFigures {
     std::int64_t n_short{0};
   };
 
-  rt::Output<double> job_time_s, job_depth_mm, job_wear_mm;
-  rt::Output<std::int64_t> job_pulses, job_shorts, job_arcs;
+  explicit JobFigures(rt::PinTable& owner)
+      : job_time_s{owner, "job_time_s", "s"},
+        job_pulses{owner, "job_pulses"},
+        job_shorts{owner, "job_shorts"},
+        job_arcs{owner, "job_arcs"},
+        job_depth_mm{owner, "job_depth_mm", "mm"},
+        job_wear_mm{owner, "job_wear_mm", "mm"} {}
 
-  /// Names the figures' pins (load time).
-  void visit(rt::PinVisitor& v);
+  rt::Output<double> job_time_s;
+  rt::Output<std::int64_t> job_pulses;
+  rt::Output<std::int64_t> job_shorts;
+  rt::Output<std::int64_t> job_arcs;
+  rt::Output<double> job_depth_mm;
+  rt::Output<double> job_wear_mm;
+
   /// A job begins at `start`: every figure is 0.
   void begin(rt::TimePoint start) noexcept;
   /// One cycle of the job at `now`.

@@ -2,7 +2,8 @@
 // PulseInputs: the generator's per-cycle pulse counters (the FPGA's, or the simulator's
 // io.td_sum_ns, io.td_count, io.n_open, io.n_short) as inputs of a C++ PROGRAM, named as the
 // TdDetector's inputs, and handed on to a child that has the same four inputs.
-// Non-RT: visit(), feed() (load and bind time); the pins themselves are RT-safe.
+// The pins are listed in the owner's pin table. Non-RT: construction, feed() (bind time); the
+// pins themselves are RT-safe.
 
 #include <cstdint>
 
@@ -11,14 +12,17 @@
 namespace edm::programs {
 
 struct PulseInputs {
-  rt::Input<std::int64_t> td_sum_ns, td_count, n_open, n_short;
+  explicit PulseInputs(rt::PinTable& owner)
+      : td_sum_ns{owner, "td_sum_ns", "ns"},
+        td_count{owner, "td_count"},
+        n_open{owner, "n_open"},
+        n_short{owner, "n_short"} {}
 
-  void visit(rt::PinVisitor& v) {
-    v.input("td_sum_ns", td_sum_ns, "ns");
-    v.input("td_count", td_count);
-    v.input("n_open", n_open);
-    v.input("n_short", n_short);
-  }
+  rt::Input<std::int64_t> td_sum_ns;
+  rt::Input<std::int64_t> td_count;
+  rt::Input<std::int64_t> n_open;
+  rt::Input<std::int64_t> n_short;
+
   /// `to`'s four counter inputs read these (a TdDetector, or another program's PulseInputs).
   template <class To>
   void feed(To& to) const noexcept {

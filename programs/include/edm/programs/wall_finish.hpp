@@ -88,34 +88,44 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
 
   WallFinish();
 
-  // Pins (named as in visit_own_pins).
-  PulseInputs pulses;  // td_sum_ns, td_count, n_open, n_short
-  rt::Input<double> x_mm, y_mm;
-  rt::Input<bool> start;
-  rt::Input<double> start_offset_mm;
-  rt::Input<double> final_offset_mm;
-  rt::Input<bool> hold;       // feed hold in the orbit
-  rt::Output<bool> no_spark;  // the no-spark timeout tripped (a fault)
-  rt::Output<double> vx_cmd_mm_s, vy_cmd_mm_s;
-  rt::Output<bool> gen_on;
-  rt::Output<bool> polarity_positive;
-  rt::Output<std::int64_t> state;
-  rt::Output<double> offset_mm;
-  rt::Output<double> rho_mm;  // reference radius actually commanded
-  rt::Output<std::int64_t> revolutions;
-  rt::Output<bool> done;
+  // Pins, listed in declaration order.
+  PulseInputs pulses{pins_};  // td_sum_ns, td_count, n_open, n_short
+  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
+  rt::Input<double> y_mm{pins_, "y_mm", "mm"};
+  rt::Input<bool> start{pins_, "start"};
+  rt::Input<double> start_offset_mm{pins_, "start_offset_mm", "mm"};
+  rt::Input<double> final_offset_mm{pins_, "final_offset_mm", "mm"};
+  rt::Input<bool> hold{pins_, "hold"};           // feed hold in the orbit
+  rt::Output<bool> no_spark{pins_, "no_spark"};  // the no-spark timeout tripped (a fault)
+  rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
+  rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
+  rt::Output<bool> gen_on{pins_, "gen_on"};
+  rt::Output<bool> polarity_positive{pins_, "polarity_positive"};
+  rt::Output<std::int64_t> state{pins_, "state"};
+  rt::Output<double> offset_mm{pins_, "offset_mm", "mm"};
+  rt::Output<double> rho_mm{pins_, "rho_mm", "mm"};  // reference radius actually commanded
+  rt::Output<std::int64_t> revolutions{pins_, "revolutions"};
+  rt::Output<bool> done{pins_, "done"};
   // The signals the sequence gives its children.
-  rt::Output<bool> polarity_request, generator_request;
-  rt::Output<bool> orbit_start, orbit_enable, rev_pulse;
-  rt::Output<double> orbit_r0_mm, orbit_final_mm;
-  rt::Output<double> x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s;
-  rt::Output<bool> loop_enable;
-  rt::Output<bool> gap_short;               // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable;          // the short retract records the contour (ORBIT only)
-  rt::Output<std::int64_t> short_retracts;  // retracts in this cycle
+  rt::Output<bool> polarity_request{pins_, "polarity_request"};
+  rt::Output<bool> generator_request{pins_, "generator_request"};
+  rt::Output<bool> orbit_start{pins_, "orbit_start"};
+  rt::Output<bool> orbit_enable{pins_, "orbit_enable"};
+  rt::Output<bool> rev_pulse{pins_, "rev_pulse"};
+  rt::Output<double> orbit_r0_mm{pins_, "orbit_r0_mm", "mm"};
+  rt::Output<double> orbit_final_mm{pins_, "orbit_final_mm", "mm"};
+  rt::Output<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
+  rt::Output<double> y_ref_mm{pins_, "y_ref_mm", "mm"};
+  rt::Output<double> vx_ff_mm_s{pins_, "vx_ff_mm_s", "mm/s"};
+  rt::Output<double> vy_ff_mm_s{pins_, "vy_ff_mm_s", "mm/s"};
+  rt::Output<bool> loop_enable{pins_, "loop_enable"};
+  rt::Output<bool> gap_short{pins_,
+                             "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<bool> retract_enable{
+      pins_, "retract_enable"};  // the short retract records the contour (ORBIT only)
+  rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this cycle
 
  protected:
-  void visit_own_pins(rt::PinVisitor& v) override;
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
   void bind_self() override;
   void activate_self() noexcept override;

@@ -7,7 +7,8 @@
 //           enter_safe_state() on entry into FAULT/ESTOP
 //
 // A block type derives from BlockWithParams<Params> (or Block for parameterless blocks),
-// declares its pins in visit_pins() and is registered by name in register_builtin_blocks().
+// declares its pins as members named in its pin table (pins_), and is registered by name in
+// register_builtin_blocks().
 // Pins are public Input<T>/Output<T> members, so a C++ PROGRAM connects its children by member.
 
 #include <cstdint>
@@ -72,8 +73,9 @@ class Block : public SafeStateHandler {
   Block(const Block&) = delete;
   Block& operator=(const Block&) = delete;
 
-  /// Names every pin. Called at load time (non-RT) and by listings.
-  virtual void visit_pins(PinVisitor& v) = 0;
+  /// Names every pin. Called at load time (non-RT) and by listings. By default the pins
+  /// declared with this block's table (`rt::Input<double> x_mm{pins_, "x_mm", "mm"};`).
+  virtual void visit_pins(PinVisitor& v) { pins_.visit(v); }
   /// Names every parameter of the live parameter set. Non-RT, load time only.
   virtual void visit_params(ParamVisitor& /*v*/) {}
   /// Checks the live parameters after the loader filled them. Non-RT.
@@ -106,6 +108,10 @@ class Block : public SafeStateHandler {
   [[nodiscard]] virtual ParamValue read_param(std::size_t index) const;
   /// Copies the live parameters to the shadow copy once loading is done. Non-RT.
   virtual void commit_params() {}
+
+ protected:
+  /// This block's named pins, in declaration order; declared before any derived member.
+  PinTable pins_;
 };
 
 /// Base for blocks with a Params struct: live parameters (read by update()) and a shadow copy

@@ -70,7 +70,8 @@ class CompositeBlock : public Block {
   /// Runs one cycle of a child; a fault is remembered as this cycle's fault source. RT-safe.
   BlockStatus step(Block& child, const CycleContext& ctx) noexcept;
 
-  virtual void visit_own_pins(PinVisitor& /*v*/) {}
+  /// The composite's own pins: by default those declared with its table (pins_).
+  virtual void visit_own_pins(PinVisitor& v) { pins_.visit(v); }
   virtual std::vector<ParamError> configure_self(const BlockSetup& /*setup*/) { return {}; }
   virtual void bind_self() {}
   virtual void activate_self() noexcept {}

@@ -26,6 +26,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace edm::rt {
 
@@ -54,10 +55,15 @@ concept PinValue = requires {
   PinTypeOf<T>::value;
 };
 
+class PinTable;
+
 template <PinValue T>
 class Output {
  public:
   explicit Output(T initial = T{}) noexcept : value_(initial), computed_(initial) {}
+  /// A named output, listed by `table` (its owner's pins) under `name` with `unit`. Both strings
+  /// must outlive the owner (string literals). Non-RT (construction).
+  Output(PinTable& table, std::string_view name, std::string_view unit = {}, T initial = T{});
   Output(const Output&) = delete;
   Output& operator=(const Output&) = delete;
 
@@ -101,6 +107,9 @@ class Input {
  public:
   /// default_value is what an unwired input reads (YAML may replace it with a constant).
   explicit Input(T default_value = T{}) noexcept : constant_(default_value) {}
+  /// A named input, listed by `table` (its owner's pins) under `name` with `unit`. Both strings
+  /// must outlive the owner (string literals). Non-RT (construction).
+  Input(PinTable& table, std::string_view name, std::string_view unit = {}, T default_value = T{});
   Input(const Input&) = delete;
   Input& operator=(const Input&) = delete;
 
@@ -240,5 +249,45 @@ class PinVisitor {
  protected:
   virtual void on_pin(std::string_view name, PinRef ref, std::string_view unit) = 0;
 };
+
+/// The named pins of one owner (a block, or a group of pins inside one), in the order they were
+/// declared: a pin constructed with a table adds itself, so its name and unit are written once,
+/// beside its declaration. Non-RT (construction and listing).
+class PinTable {
+ public:
+  PinTable() = default;
+  PinTable(const PinTable&) = delete;
+  PinTable& operator=(const PinTable&) = delete;
+
+  void add(std::string_view name, PinRef ref, std::string_view unit) {
+    entries_.push_back({name, ref, unit});
+  }
+  /// Hands every pin to `v`, in declaration order.
+  void visit(PinVisitor& v) const {
+    for (const Entry& e : entries_) {
+      v.forward(e.name, e.ref, e.unit);
+    }
+  }
+
+ private:
+  struct Entry {
+    std::string_view name;
+    PinRef ref;
+    std::string_view unit;
+  };
+  std::vector<Entry> entries_;
+};
+
+template <PinValue T>
+Output<T>::Output(PinTable& table, std::string_view name, std::string_view unit, T initial)
+    : Output(initial) {
+  table.add(name, PinRef::of(*this), unit);
+}
+
+template <PinValue T>
+Input<T>::Input(PinTable& table, std::string_view name, std::string_view unit, T default_value)
+    : Input(default_value) {
+  table.add(name, PinRef::of(*this), unit);
+}
 
 }  // namespace edm::rt
