@@ -75,8 +75,8 @@ HorizonResult choose_horizon(const std::vector<double>& x, double wn, const Hori
     ++r.scored;
     const double* win = f.data() + (k + 1 - opt.window);
     for (std::size_t p = 0; p <= opt.max_horizon; ++p) {
-      const auto fit =
-          blocks::GreyPredictorGM11::predict(win, opt.window, static_cast<std::int64_t>(p), false);
+      const auto fit = blocks::GreyPredictorGM11::predict(
+          win, opt.window, static_cast<std::int64_t>(p), opt.paper_exp);
       const double pred = fit.valid ? std::clamp(fit.prediction, opt.out_min, opt.out_max) : f[k];
       const double e = pred - o[k];
       r.rms[p] += e * e;
@@ -87,6 +87,36 @@ HorizonResult choose_horizon(const std::vector<double>& x, double wn, const Hori
   }
   r.best_rms = std::numeric_limits<double>::infinity();
   for (std::size_t p = 0; p <= opt.max_horizon; ++p) {
+    r.rms[p] = std::sqrt(r.rms[p] / static_cast<double>(r.scored));
+    if (r.rms[p] < r.best_rms) {
+      r.best_rms = r.rms[p];
+      r.best_p = p;
+    }
+  }
+  return r;
+}
+
+HorizonResult pool_horizons(const std::vector<HorizonResult>& results) {
+  if (results.empty()) {
+    throw std::invalid_argument("pool_horizons: no results");
+  }
+  HorizonResult r;
+  r.wn = results.front().wn;
+  r.rms.assign(results.front().rms.size(), 0.0);
+  for (const HorizonResult& x : results) {
+    if (x.rms.size() != r.rms.size()) {
+      throw std::invalid_argument("pool_horizons: results of different horizon ranges");
+    }
+    for (std::size_t p = 0; p < r.rms.size(); ++p) {
+      r.rms[p] += x.rms[p] * x.rms[p] * static_cast<double>(x.scored);
+    }
+    r.scored += x.scored;
+  }
+  if (r.scored == 0) {
+    throw std::invalid_argument("pool_horizons: nothing scored");
+  }
+  r.best_rms = std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < r.rms.size(); ++p) {
     r.rms[p] = std::sqrt(r.rms[p] / static_cast<double>(r.scored));
     if (r.rms[p] < r.best_rms) {
       r.best_rms = r.rms[p];

@@ -6,7 +6,8 @@
 //   filtered   f = ButterworthLowPass::design(Wn) applied to x, started in steady state at x(0)
 //   objective  o(k) = mean of x(k−L+1+s … k+s), L = 50, s = 25: the 50-step moving average
 //              shifted 25 steps back, i.e. centred on k + 0.5 (needs 25 future samples)
-//   prediction r_p(k) = GM(1,1) over f(k−n+1 … k) (n = 5), p steps ahead, clamped to
+//   prediction r_p(k) = GM(1,1) over f(k−n+1 … k) (n = 5), p steps ahead (eq. 1, or the ρ form
+//              with paper_exp = false: the block's two forms), clamped to
 //              [out_min, out_max]; the latest f(k) where the fit is not valid (as the block)
 //   error      RMS over k of r_p(k) − o(k): the value the controller uses at time k against the
 //              best non-causal estimate of the signal at time k
@@ -30,6 +31,7 @@ struct HorizonOptions {
   std::size_t warmup{300};      // samples skipped before scoring (filter transient)
   double out_min{0.0};          // the prediction's clamp (Rab: 0 … 1, as wired in the bench)
   double out_max{1.0};
+  bool paper_exp{true};  // the predictor's form: eq. 1's e^(−c) (the block's default) or ρ
 };
 
 struct HorizonResult {
@@ -53,5 +55,10 @@ std::vector<double> shifted_moving_average(const std::vector<double>& x, std::si
 /// The RMS error for every p and the best p (ties: the smaller p). Throws std::invalid_argument
 /// when the record leaves nothing to score.
 HorizonResult choose_horizon(const std::vector<double>& x, double wn, const HorizonOptions& opt);
+
+/// Pools results of the same Wn over several records: RMS² weighted by each record's scored
+/// samples, then the argmin again (ties: the smaller p). Throws std::invalid_argument on an
+/// empty list or on results of different lengths.
+HorizonResult pool_horizons(const std::vector<HorizonResult>& results);
 
 }  // namespace edm::greyhorizon

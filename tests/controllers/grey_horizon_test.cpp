@@ -97,3 +97,44 @@ TEST(GreyHorizon, TooShortARecordIsRefused) {
   gh::HorizonOptions opt;
   EXPECT_THROW(gh::choose_horizon(x, 0.012, opt), std::invalid_argument);
 }
+
+TEST(GreyHorizon, PoolingTwoRecordsIsScoringTheirConcatenatedErrors) {
+  // Pooled RMS² = (Σ over both records of the squared errors) / (samples of both): the same as
+  // one record scored twice when the records are equal, and the weighted mean of RMS² otherwise.
+  gh::HorizonOptions opt;
+  opt.max_horizon = 20;
+  const auto a = ramp(1200, 0.3, 2e-4);
+  auto b = ramp(1600, 0.5, -1e-4);
+  for (std::size_t k = 0; k < b.size(); ++k) b[k] += 0.01 * std::sin(0.05 * static_cast<double>(k));
+  const auto ra = gh::choose_horizon(a, 0.012, opt);
+  const auto rb = gh::choose_horizon(b, 0.012, opt);
+  const auto same = gh::pool_horizons({ra, ra});
+  EXPECT_EQ(same.best_p, ra.best_p);
+  EXPECT_EQ(same.scored, 2 * ra.scored);
+  const auto both = gh::pool_horizons({ra, rb});
+  ASSERT_EQ(both.rms.size(), ra.rms.size());
+  for (std::size_t p = 0; p < both.rms.size(); ++p) {
+    EXPECT_NEAR(same.rms[p], ra.rms[p], 1e-15);
+    const double want = (ra.rms[p] * ra.rms[p] * static_cast<double>(ra.scored) +
+                         rb.rms[p] * rb.rms[p] * static_cast<double>(rb.scored)) /
+                        static_cast<double>(ra.scored + rb.scored);
+    EXPECT_NEAR(both.rms[p] * both.rms[p], want, 1e-15);
+    EXPECT_GE(both.rms[p], both.best_rms);
+  }
+  EXPECT_THROW(gh::pool_horizons({}), std::invalid_argument);
+}
+
+TEST(GreyHorizon, PaperFormAndRhoChooseTheSameHorizonOnASlowSignal) {
+  // |c| ≪ 1 on a slowly drifting filtered signal: e^(−c) and ρ differ by O(c³) per step.
+  gh::HorizonOptions paper;
+  paper.max_horizon = 60;
+  gh::HorizonOptions rho = paper;
+  rho.paper_exp = false;
+  const auto x = ramp(3000, 0.3, 5e-5);
+  for (double wn : kPaperWn) {
+    const auto rp = gh::choose_horizon(x, wn, paper);
+    const auto rr = gh::choose_horizon(x, wn, rho);
+    EXPECT_EQ(rp.best_p, rr.best_p) << "Wn " << wn;
+    EXPECT_NEAR(rp.best_rms, rr.best_rms, 1e-9) << "Wn " << wn;
+  }
+}

@@ -124,7 +124,8 @@ TEST(SelfTuningFuzzyPI, increment_is_du_times_ku_abs_e_phi_psi) {
     const double f =
         (1.0 - std::exp(-5.0 * big_e * big_ce)) / (1.0 + std::exp(-5.0 * big_e * big_ce));
     const double phi = (1.0 + p.alpha) / 2.0 + (1.0 - p.alpha) / 2.0 * f;
-    const double psi = e < -0.01 ? std::max(0.0, p.ol * (1.0 + 100.0 * (c.x1 - c.f1))) : 1.0;
+    const double psi =
+        e < p.overload_error ? std::max(0.0, p.ol * (1.0 + 100.0 * (c.x1 - c.f1))) : 1.0;
     const double du = SelfTuningFuzzyPI::rule_output(big_e, big_ce);
     EXPECT_NEAR(pi.phi(), phi, 1e-12);
     EXPECT_NEAR(pi.psi(), psi, 1e-12);
@@ -161,7 +162,7 @@ TEST(SelfTuningFuzzyPI, phi_attenuates_when_approaching_the_set_point) {
 
 TEST(SelfTuningFuzzyPI, psi_boosts_the_action_in_overload_by_the_prediction_lead) {
   const SelfTuningFuzzyPIParams p;  // ol = 2
-  // Not overloaded (e ≥ −0.01): Ψ = 1 whatever d_pf is.
+  // Not overloaded (e ≥ 0.01, eq. 8): Ψ = 1 whatever d_pf is.
   Pi under(p);
   under.step(0.55, 0.50);
   under.step(0.55, 0.50);

@@ -8,15 +8,18 @@
 //   grey model   x⁰(k) + c·z(k) = b    (c: development coefficient, b: grey input)
 //   least squares over k = 2…n, in centred form (well conditioned for slowly varying data):
 //                c = −Σ(z−z̄)(x⁰−x̄) / Σ(z−z̄)²,   b = x̄ + c·z̄
-//   prediction   x̂⁰(n+p) = (b − c·x⁰(1))/(1 + c/2) · ρ^(n+p−2),   ρ = (1 − c/2)/(1 + c/2)
+//   prediction (eq. 1, the default, `paper_exp: true`), with y(0) = x⁰(1) the oldest sample:
+//                x̂⁰(n+p) = (1 − e^c)·(x⁰(1) − b/c)·e^(−c·(n−1+p))
+//                         = (b − c·x⁰(1))·expm1(c)/c·e^(−c·(n+p−1))   (no b/c: c = 0 is regular)
+//   or (`paper_exp: false`, an option)
+//                x̂⁰(n+p) = (b − c·x⁰(1))/(1 + c/2)·ρ^(n+p−2),   ρ = (1 − c/2)/(1 + c/2)
 //
-// The paper's eq. (1), ŷ(k+p) = (1 − e^c)(y(0) − b/c)·e^(−c(k+p)), is the same expression with ρ
-// replaced by e^(−c) (the whitened continuous solution). The two agree to O(c³) per step for the
-// slowly varying filtered Rab (|c| ≪ 1), but only ρ — the exact solution of the fitted difference
-// equation — makes the predictor exact on exponential sequences x⁰(k) = C·e^(αk) (the fit has
-// zero residual there and ρ = e^α). We use ρ by default; `paper_exp` selects e^(−c), written
-// as (b − c·x⁰(1))·expm1(c)/c·e^(−c(n+p−1)). Both forms are written without b/c, so c = 0 is
-// not a special case.
+// The paper's eq. (1), ŷ(k+p) = (1 − e^c)(y(0) − b/c)·e^(−c(k+p)), is the whitened continuous
+// solution of the fitted model; the option replaces e^(−c) by ρ, the exact solution of the fitted
+// difference equation. The two agree to O(c³) per step for the slowly varying filtered Rab
+// (|c| ≪ 1); only ρ makes the predictor exact on exponential sequences x⁰(k) = C·e^(αk) (the
+// fit has zero residual there and ρ = e^α). Until issue 20 ρ was the default; the paper's form
+// is now, and the wire benchmark (B6) measures both (docs/controllers.md).
 //
 // Outputs: out = x̂⁰(n+p) clamped to [out_min, out_max]; c and b of the fit; valid = true when
 // out is a prediction. The clamp matters for a ratio such as Rab: on a start-up transient (the
@@ -46,7 +49,7 @@ struct GreyPredictorGM11Params {
 
   std::int64_t window{5};    // n samples in the fit, 4..kMaxWindow (load time only)
   std::int64_t horizon{37};  // p samples ahead, 0..kMaxHorizon (seed 000: 37 at Wn = 0.012)
-  bool paper_exp{false};     // use e^(−c) of eq. (1) instead of the exact discrete ρ
+  bool paper_exp{true};      // eq. (1)'s e^(−c); false: the exact discrete ρ
   double out_min{-1e12};     // out is clamped to [out_min, out_max] (Rab: 0 and 1)
   double out_max{1e12};
 
@@ -62,8 +65,7 @@ struct GreyPredictorGM11Params {
              .range = rt::closed(0.0, static_cast<double>(kMaxHorizon))});
     v.param("paper_exp", paper_exp,
             {.unit = "",
-             .description =
-                 "use exp(-c) of the paper's eq. 1 (not exact on exponentials) instead of rho"});
+             .description = "true: exp(-c) of the paper's eq. 1; false: the exact discrete rho"});
     v.param("out_min", out_min, {.unit = "", .description = "lower clamp of out (Rab: 0)"});
     v.param("out_max", out_max,
             {.unit = "", .description = "upper clamp of out (Rab: 1), >= out_min"});

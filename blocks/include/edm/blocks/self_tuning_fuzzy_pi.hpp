@@ -9,10 +9,11 @@
 //           rule (E is A_i, CE is A_j) → dU is A_clamp(−(i+j), −3, 3),  i, j = −3…+3 (NB…PB)
 //           = Σ w_ij·clamp(−(i+j)) / Σ w_ij,   w_ij = min(μ_i(E), μ_j(CE))
 //   Φ     = g1 + g2·f(CE, 5E),  g1 = (1+α)/2, g2 = (1−α)/2, f(x, a) = (1 − e^(−a·x))/(1 + e^(−a·x))
-//   Ψ     = max(psi_min, ol·(1 + dpf_gain·d_pf)) if e < overload_error, else 1;  d_pf = Rab_p −
-//   Rab_f Gu    = Ku·|e|·Φ·Ψ,   Gv = Kv·|e|·Φ·Ψ                                          (eq. 6a,
-//   6b) u(k)  = clamp(u(k−1) + dU·Gu, u_min_us, u_max_us)                          (eq. 4a, 5a)
-//   v(k)  = clamp(v(k−1) + dU·Gv, v_min_v, v_max_v)                            (eq. 4b, 5b)
+//   Ψ     = max(psi_min, ol·(1 + dpf_gain·d_pf))  if e < overload_error, else 1            (eq. 8)
+//           d_pf = Rab_p − Rab_f
+//   Gu    = Ku·|e|·Φ·Ψ,   Gv = Kv·|e|·Φ·Ψ                                           (eq. 6a, 6b)
+//   u(k)  = clamp(u(k−1) + dU·Gu, u_min_us, u_max_us)                           (eq. 4a, 5a)
+//   v(k)  = clamp(v(k−1) + dU·Gv, v_min_v, v_max_v)                             (eq. 4b, 5b)
 //
 // Raising u or v lowers Rab (paper, Figs. 2-3): Rab above the set point gives e < 0, dU > 0, and
 // both actuators rise. Φ → 1 when E and CE have the same sign (the error grows) and → α when they
@@ -24,8 +25,9 @@
 //   exactly the table value; between them it interpolates.
 // - Table 3 is read back as dU = clamp(−(E + CE)) (SEEDS.md; the extracted table has a missing
 //   cell in column PS and agrees with the formula elsewhere).
-// - Eq. (8) reads "e < 0.01" in the extracted text; SEEDS.md gives e < −0.01 (Rab above the set
-//   point), which we use as the default of `overload_error`.
+// - Eq. (8) reads "e < 0.01": the default of `overload_error` is the paper's 0.01, so Ψ also
+//   acts in the band −0.01 ≤ e < 0.01 around the set point. (SEEDS.md's digest wrote e < −0.01,
+//   the default until issue 20; −0.01 remains a setting, see docs/controllers.md.)
 // - Ψ is floored at psi_min (default 0): ol·(1 + 100·d_pf) turns negative for d_pf < −0.01 and
 //   would reverse the action; the floor only prevents that reversal.
 // - Units: u in µs and v in V (Table 1: 9…50 µs, 30…70 V); Ku in µs and Kv in V per unit of
@@ -52,17 +54,17 @@
 namespace edm::blocks {
 
 struct SelfTuningFuzzyPIParams {
-  double ge{5.0};                // Ge [1/Rab], Table 5
-  double gce{40.0};              // Gce [1/Rab], Table 5
-  double alpha{0.7};             // α in (0, 1], Table 5
-  double ol{2.0};                // overloading parameter, Table 5
-  double ku{0.06};               // Ku [µs], Table 5 case 1
-  double kv{0.03};               // Kv [V], Table 5 case 1
-  double rab_ref_default{0.6};   // Rab_ref in (0, 1] while the rab_ref input is 0, Table 5 case 1
-  double overload_error{-0.01};  // Ψ applies when e < this (eq. 8)
-  double dpf_gain{100.0};        // the 100 of eq. 8
-  double psi_min{0.0};           // floor of Ψ in overload (≥ 0)
-  double u_min_us{9.0};          // arc-off time range, Table 1 [µs]
+  double ge{5.0};               // Ge [1/Rab], Table 5
+  double gce{40.0};             // Gce [1/Rab], Table 5
+  double alpha{0.7};            // α in (0, 1], Table 5
+  double ol{2.0};               // overloading parameter, Table 5
+  double ku{0.06};              // Ku [µs], Table 5 case 1
+  double kv{0.03};              // Kv [V], Table 5 case 1
+  double rab_ref_default{0.6};  // Rab_ref in (0, 1] while the rab_ref input is 0, Table 5 case 1
+  double overload_error{0.01};  // Ψ applies when e < this (eq. 8 as printed: 0.01)
+  double dpf_gain{100.0};       // the 100 of eq. 8
+  double psi_min{0.0};          // floor of Ψ in overload (≥ 0)
+  double u_min_us{9.0};         // arc-off time range, Table 1 [µs]
   double u_max_us{50.0};
   double u_initial_us{20.0};  // arc-off time after activate() [µs]
   double v_min_v{30.0};       // servo reference voltage range, Table 1 [V]
@@ -94,8 +96,8 @@ struct SelfTuningFuzzyPIParams {
              .range = rt::closed(1e-9, 1.0)});
     v.param("overload_error", overload_error,
             {.unit = "1",
-             .description = "Psi applies when e is below this",
-             .range = rt::closed(-1.0, 0.0)});
+             .description = "Psi applies when e is below this (eq. 8: 0.01)",
+             .range = rt::closed(-1.0, 1.0)});
     v.param("dpf_gain", dpf_gain,
             {.unit = "1",
              .description = "gain on d_pf = Rab_p - Rab_f in Psi",
