@@ -47,9 +47,19 @@ std::vector<rt::ParamError> FuzzyServoLUT::configure(const rt::BlockSetup& /*set
   if (!rules) {
     return {{"rules", se.message}};
   }
+  // The paper's coding: y = round(quant_num · v / quant_den), v in paper units (±quant_v_full).
+  const double code_per_unit = static_cast<double>(params_.quant_num) /
+                               static_cast<double>(params_.quant_den) * params_.quant_v_full;
+  const double full_code = std::round(code_per_unit);
+  if (!(full_code >= 1.0 && full_code <= 32767.0)) {
+    return {{"quant_num", "the full-scale code round(quant_num * quant_v_full / quant_den) = " +
+                              std::to_string(full_code) +
+                              " does not fit the int16 table (1 ... 32767)"}};
+  }
   engine_ =
       std::make_unique<fuzzy::MamdaniEngine>(std::move(inputs), std::move(out), std::move(*rules),
                                              static_cast<std::size_t>(params_.samples));
+  table_.fill(0);  // addresses with a count above 32 are never read
   for (int o = 0; o < kCounts; ++o) {
     for (int s = 0; s < kCounts; ++s) {
       const double x[3] = {static_cast<double>(o), static_cast<double>(s),
@@ -60,10 +70,14 @@ std::vector<rt::ParamError> FuzzyServoLUT::configure(const rt::BlockSetup& /*set
         return {{"rules", "no rule fires at open = " + std::to_string(o) + ", short = " +
                               std::to_string(s) + " (every reachable cell needs one)"}};
       }
-      table_[static_cast<std::size_t>(o * kCounts + s)] =
-          std::isnan(y) ? 0.0 : std::clamp(y, -1.0, 1.0);
+      const double v = std::isnan(y) ? 0.0 : std::clamp(y, -1.0, 1.0);
+      const double v_paper = params_.quant_v_full * v;
+      table_[static_cast<std::size_t>(address(o, s))] =
+          static_cast<std::int16_t>(std::lround(static_cast<double>(params_.quant_num) * v_paper /
+                                                static_cast<double>(params_.quant_den)));
     }
   }
+  lsb_ = 1.0 / code_per_unit;
   return errs;
 }
 
@@ -75,7 +89,7 @@ rt::BlockStatus FuzzyServoLUT::update(const rt::CycleContext& /*ctx*/) noexcept 
   if (o < 0 || o > kWindow || s < 0 || s > kWindow) {
     return rt::BlockStatus::kFault;
   }
-  v_mm_s_.set(params_.v_max_mm_s * table_[static_cast<std::size_t>(o * kCounts + s)]);
+  v_mm_s_.set(params_.v_max_mm_s * table(static_cast<int>(o), static_cast<int>(s)));
   return rt::BlockStatus::kOk;
 }
 

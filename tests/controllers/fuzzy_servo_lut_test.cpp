@@ -1,4 +1,5 @@
-// Seed 003 fuzzy servo controller: the Mamdani engine, its text encoding, and the 33 × 33 table.
+// Seed 003 fuzzy servo controller: the Mamdani engine, its text encoding, and the integer table.
+// The table against direct inference at off-grid inputs: seed_003_lut_vs_inference_test.cpp.
 
 #include "edm/blocks/fuzzy_servo_lut.hpp"
 
@@ -14,25 +15,11 @@
 namespace edm::blocks {
 namespace {
 
-constexpr double kCornerTol = 1e-9;
-
 fuzzy::Variable variable(const std::string& name, const std::string& text) {
   fuzzy::SyntaxError err;
   auto terms = fuzzy::parse_terms(text, err);
   EXPECT_TRUE(terms.has_value()) << err.message;
   return {name, terms.value_or(std::vector<fuzzy::Term>{})};
-}
-
-// An engine built here from the parameter strings, independently of the block's own instance.
-fuzzy::MamdaniEngine engine_from(const FuzzyServoLUTParams& p) {
-  std::vector<fuzzy::Variable> in{
-      variable("open", p.open_terms), variable("short", p.short_terms), {"normal", {}}};
-  fuzzy::Variable out = variable("v", p.velocity_terms);
-  fuzzy::SyntaxError err;
-  auto rules = fuzzy::parse_rules(p.rules, in, out, err);
-  EXPECT_TRUE(rules.has_value()) << err.message;
-  return fuzzy::MamdaniEngine(in, out, rules.value_or(std::vector<fuzzy::Rule>{}),
-                              static_cast<std::size_t>(p.samples));
 }
 
 TEST(FuzzyServoLUT, default_open_terms_match_the_papers_example) {
@@ -52,6 +39,29 @@ TEST(FuzzyServoLUT, default_open_terms_match_the_papers_example) {
   }
 }
 
+TEST(FuzzyServoLUT, the_table_holds_the_papers_integer_codes_at_the_papers_addresses) {
+  // Paper, §2.2 (2): y = round(30000 · velocity / 366), velocity in [−5, +5]: the corners are
+  // all-open → +5 → round(409.84) = +410, all-short → −410, all-normal → 0.
+  BlockHarness<FuzzyServoLUT> h;
+  h.start_ok(FuzzyServoLUTParams{});
+  const auto& b = h.block();
+  EXPECT_EQ(b.code(32, 0), 410);
+  EXPECT_EQ(b.code(0, 32), -410);
+  EXPECT_EQ(b.code(0, 0), 0);
+  EXPECT_DOUBLE_EQ(b.lsb(), 366.0 / (30000.0 * 5.0));
+  // Open count = high address, short count = low address, 6 bits each.
+  EXPECT_EQ(FuzzyServoLUT::address(32, 0), 32 * 64);
+  EXPECT_EQ(FuzzyServoLUT::address(0, 32), 32);
+  EXPECT_EQ(FuzzyServoLUT::kWords, 4096);
+  // Every code fits the paper's 10-bit word (4096 words × 10 bits = the paper's 40 960 bits).
+  for (int o = 0; o < 64; ++o) {
+    for (int s = 0; s < 64; ++s) {
+      ASSERT_LE(std::abs(int{b.code(o, s)}), 410) << o << "," << s;
+      ASSERT_TRUE((o <= 32 && s <= 32) || b.code(o, s) == 0) << "unreadable word " << o << "," << s;
+    }
+  }
+}
+
 TEST(FuzzyServoLUT, corners_all_open_advance_all_short_retract_all_normal_hold) {
   BlockHarness<FuzzyServoLUT> h;
   FuzzyServoLUTParams p;
@@ -65,33 +75,23 @@ TEST(FuzzyServoLUT, corners_all_open_advance_all_short_retract_all_normal_hold) 
     EXPECT_EQ(h.step(), BlockStatus::kOk);
     return h.out("v_mm_s");
   };
-  EXPECT_NEAR(v(32, 0), +2.5, kCornerTol * 2.5);
-  EXPECT_NEAR(v(0, 32), -2.5, kCornerTol * 2.5);
-  EXPECT_NEAR(v(0, 0), 0.0, kCornerTol * 2.5);
+  // Read back from the integer code: within half a code of ±v_max (410 · 366 / 30000 = 5.002).
+  const double half_code = 2.5 * h.block().lsb() / 2.0;
+  EXPECT_NEAR(v(32, 0), +2.5, half_code);
+  EXPECT_NEAR(v(0, 32), -2.5, half_code);
+  EXPECT_EQ(v(0, 0), 0.0);
 }
 
-TEST(FuzzyServoLUT, every_cell_equals_direct_inference) {
-  BlockHarness<FuzzyServoLUT> h;
-  const FuzzyServoLUTParams p;
-  ASSERT_TRUE(h.start(p).empty());
-  const auto eng = engine_from(p);
-  auto& open = h.source<std::int64_t>("open_count");
-  auto& shorts = h.source<std::int64_t>("short_count");
-  for (int o = 0; o <= 32; ++o) {
-    for (int s = 0; s <= 32; ++s) {
-      const double x[3] = {double(o), double(s), double(std::max(0, 32 - o - s))};
-      const double direct = eng.infer(x);
-      if (o + s <= 32) {
-        ASSERT_FALSE(std::isnan(direct)) << o << "," << s;
-      }
-      const double want = std::isnan(direct) ? 0.0 : std::clamp(direct, -1.0, 1.0);
-      ASSERT_EQ(h.block().table(o, s), want) << "open " << o << " short " << s;
-      open.set(o);
-      shorts.set(s);
-      ASSERT_EQ(h.step(), BlockStatus::kOk);
-      ASSERT_EQ(h.out("v_mm_s"), p.v_max_mm_s * want);
-    }
-  }
+TEST(FuzzyServoLUT, a_coding_whose_full_scale_overflows_the_int16_table_is_refused) {
+  FuzzyServoLUTParams p;
+  p.quant_num = 3'000'000;  // 5 · 3e6 / 366 = 40 984 codes
+  FuzzyServoLUT blk;
+  blk.set_params(p);
+  ASSERT_TRUE(blk.validate().empty());
+  const auto errs = blk.configure({"test.lut", std::chrono::milliseconds(1)});
+  ASSERT_EQ(errs.size(), 1u);
+  EXPECT_EQ(errs[0].field, "quant_num");
+  EXPECT_NE(errs[0].message.find("40984"), std::string::npos) << errs[0].message;
 }
 
 TEST(FuzzyServoLUT, monotone_in_open_and_short_over_the_reachable_triangle) {
@@ -215,9 +215,9 @@ TEST(FuzzyServoLUT, normal_count_variable_and_custom_rules) {
   BlockHarness<FuzzyServoLUT> h;
   const auto errs = h.start(p);
   ASSERT_TRUE(errs.empty()) << describe(errs);
-  EXPECT_NEAR(h.block().table(0, 0), 0.0, kCornerTol);  // 32 normal
-  EXPECT_NEAR(h.block().table(32, 0), 1.0, kCornerTol);
-  EXPECT_NEAR(h.block().table(0, 32), 1.0, kCornerTol);
+  EXPECT_EQ(h.block().code(0, 0), 0);  // 32 normal
+  EXPECT_EQ(h.block().code(32, 0), 410);
+  EXPECT_EQ(h.block().code(0, 32), 410);
   EXPECT_GT(h.block().table(10, 10), h.block().table(5, 5));
 }
 
@@ -243,9 +243,11 @@ TEST(FuzzyServoLUT, v_max_is_writable_at_run_time_and_strings_are_not) {
   h.source<std::int64_t>("open_count").set(32);
   ASSERT_TRUE(h.write_param("v_max_mm_s", rt::ParamValue::of_real(1.5)).empty());
   h.step();
-  EXPECT_NEAR(h.out("v_mm_s"), 1.5, 1.5 * kCornerTol);
+  EXPECT_NEAR(h.out("v_mm_s"), 1.5, 1.5 * h.block().lsb() / 2.0);
   EXPECT_FALSE(h.write_param("v_max_mm_s", rt::ParamValue::of_real(-1.0)).empty());
   EXPECT_FALSE(h.block().stage_param(h.param_index("rules"), rt::ParamValue{}).empty());
+  EXPECT_FALSE(h.write_param("quant_den", rt::ParamValue::of_int(300)).empty())
+      << "the coding filled the table: load time only";
 }
 
 }  // namespace

@@ -2,40 +2,43 @@
 // DischargeStateCounter: the discharge-state statistics circuit of seed 003 (Liu 2011, §1, Fig. 2).
 //
 // Three 32-bit shift registers R_open, R_normal, R_short remember the class of the last 32
-// sampled pulses. Each pulse shifts every register left by one; a 1 enters bit D0 of the
-// register of the pulse's class and a 0 enters the other two; the 33rd-oldest pulse drops out of
-// D31. The counts are popcounts:
+// sampled pulses (bit 0 = newest pulse, the 33rd-oldest drops out of bit 31). The counts are
+// popcounts:
 //
 //   N_open = popcount(R_open),  N_normal = popcount(R_normal),  N_short = popcount(R_short)
 //   N_open + N_normal + N_short = min(32, pulses seen since activate())          [pulses]
 //
-// The analysis interval m (LINT `interval`, ≥ 1) latches the three counts every m pulses (the
-// paper's 锁存信号); the latched counts are the outputs and `data_ready` is true in each cycle in
-// which at least one latch happened (the paper's data-ready flag, as a one-cycle pulse). m = 1
-// latches after every pulse (newest pulse plus 31 old ones); m ≥ 32 makes every latched window
-// consist only of pulses that arrived after the previous latch ("all-new pulses").
+// The registers are not rebuilt here: the block reads the generator's own last-32 class bitmasks
+// (the simulator's io.hist_open, io.hist_short, io.hist_arc; bit 0 newest), which the plant shifts
+// one bit per pulse exactly as the paper's registers do. From them:
 //
-// Input mapping (choices; the paper samples one pulse at a time, a PLC cycle sees many):
-// - Classes. The paper has open / normal / short (arcs are rare in EDM milling and left out).
-//   The simulator also reports transient and stable arcs; with `arcs_as_short` (default) they are
-//   counted as short (seed 000 lumps arcs with shorts as "abnormal"), otherwise as normal.
-// - Order within a cycle. The cycle's T = o + n + s pulses (o open, n normal, s short incl. arcs)
-//   are shifted in a fixed, evenly interleaved order: open pulses are spread over the T slots by
-//   a centred Bresenham sequence, E(i; a, T) = ⌊(2·i·a + T) / (2T)⌋ open pulses among the first i,
-//   and the remaining T − o slots are split between normal and short the same way. Every class
-//   enters exactly its count (the sum invariant holds), any 32 consecutive pulses of one cycle
-//   hold each class within ±2 of its proportional share, and the result depends on nothing but
-//   the counts (deterministic). The class of pulse i is O(1), so a cycle costs at most two
-//   32-pulse windows (the last latch of the cycle and the end of the cycle), whatever T is.
-// - Latches inside a cycle. When several latches fall inside one cycle, the outputs show the
-//   last one; `latches` says how many there were.
+//   R_open   = hist_open
+//   R_short  = hist_short | hist_arc         (arcs_as_short, the default)  or  hist_short
+//   R_normal = ~(hist_open | hist_short | hist_arc) (| hist_arc when arcs count as normal)
 //
-// Counters that are negative or above kMaxCount per cycle are a broken signal: nothing is
-// shifted, the outputs are held and update() returns kFault.
+// each masked to the pulses seen since activate() (the paper's registers start cleared, so the
+// three counts sum to 32 only once 32 pulses have been seen). The per-cycle pulse counters
+// (n_open … n_stable_arc) are the paper's sampling signal: their sum T is the number of pulses
+// that were shifted in this cycle, and it clocks the analysis interval.
+//
+// Analysis interval m (LINT `interval`, ≥ 1; the paper's 分析间隔数 and 锁存信号): the counts are
+// latched when at least m pulses have been shifted in since the previous latch, and `data_ready`
+// is true in the cycle of a latch (the paper's data-ready flag, as a one-cycle pulse).
+// m ≥ 32 makes every latched window consist only of pulses that arrived after the previous latch
+// (the paper's "all-new pulses").
+//
+// Deviation (the one a PLC cannot avoid): a PLC cycle sees many pulses (about 26 per 1 ms cycle
+// on the drill preset) and the bitmasks only at the cycle's end, so a latch falls at the end of
+// the first cycle in which the m-th pulse since the previous latch arrived, not at that pulse:
+// latches are at most one per cycle and m … m + T − 1 pulses apart. With m ≤ T the block latches
+// every cycle with pulses (the paper's m = 1 behaviour: the newest pulses plus old ones).
+//
+// A broken signal — a bitmask outside 0 … 2³² − 1, two class bitmasks with a common bit (a pulse
+// has one class), or a counter that is negative or above kMaxCount — shifts nothing, holds the
+// outputs and makes update() return kFault.
 // RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
 
 #include <cstdint>
-#include <vector>
 
 #include "edm/runtime/block.hpp"
 
@@ -50,8 +53,8 @@ struct DischargeStateCounterParams {
   void visit(rt::ParamVisitor& v) {
     v.param("interval", interval,
             {.unit = "pulses",
-             .description = "analysis interval m: latch the counts every m pulses (>= 32: all-new "
-                            "pulses)",
+             .description = "analysis interval m: latch the counts once m pulses arrived since "
+                            "the last latch (>= 32: all-new pulses)",
              .range = rt::closed(1.0, static_cast<double>(kMaxInterval))});
     v.param("arcs_as_short", arcs_as_short,
             {.unit = "",
@@ -63,33 +66,23 @@ class DischargeStateCounter final : public rt::BlockWithParams<DischargeStateCou
  public:
   /// Register width and largest count (paper: 32-bit shift registers).
   static constexpr int kBits = 32;
-  /// Per-cycle count above this is a broken signal (keeps 2·i·a in int64).
+  /// Per-cycle count above this is a broken signal.
   static constexpr std::int64_t kMaxCount = std::int64_t{1} << 28;
 
-  enum class PulseClass : std::uint8_t { kOpen, kNormal, kShort };
-  /// Non-RT. Clears the registers and the outputs.
+  /// Non-RT. Clears the registers, the pulse count and the outputs.
   void activate() noexcept override;
-  /// RT-safe. kOk, or kFault (nothing shifted, outputs held) on a broken counter.
+  /// RT-safe. kOk, or kFault (nothing shifted, outputs held) on a broken signal.
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
-  /// Class of pulse i (0-based) among the o + n + s pulses of one cycle, in the interleaved order
-  /// described above. Pure, RT-safe; exposed for tests.
-  static PulseClass pulse_class(std::int64_t i, std::int64_t o, std::int64_t n,
-                                std::int64_t s) noexcept;
-
-  /// The live registers (bit 0 = newest pulse). Owning thread only (tests, diagnostics).
+  /// The live registers after the last update (bit 0 = newest pulse). Owning thread only.
   [[nodiscard]] std::uint32_t open_register() const noexcept { return reg_[0]; }
   [[nodiscard]] std::uint32_t normal_register() const noexcept { return reg_[1]; }
   [[nodiscard]] std::uint32_t short_register() const noexcept { return reg_[2]; }
 
  private:
-  struct Regs {
-    std::uint32_t r[3]{0, 0, 0};
-  };
-  // Registers after pulses 0..j of this cycle were shifted into `before`.
-  static Regs shifted(const Regs& before, std::int64_t j, std::int64_t o, std::int64_t n,
-                      std::int64_t s) noexcept;
-
+  rt::Input<std::int64_t> hist_open_{pins_, "hist_open", "bitmask"};
+  rt::Input<std::int64_t> hist_short_{pins_, "hist_short", "bitmask"};
+  rt::Input<std::int64_t> hist_arc_{pins_, "hist_arc", "bitmask"};
   rt::Input<std::int64_t> n_open_{pins_, "n_open", "pulses"};
   rt::Input<std::int64_t> n_normal_{pins_, "n_normal", "pulses"};
   rt::Input<std::int64_t> n_short_{pins_, "n_short", "pulses"};
@@ -98,9 +91,9 @@ class DischargeStateCounter final : public rt::BlockWithParams<DischargeStateCou
   rt::Output<std::int64_t> open_count_{pins_, "open_count", "pulses"};
   rt::Output<std::int64_t> normal_count_{pins_, "normal_count", "pulses"};
   rt::Output<std::int64_t> short_count_{pins_, "short_count", "pulses"};
-  rt::Output<std::int64_t> latches_{pins_, "latches"};
   rt::Output<bool> data_ready_{pins_, "data_ready"};
   std::uint32_t reg_[3]{0, 0, 0};
+  std::int64_t seen_{0};         // pulses since activate(), saturated at kBits
   std::int64_t since_latch_{0};  // pulses since the last latch, < interval
 };
 
