@@ -89,7 +89,10 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
       if ((ratio != wanted || ratio_in < 0.0) && status == rt::BlockStatus::kOk) {
         status = rt::BlockStatus::kSaturated;
       }
-      vd = ratio * area_ratio_ * new_depth_mm / dt_s_;  // v_bottom = new depth per cycle
+      const double area_in = area_ratio.get();
+      if (!std::isfinite(area_in)) status = rt::BlockStatus::kFault;
+      const double areas = area_in > 0.0 && std::isfinite(area_in) ? area_in : area_ratio_;
+      vd = ratio * areas * new_depth_mm / dt_s_;  // v_bottom = new depth per cycle
     }
   }
   const double vz_out = vz_in - vd;

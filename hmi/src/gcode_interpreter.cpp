@@ -424,12 +424,14 @@ class Interpreter {
     }
     const Condition* c = tables_.condition(armed_);
     const double lz = start.z - target.z;
-    const machining::WearPrecomp wp =
-        machining::wear_precompensate(lz, c != nullptr ? c->wear_ratio : 0.0);
-    mb.z_travel_mm = wp.travel_mm;
+    // Eq. (9)-(11): wear is planned for the depth eroded, below the work surface (Z0).
+    const double lz_cut = std::max(0.0, std::min(start.z, 0.0) - target.z);
+    const machining::WearPrecomp wp = machining::wear_precompensate(
+        lz_cut, c != nullptr ? c->wear_ratio : 0.0, c != nullptr ? c->area_ratio : 1.0);
+    mb.z_travel_mm = lz + wp.delta_mm;
     result_.blocks.push_back(mb);
     pos_ = start;  // the runtime retracts out of the hole and returns to the block's start
-    result_.drill_depth_mm += lz;
+    result_.drill_depth_mm += lz_cut;
     result_.electrode_wear_mm += wp.delta_mm;
     ++result_.drill_blocks;
   }

@@ -86,7 +86,7 @@ SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out)
   out.loc = v.loc;
   SourceLoc e_loc = v.loc;
   auto m = r.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
-                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio"});
+                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio", "area_ratio"});
   if (!m) {
     return e_loc;
   }
@@ -114,6 +114,15 @@ SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out)
         r.error(f->value, "must be in 0..10 (got " + f->value.node.Scalar() + ")");
       } else {
         out.wear_ratio = *x;
+      }
+    }
+  }
+  if (const Field* f = m->find("area_ratio")) {
+    if (auto x = r.real(f->value)) {
+      if (!(*x > 0.0 && *x <= 100.0)) {
+        r.error(f->value, "must be in (0, 100] (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.area_ratio = *x;
       }
     }
   }

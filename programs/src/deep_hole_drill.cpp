@@ -90,6 +90,7 @@ void DeepHoleDrill::bind_self() {
   gap_.tdr_us.follow(tdr_us);
   wear_.vz_in_mm_s.connect(vz_servo_cmd_mm_s);
   wear_.wear_ratio.follow(wear_ratio);
+  wear_.area_ratio.follow(area_ratio);
   wear_.enable.follow(enable_wear_comp);
   wear_.reset_wear.connect(reset_wear);
   retract_.z_mm.follow(z_mm);

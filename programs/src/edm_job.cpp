@@ -72,6 +72,7 @@ void EdmJob::bind_self() {
   drill_.start.connect(drill_start);
   drill_.depth_mm.connect(drill_depth_mm);
   drill_.wear_ratio.connect(wear_ratio);
+  drill_.area_ratio.connect(area_ratio);
   drill_.tdr_us.connect(tdr_us);
   drill_.hold.connect(feed_hold);
   finish_.hold.connect(feed_hold);  // one hold for either child
@@ -173,6 +174,7 @@ void EdmJob::select_condition(int e) noexcept {
   off_time_us.set(condition_->off_time_us);
   servo_ref_v.set(condition_->servo_ref_v);
   wear_ratio.set(condition_->wear_ratio);
+  area_ratio.set(condition_->area_ratio);
   tdr_us.set(condition_->tdr_us);
 }
 

@@ -217,6 +217,26 @@ TEST(WearCompensatorTest, runtime_write_of_the_areas) {
   EXPECT_FALSE(h.write_param("hole_area_mm2", rt::ParamValue::of_real(0.0)).empty());
 }
 
+// The active condition's A_hole/A_e (EdmJob wires it) replaces the area parameters while > 0, so
+// eq. 8 and the HMI's eq. 10 use one ratio; unwired (0) or negative: the parameters' ratio.
+TEST(WearCompensatorTest, area_ratio_input_replaces_the_area_parameters_while_positive) {
+  BlockHarness<WearCompensator> h(1ms);
+  ASSERT_TRUE(h.start({.hole_area_mm2 = 2.0, .electrode_area_mm2 = 1.0}).empty());
+  h.source<double>("wear_ratio").set(0.5);
+  auto& areas = h.source<double>("area_ratio");
+  EXPECT_EQ(step(h, -1.0), BlockStatus::kOk);
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.5 * 2.0 * 1.0, 1e-12) << "unwired: the parameters' 2.0";
+  areas.set(1.3297);
+  EXPECT_EQ(step(h, -2.0), BlockStatus::kOk);
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.5 * 1.3297 * 2.0, 1e-12) << "the condition's ratio";
+  areas.set(-1.0);
+  EXPECT_EQ(step(h, -3.0), BlockStatus::kOk);
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.5 * 2.0 * 3.0, 1e-12) << "not positive: the parameters'";
+  areas.set(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(step(h, -4.0), BlockStatus::kFault) << "a broken ratio is reported";
+  EXPECT_NEAR(h.out("vd_mm_s"), 0.5 * 2.0 * 4.0, 1e-12) << "and the parameters' ratio used";
+}
+
 TEST(WearCompensatorTest, validate_refuses_bad_parameters) {
   EXPECT_TRUE(rt::validate_params(WearCompensatorParams{}).empty());
   EXPECT_FALSE(rt::validate_params(WearCompensatorParams{.hole_area_mm2 = -1.0}).empty());

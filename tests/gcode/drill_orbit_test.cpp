@@ -13,15 +13,18 @@ namespace {
 
 using machining::Vec3;
 
-// Seed 004 eq. (9)-(11) written out with explicit rates, independently of the library:
-// Tw = lz/(MRRw/A), δ = Vd·Tw with Vd = MRRe/A (eq. 8), lz' = lz + δ; θ = MRRe/MRRw.
-double precompensated_travel(double lz, double theta) {
-  const double area = std::numbers::pi * 0.5 * 0.5;  // Ø1 mm electrode, mm²
-  const double mrr_w = 2.7;                          // mm³/s, any value
+// Seed 004 eq. (8)-(11) written out with explicit rates and the two cross-sections, independently
+// of the library: Vd = MRRe/A_e (8), the hole bottom advances at MRRw/A_hole so
+// Tw = lz/(MRRw/A_hole) (9), δ = Vd·Tw (10), and the Z travel is the block's length + δ (11);
+// θ = MRRe/MRRw. lz is the depth eroded (below the work surface Z0), `block` the whole Z move.
+double precompensated_travel(double block, double lz, double theta, double area_ratio) {
+  const double a_e = std::numbers::pi * (0.5 * 0.5 - 0.15 * 0.15);  // Ø1.0/0.3 tube, mm²
+  const double a_hole = area_ratio * a_e;
+  const double mrr_w = 2.7;  // mm³/s, any value
   const double mrr_e = theta * mrr_w;
-  const double tw = lz / (mrr_w / area);     // (9)
-  const double delta = (mrr_e / area) * tw;  // (10)
-  return lz + delta;                         // (11)
+  const double tw = lz / (mrr_w / a_hole);  // (9)
+  const double delta = (mrr_e / a_e) * tw;  // (10)
+  return block + delta;                     // (11)
 }
 
 TEST(GcodeDrill, G01DownWhileArmedIsAGapControlledDrillBlock) {
@@ -30,22 +33,23 @@ TEST(GcodeDrill, G01DownWhileArmedIsAGapControlledDrillBlock) {
   const auto d = of_kind(r.blocks, MotionKind::kDrill);
   ASSERT_EQ(d.size(), 1u);
   EXPECT_EQ(d[0].target, (Vec3{3, 4, -20}));  // nominal bottom
-  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(20.5, 0.6), 1e-9);
-  EXPECT_NEAR(d[0].z_travel_mm, 32.8, 1e-9);
+  // 0.5 mm of air above the surface, 20 mm eroded: wear planned for the 20 mm only.
+  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(20.5, 20.0, 0.6, 1.25), 1e-9);
+  EXPECT_NEAR(d[0].z_travel_mm, 20.5 + 0.6 * 1.25 * 20.0, 1e-9);
   EXPECT_DOUBLE_EQ(d[0].feed_mm_s, 1.0);  // F caps the gap-controlled speed
   EXPECT_EQ(d[0].condition, 1);
   EXPECT_EQ(d[0].line, 3);
   EXPECT_EQ(d[0].col, 1);
   EXPECT_EQ(r.drill_blocks, 1);
-  EXPECT_NEAR(r.drill_depth_mm, 20.5, 1e-9);
-  EXPECT_NEAR(r.electrode_wear_mm, 0.6 * 20.5, 1e-9);
+  EXPECT_NEAR(r.drill_depth_mm, 20.0, 1e-9);
+  EXPECT_NEAR(r.electrode_wear_mm, 0.6 * 1.25 * 20.0, 1e-9);
 }
 
 TEST(GcodeDrill, UsesTheArmedConditionsWearRatio) {
   const auto d = of_kind(blocks_of("E2\nG91 G01 Z-4 F30\nZ-6"), MotionKind::kDrill);
   ASSERT_EQ(d.size(), 2u);
-  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(4.0, 0.05), 1e-9);
-  EXPECT_NEAR(d[1].z_travel_mm, precompensated_travel(6.0, 0.05), 1e-9);
+  EXPECT_NEAR(d[0].z_travel_mm, precompensated_travel(4.0, 4.0, 0.05, 1.0), 1e-9);
+  EXPECT_NEAR(d[1].z_travel_mm, precompensated_travel(6.0, 6.0, 0.05, 1.0), 1e-9);
   // A drilling block ends back at its start point (the runtime retracts out of the hole and
   // returns there), so the incremental second block starts at Z0 again.
   EXPECT_DOUBLE_EQ(d[1].target.z, -6.0);
@@ -86,12 +90,12 @@ TEST(GcodeDrill, MustBeStraight) {
 }
 
 TEST(GcodeDrill, PrecompensatedTravelMustStayInsideTheZLimits) {
-  // Nominal −50 is inside −60..20, but the Z axis travels 50·1.6 = 80 mm, to −80.
+  // Nominal −40 is inside −60..20, but the Z axis travels 40 + 0.6·1.25·40 = 70 mm, to −70.
   EXPECT_EQ(
-      first_error("E1\nG01 Z-50 F60"),
-      "t.nc:2:5: drilling with wear pre-compensation moves Z to -80.000 mm (nominal -50.000 - "
+      first_error("E1\nG01 Z-40 F60"),
+      "t.nc:2:5: drilling with wear pre-compensation moves Z to -70.000 mm (nominal -40.000 - "
       "wear 30.000 mm), beyond the Z soft limit (-60.000..20.000 mm)");
-  EXPECT_TRUE(interpret("E1\nG01 Z-37.5 F60\nM30").ok());  // travel 60: exactly at the limit
+  EXPECT_TRUE(interpret("E1\nG01 Z-34.2857142857 F60\nM30").ok());  // travel 60: at the limit
 }
 
 TEST(GcodeSoftLimits, EndPointsOutsideTheAxesAreRefusedAtTheirWord) {

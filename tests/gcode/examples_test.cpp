@@ -57,7 +57,8 @@ TEST(GcodeExamples, BlindHoleIsOneDrillTo20mmWithE1) {
   ASSERT_EQ(d.size(), 1u);
   EXPECT_DOUBLE_EQ(d[0].target.z, -20.0);
   EXPECT_EQ(d[0].condition, 1);
-  EXPECT_NEAR(d[0].z_travel_mm, 20.5 * 1.6, 1e-9);  // from Z0.5, wear ratio 0.6
+  // From Z0.5: 0.5 mm of air, then 20 mm eroded with θ 0.6 and A_hole/A_e 1.25 (test machine).
+  EXPECT_NEAR(d[0].z_travel_mm, 20.5 + 0.6 * 1.25 * 20.0, 1e-9);
 }
 
 TEST(GcodeExamples, ThroughHoleGoesPastTheFarSide) {

@@ -22,7 +22,8 @@ inline machining::MachineTables test_tables() {
                           .name = "drill-rough",
                           .polarity = machining::Polarity::kNegative,
                           .tdr_us = 8.0,
-                          .wear_ratio = 0.6});
+                          .wear_ratio = 0.6,
+                          .area_ratio = 1.25});
   t.conditions.push_back({.e = 2,
                           .name = "wall-finish",
                           .polarity = machining::Polarity::kPositive,

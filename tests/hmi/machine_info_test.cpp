@@ -23,10 +23,10 @@ MachineTables drill_tables() {
   t.axes = {{'X', -100.0, 100.0, 30.0, 2000.0},
             {'Y', -90.5, 80.25, 25.0, 1500.0},
             {'Z', -60.0, 20.0, 12.5, 999.75}};
-  // e, name, polarity, open V, peak A, on µs, off µs, Tdr µs, servo ref V, wear ratio.
+  // e, name, polarity, open V, peak A, on µs, off µs, Tdr µs, servo ref V, wear ratio, area ratio.
   t.conditions = {
-      {1, "drill-rough", Polarity::kNegative, 100.0, 15.0, 20.0, 10.0, 8.0, 40.0, 0.6195},
-      {7, "wall-finish", Polarity::kPositive, 80.0, 3.5, 2.25, 17.0, 1.5, 33.0, 0.05}};
+      {1, "drill-rough", Polarity::kNegative, 100.0, 15.0, 20.0, 10.0, 8.0, 40.0, 0.6195, 1.3297},
+      {7, "wall-finish", Polarity::kPositive, 80.0, 3.5, 2.25, 17.0, 1.5, 33.0, 0.05, 1.0}};
   return t;
 }
 
@@ -53,7 +53,17 @@ void expect_same(const MachineTables& a, const MachineTables& b) {
     EXPECT_EQ(x.tdr_us, y.tdr_us) << i;
     EXPECT_EQ(x.servo_ref_v, y.servo_ref_v) << i;
     EXPECT_EQ(x.wear_ratio, y.wear_ratio) << i;
+    EXPECT_EQ(x.area_ratio, y.area_ratio) << i;
   }
+}
+
+TEST(MachineInfoCodec, AReplyWithoutAreaRatioMeansThePapersSingleArea) {
+  Json body = bridge::to_json(drill_tables(), "drill-sim");
+  for (Json& c : body["conditions"]) c.erase("area_ratio");
+  MachineTables out;
+  std::string name, error;
+  ASSERT_TRUE(bridge::from_json(body, out, name, error)) << error;
+  for (const Condition& c : out.conditions) EXPECT_EQ(c.area_ratio, 1.0) << c.e;
 }
 
 TEST(MachineInfoCodec, RoundTripKeepsEveryField) {
@@ -134,6 +144,15 @@ TEST(MachineInfoCodec, EachMalformedBodyIsRefusedNamingTheField) {
        "conditions[1].polarity"},
       {"polarity missing", [](Json& j) { j["conditions"][0].erase("polarity"); },
        "conditions[0].polarity"},
+      // area_ratio is optional (an older runtime's reply has none), but never 0, < 0 or absurd.
+      {"area_ratio zero", [](Json& j) { j["conditions"][0]["area_ratio"] = 0.0; },
+       "conditions[0].area_ratio"},
+      {"area_ratio negative", [](Json& j) { j["conditions"][1]["area_ratio"] = -1.3; },
+       "conditions[1].area_ratio"},
+      {"area_ratio huge", [](Json& j) { j["conditions"][0]["area_ratio"] = 1e9; },
+       "conditions[0].area_ratio"},
+      {"area_ratio a string", [](Json& j) { j["conditions"][0]["area_ratio"] = "1.3"; },
+       "conditions[0].area_ratio"},
   };
   // Every number of a condition, missing and non-finite.
   std::vector<Malformed> all = cases;

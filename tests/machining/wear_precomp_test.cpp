@@ -23,10 +23,28 @@ TEST(WearPrecomp, DeltaIsWearRateTimesMachiningTime) {
   EXPECT_NEAR(p.travel_mm, lz + vd * tw, 1e-12);  // eq. (11)
 }
 
+TEST(WearPrecomp, DeltaUsesEq8sAreaRatioWhenTheHoleIsWiderThanTheElectrode) {
+  // Vd = MRRe/A_e (eq. 8) while the hole bottom advances at MRRw/A_hole, so the machining time of
+  // lz is lz·A_hole/MRRw (eq. 9): δ = θ·(A_hole/A_e)·lz. A Ø1.0/0.3 tube in a Ø1.1 hole.
+  const double a_e = 0.25 * 3.141592653589793 * (1.0 - 0.09);
+  const double a_hole = 0.25 * 3.141592653589793 * 1.21;
+  const double lz = 12.0, theta = 0.6, mrr_w = 3.5;
+  const double vd = theta * mrr_w / a_e;
+  const double tw = machining_time_s(lz, mrr_w, a_hole);
+  const WearPrecomp p = wear_precompensate(lz, theta, a_hole / a_e);
+  EXPECT_NEAR(p.delta_mm, vd * tw, 1e-12);
+  EXPECT_NEAR(p.travel_mm, lz + vd * tw, 1e-12);
+  // The one-area form (area ratio 1) under-plans this electrode's wear by A_hole/A_e.
+  EXPECT_NEAR(p.delta_mm / wear_precompensate(lz, theta).delta_mm, 1.21 / 0.91, 1e-12);
+}
+
 TEST(WearPrecomp, NoWearMeansNoChangeAndBadInputIsPassedThrough) {
   EXPECT_EQ(wear_precompensate(5.0, 0.0).travel_mm, 5.0);
   EXPECT_EQ(wear_precompensate(5.0, -1.0).travel_mm, 5.0);
   EXPECT_EQ(wear_precompensate(5.0, std::numeric_limits<double>::quiet_NaN()).delta_mm, 0.0);
+  EXPECT_EQ(wear_precompensate(5.0, 0.6, 0.0).travel_mm, 5.0);
+  EXPECT_EQ(wear_precompensate(5.0, 0.6, -2.0).delta_mm, 0.0);
+  EXPECT_EQ(wear_precompensate(5.0, 0.6, std::numeric_limits<double>::infinity()).delta_mm, 0.0);
   EXPECT_EQ(machining_time_s(5.0, 0.0, 1.0), 0.0);
 }
 

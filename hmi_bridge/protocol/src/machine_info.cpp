@@ -33,6 +33,18 @@ bool get_string(const Json& o, const char* key, std::string& out, std::string& e
   return true;
 }
 
+// Optional: absent from an older runtime's reply, it is the paper's single A (1).
+bool area_ratio_from_json(const Json& j, Condition& c, std::string& error,
+                          const std::string& where) {
+  if (!j.contains("area_ratio")) return true;
+  if (!get_number(j, "area_ratio", c.area_ratio, error, where)) return false;
+  if (!(c.area_ratio > 0.0 && c.area_ratio <= 100.0)) {
+    error = where + ".area_ratio: must be in (0, 100]";
+    return false;
+  }
+  return true;
+}
+
 bool axis_from_json(const Json& j, AxisLimits& a, std::string& error, const std::string& where) {
   if (!j.is_object()) {
     error = where + ": an object is required";
@@ -87,7 +99,8 @@ bool condition_from_json(const Json& j, Condition& c, std::string& error,
          get_number(j, "off_time_us", c.off_time_us, error, where) &&
          get_number(j, "tdr_us", c.tdr_us, error, where) &&
          get_number(j, "servo_ref_v", c.servo_ref_v, error, where) &&
-         get_number(j, "wear_ratio", c.wear_ratio, error, where);
+         get_number(j, "wear_ratio", c.wear_ratio, error, where) &&
+         area_ratio_from_json(j, c, error, where);
 }
 
 }  // namespace
@@ -112,7 +125,8 @@ Json to_json(const machining::MachineTables& tables, const std::string& machine_
                           {"off_time_us", c.off_time_us},
                           {"tdr_us", c.tdr_us},
                           {"servo_ref_v", c.servo_ref_v},
-                          {"wear_ratio", c.wear_ratio}});
+                          {"wear_ratio", c.wear_ratio},
+                          {"area_ratio", c.area_ratio}});
   }
   return Json{{"name", machine_name}, {"axes", axes}, {"conditions", conditions}};
 }

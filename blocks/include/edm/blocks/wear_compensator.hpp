@@ -25,6 +25,9 @@
 // as in Integrator: a retained value restored into it is where accumulation continues (the front
 // and high-water mark restart at 0 there). configure() and reset_wear = true set wear_mm, the
 // front and the high-water mark to 0; activate() leaves them alone.
+// The area ratio A_hole/A_e is the area_ratio input when it is > 0 (the active condition's, so that
+// eq. 8 and the HMI's eq. 10 use one value), else hole_area_mm2/electrode_area_mm2. A non-finite
+// area_ratio input: the parameters' ratio for that cycle, kFault.
 // While the wear_ratio input is <= 0 (an unwired input reads 0) the parameter wear_ratio_default
 // is θ instead (default 0: no compensation without an estimate). θ is clamped to
 // [0, wear_ratio_max]; kSaturated when it was cut or the input was negative.
@@ -86,6 +89,7 @@ class WearCompensator final : public rt::BlockWithParams<WearCompensatorParams> 
   // Pins, listed under their names in declaration order: a C++ PROGRAM connects them by member.
   rt::Input<double> vz_in_mm_s{pins_, "vz_in_mm_s", "mm/s"};
   rt::Input<double> wear_ratio{pins_, "wear_ratio"};
+  rt::Input<double> area_ratio{pins_, "area_ratio"};  // ≤ 0 (unwired): the two area parameters
   rt::Input<bool> enable{pins_, "enable", "", true};
   rt::Input<bool> reset_wear{pins_, "reset_wear"};
   rt::Output<double> vz_out_mm_s{pins_, "vz_out_mm_s", "mm/s"};

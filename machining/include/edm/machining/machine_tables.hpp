@@ -25,7 +25,10 @@ struct Condition {
   double off_time_us{40.0};
   double tdr_us{8.0};        // reference ignition delay for the gap controller
   double servo_ref_v{40.0};  // reference mean gap voltage for voltage-based servos
-  double wear_ratio{0.0};    // electrode volume / workpiece volume removed, 0..10
+  double wear_ratio{0.0};    // θ: electrode volume / workpiece volume removed, 0..10
+  // A_hole / A_e: the hole's cross-section over the electrode's (seed 004 eq. 8; a drilling
+  // condition is set for one electrode), > 0 and <= 100; 1 = the paper's single A.
+  double area_ratio{1.0};
 };
 
 /// Soft limits and dynamics of one axis (machine coordinates, mm).

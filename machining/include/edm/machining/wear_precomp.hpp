@@ -5,9 +5,13 @@
 //   (9)  Tw = lz / (MRRw / A)       machining time of a Z block of length lz
 //   (10) δ  = Vd·Tw = MRRe·lz/MRRw  electrode length worn meanwhile (Vd = MRRe/A, eq. 8)
 //   (11) lz' = lz + δ               the Z travel actually commanded
-// With the condition's volumetric wear ratio θ = MRRe/MRRw this is δ = θ·lz: the electrode and the
-// hole are taken to have the same cross-section A, as in the paper (for a tube electrode whose
-// hole is wider than its section the RT compensator's area ratio refines this; docs/blocks.md).
+// The paper writes one A for both; a tube electrode's section A_e is smaller than the hole's
+// A_hole, and eq. (8) (Vd = MRRe/A_e) and eq. (9) (the hole bottom advances at MRRw/A_hole) then
+// give
+//   (10) δ = (MRRe/A_e)·(lz·A_hole/MRRw) = θ·(A_hole/A_e)·lz,   θ = MRRe/MRRw,
+// the same area ratio the real-time compensator (WearCompensator, eq. 8) uses, so the planned
+// travel lz' and the travel eq. (8) produces agree. lz is the depth actually eroded: the part of
+// the block below the work surface (Z0 of the program), no wear is planned for the air above it.
 
 namespace edm::machining {
 
@@ -16,9 +20,10 @@ struct WearPrecomp {
   double travel_mm{0.0};  // lz' = lz + δ, eq. (11)
 };
 
-/// lz ≥ 0 the nominal Z block length (mm), wear_ratio ≥ 0 the condition's θ = MRRe/MRRw.
-/// Negative or non-finite inputs give {0, lz} unchanged (the caller validates its inputs).
-WearPrecomp wear_precompensate(double lz_mm, double wear_ratio) noexcept;
+/// lz ≥ 0 the depth eroded by the block (mm), wear_ratio ≥ 0 the condition's θ = MRRe/MRRw,
+/// area_ratio > 0 its A_hole/A_e. Negative or non-finite inputs give {0, lz} unchanged (the caller
+/// validates its inputs).
+WearPrecomp wear_precompensate(double lz_mm, double wear_ratio, double area_ratio = 1.0) noexcept;
 
 /// Eq. (9): machining time of lz at the workpiece removal rate mrr_w (mm³/s) through area A
 /// (mm²); 0 when mrr_w ≤ 0.

@@ -67,7 +67,8 @@
 //   gap.td_us, gap.valid ← td;   gap.tdr_us ← tdr_us
 //   wear.vz_in_mm_s ← vz_servo_cmd_mm_s (gap.vz_mm_s, or the external servo's when
 //                     vz_servo_mm_s is wired: bind() sees the YAML wiring)
-//   wear.wear_ratio ← wear_ratio;  wear.enable ← enable_wear_comp;  wear.reset_wear ← reset_wear
+//   wear.wear_ratio ← wear_ratio;  wear.area_ratio ← area_ratio;  wear.enable ← enable_wear_comp;
+//   wear.reset_wear ← reset_wear
 // Extra outputs: reset_wear (true in the cycle the wear estimate restarts, at the touch) and
 // vz_servo_cmd_mm_s (the servo command into wear: clamped, ramped after a retract, never down
 // while the gap reads short).
@@ -132,6 +133,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<double> depth_mm{pins_, "depth_mm", "mm"};  // 0: use depth_default_mm
   rt::Input<double> wear_ratio{pins_,
                                "wear_ratio"};  // ≤ 0 (unwired): the wear child's wear_ratio_default
+  rt::Input<double> area_ratio{pins_, "area_ratio"};  // ≤ 0 (unwired): the wear child's areas
   rt::Input<bool> enable_wear_comp{pins_, "enable_wear_comp", "", true};
   rt::Input<double> tdr_us{pins_, "tdr_us", "us"};  // ≤ 0 (unwired): the gap child's tdr_default_us
   rt::Input<bool> through{pins_, "through"};        // a through hole: detect the breakthrough

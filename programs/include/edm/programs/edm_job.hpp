@@ -114,6 +114,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<bool> feed_hold{pins_, "feed_hold"};
   rt::Output<double> drill_depth_mm{pins_, "drill_depth_mm", "mm"};
   rt::Output<double> wear_ratio{pins_, "wear_ratio"};
+  rt::Output<double> area_ratio{pins_, "area_ratio"};
   rt::Output<double> tdr_us{pins_, "tdr_us", "us"};
   rt::Output<double> finish_final_offset_mm{pins_, "finish_final_offset_mm", "mm"};
   rt::Output<double> finish_start_offset_mm{pins_, "finish_start_offset_mm", "mm"};
