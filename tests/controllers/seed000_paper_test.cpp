@@ -108,5 +108,26 @@ TEST(Seed000, psi_threshold_is_eq_8_as_printed) {
   EXPECT_NEAR(psi_after(-0.0101, d_pf, digest), p.ol * (1.0 + 100.0 * d_pf), 1e-9);
 }
 
+TEST(Seed000, psi_unfloored_is_eq_8_as_printed_and_reverses_the_action) {
+  // Overloaded (e < 0.01) with the prediction 0.02 below the filtered value: eq. 8 gives
+  // Ψ = ol·(1 − 2) = −ol, so the step has the sign of −dU. The default floor (psi_min 0) stops
+  // the action instead; psi_min = −1e9 leaves eq. 8 as printed.
+  SelfTuningFuzzyPIParams p;
+  EXPECT_EQ(psi_after(-0.1, -0.02, p), 0.0);
+  p.psi_min = -1e9;
+  EXPECT_NEAR(psi_after(-0.1, -0.02, p), -p.ol, 1e-9);
+  BlockHarness<SelfTuningFuzzyPI> h;
+  ASSERT_TRUE(h.start(p).empty());
+  auto& rab_p = h.source<double>("rab_p");
+  auto& rab_f = h.source<double>("rab_f");
+  for (int k = 0; k < 2; ++k) {
+    rab_p.set(0.7);  // e = −0.1: dU > 0 (lengthen the arc-off time) …
+    rab_f.set(0.72);
+    h.step();
+  }
+  EXPECT_GT(h.out("du"), 0.0);
+  EXPECT_LT(h.out("arc_off_time_us"), p.u_initial_us) << "… but Ψ < 0 shortens it";
+}
+
 }  // namespace
 }  // namespace edm::blocks

@@ -29,7 +29,8 @@
 //   acts in the band −0.01 ≤ e < 0.01 around the set point. (SEEDS.md's digest wrote e < −0.01,
 //   the default until issue 20; −0.01 remains a setting, see docs/controllers.md.)
 // - Ψ is floored at psi_min (default 0): ol·(1 + 100·d_pf) turns negative for d_pf < −0.01 and
-//   would reverse the action; the floor only prevents that reversal.
+//   would reverse the action; the floor only prevents that reversal. psi_min = −1e9 leaves eq. 8
+//   unfloored, as printed (B6 measures both).
 // - Units: u in µs and v in V (Table 1: 9…50 µs, 30…70 V); Ku in µs and Kv in V per unit of
 //   dU·|e|. The initial u and v (Table 4 is not legible) are parameters.
 // - Rab_ref: the input rab_ref when > 0, else the parameter rab_ref_default.
@@ -63,7 +64,7 @@ struct SelfTuningFuzzyPIParams {
   double rab_ref_default{0.6};  // Rab_ref in (0, 1] while the rab_ref input is 0, Table 5 case 1
   double overload_error{0.01};  // Ψ applies when e < this (eq. 8 as printed: 0.01)
   double dpf_gain{100.0};       // the 100 of eq. 8
-  double psi_min{0.0};          // floor of Ψ in overload (≥ 0)
+  double psi_min{0.0};          // floor of Ψ in overload (−1e9: none, eq. 8 as printed)
   double u_min_us{9.0};         // arc-off time range, Table 1 [µs]
   double u_max_us{50.0};
   double u_initial_us{20.0};  // arc-off time after activate() [µs]
@@ -102,8 +103,10 @@ struct SelfTuningFuzzyPIParams {
             {.unit = "1",
              .description = "gain on d_pf = Rab_p - Rab_f in Psi",
              .range = rt::kNonNegative});
-    v.param("psi_min", psi_min,
-            {.unit = "1", .description = "floor of Psi in overload", .range = rt::kNonNegative});
+    v.param(
+        "psi_min", psi_min,
+        {.unit = "1",
+         .description = "floor of Psi in overload (0: no reversal; -1e9: none, eq. 8 as printed)"});
     v.param("u_min_us", u_min_us, {.unit = "us", .description = "shortest arc-off time"});
     v.param("u_max_us", u_max_us,
             {.unit = "us", .description = "longest arc-off time, >= u_min_us"});
