@@ -30,6 +30,9 @@ void SelfTuningRegulator::activate() noexcept {
   aux_.reset(1, p.p0, aux_init);
   hist_v_.fill(std::clamp(p.u_v_initial, p.u_v_min, p.u_v_max));
   u_t_ = std::clamp(p.to_initial_us, p.to_min_us, p.to_max_us);
+  aux_turn_ = false;
+  sat_v_ = false;
+  sat_t_ = false;
   y_rv_ = p.y_rv_good;
   y_rt_ = p.y_rt_good;
   y_v_out_.set(0.0);
@@ -40,7 +43,9 @@ void SelfTuningRegulator::activate() noexcept {
 }
 
 void SelfTuningRegulator::publish() noexcept {
-  servo_ref_v_.set(params_.us_per_unit_v * hist_v_[0]);
+  // §3: the automatic gain K1 = ti/tp of the off time output now, on the Us input.
+  const double k1_us = params_.k1_on_us ? params_.ti_us / (params_.ti_us + u_t_) : 1.0;
+  servo_ref_v_.set(k1_us * params_.us_per_unit_v * hist_v_[0]);
   off_time_us_.set(u_t_);
   u_v_out_.set(hist_v_[0]);
   y_rv_out_.set(y_rv_);
@@ -69,11 +74,21 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
   y_v_out_.set(y_v);
   y_t_out_.set(y_t);
   k1_.set(k1);
+  // §4: the loops in turn (alternate) or both every sample.
+  const bool do_main = !p.alternate || !aux_turn_;
+  const bool do_aux = !p.alternate || aux_turn_;
+  if (p.alternate) {
+    aux_turn_ = !aux_turn_;
+  }
   if (!enable_.get()) {
     // Hold u; the history still shifts, so the model's timing stays true on re-enable.
-    for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
-      hist_v_[i] = hist_v_[i - 1];
+    if (do_main) {
+      for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
+        hist_v_[i] = hist_v_[i - 1];
+      }
     }
+    sat_v_ = false;
+    sat_t_ = false;
     saturated_.set(false);
     publish();
     return rt::BlockStatus::kOk;
@@ -90,32 +105,44 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
   const double y_rv = rv_in > 0.0 ? rv_in : y_rv_;
   const double y_rt = rt_in > 0.0 ? rt_in : y_rt_;
 
-  // Main loop: y_v(k) − β00·u_v(k−d−1) = β01·u_v(k−d−2) + β0c.
-  const auto d = static_cast<std::size_t>(p.delay_v);
-  const double phi_v[2] = {hist_v_[d + 1], 1.0};
-  const RlsCore::Result rv =
-      main_.update(phi_v, y_v - p.beta00 * hist_v_[d], p.lambda, p.trace_max);
+  // Main loop: y_v(k) − β00·u_v(k−d−1) = β01·u_v(k−d−2) + β0c (k counts main-loop samples).
+  if (do_main) {
+    const auto d = static_cast<std::size_t>(p.delay_v);
+    const double phi_v[2] = {hist_v_[d + 1], 1.0};
+    const RlsCore::Result rv =
+        main_.update(phi_v, y_v - p.beta00 * hist_v_[d], p.lambda, p.trace_max);
+    if (!rv.ok) {
+      return rt::BlockStatus::kFault;
+    }
+    // Minimum-variance law: the model's prediction put on the reference.
+    const double u_v_raw = (y_rv - main_.theta(0) * hist_v_[0] - main_.theta(1)) / p.beta00;
+    if (!std::isfinite(u_v_raw)) {
+      return rt::BlockStatus::kFault;
+    }
+    const double u_v = std::clamp(u_v_raw, p.u_v_min, p.u_v_max);
+    for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
+      hist_v_[i] = hist_v_[i - 1];
+    }
+    hist_v_[0] = u_v;
+    sat_v_ = u_v != u_v_raw;
+  }
   // Auxiliary loop: y_t(k) − β10·u_t(k−1) = β1c.
-  const double beta10 = -1.0 / p.ti_us;
-  const double one[1] = {1.0};
-  const RlsCore::Result rt_res = aux_.update(one, y_t - beta10 * u_t_, p.lambda, p.trace_max);
-  if (!rv.ok || !rt_res.ok) {
-    return rt::BlockStatus::kFault;
+  if (do_aux) {
+    const double beta10 = -1.0 / p.ti_us;
+    const double one[1] = {1.0};
+    const RlsCore::Result rt_res = aux_.update(one, y_t - beta10 * u_t_, p.lambda, p.trace_max);
+    if (!rt_res.ok) {
+      return rt::BlockStatus::kFault;
+    }
+    const double u_t_raw = (y_rt - aux_.theta(0)) / beta10;
+    if (!std::isfinite(u_t_raw)) {
+      return rt::BlockStatus::kFault;
+    }
+    u_t_ = std::clamp(u_t_raw, p.to_min_us, p.to_max_us);
+    sat_t_ = u_t_ != u_t_raw;
   }
-
-  // Minimum-variance laws: the model's prediction put on the reference.
-  const double u_v_raw = (y_rv - main_.theta(0) * hist_v_[0] - main_.theta(1)) / p.beta00;
-  const double u_t_raw = (y_rt - aux_.theta(0)) / beta10;
-  if (!std::isfinite(u_v_raw) || !std::isfinite(u_t_raw)) {
-    return rt::BlockStatus::kFault;
-  }
-  const double u_v = std::clamp(u_v_raw, p.u_v_min, p.u_v_max);
-  u_t_ = std::clamp(u_t_raw, p.to_min_us, p.to_max_us);
-  for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
-    hist_v_[i] = hist_v_[i - 1];
-  }
-  hist_v_[0] = u_v;
-  const bool saturated = u_v != u_v_raw || u_t_ != u_t_raw;
+  // A loop held this sample (alternate) keeps its clamped value and its flag.
+  const bool saturated = sat_v_ || sat_t_;
   saturated_.set(saturated);
   publish();
   return saturated ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;

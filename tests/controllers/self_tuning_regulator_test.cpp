@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <random>
@@ -49,6 +50,15 @@ class Str {
   rt::Output<double>* y_rt_ref_{nullptr};
 };
 
+// The per-loop equations are tested with both loops computed every sample and Us = us·u_v; the
+// paper's structure (K1 on Us, loops in turn: the defaults) has its own tests at the end.
+SelfTuningRegulatorParams both_loops_every_sample() {
+  SelfTuningRegulatorParams p;
+  p.k1_on_us = false;
+  p.alternate = false;
+  return p;
+}
+
 // The paper's main model as the plant: y_v(k) = β00·u(k−d−1) + β01·u(k−d−2) + β0c + ε(k), with
 // ε white N(0, σ²). Fed to the block through ratio_normal alone (y_v = φe when the other ratios
 // are 0). Returns the mean and variance of y_v over the last `measure` samples.
@@ -58,7 +68,7 @@ struct MvResult {
 };
 MvResult run_main_loop(std::int64_t d, double beta01, double beta0c, double sigma, double y_ref,
                        unsigned seed) {
-  SelfTuningRegulatorParams p;
+  SelfTuningRegulatorParams p = both_loops_every_sample();
   p.delay_v = d;
   Str str(p);
   str.refs(y_ref, 0.0);
@@ -100,7 +110,7 @@ TEST(SelfTuningRegulator, minimum_variance_main_loop_reaches_the_noise_floor_and
 
 TEST(SelfTuningRegulator, steady_control_solves_the_model_for_the_reference) {
   // Noise-free: the loop settles where β00·u + β01·u + β0c = y_r, u* = (y_r − β0c)/(β00 + β01).
-  SelfTuningRegulatorParams p;
+  SelfTuningRegulatorParams p = both_loops_every_sample();
   p.delay_v = 1;
   Str str(p);
   str.refs(0.95, 0.0);
@@ -124,7 +134,7 @@ TEST(SelfTuningRegulator, steady_control_solves_the_model_for_the_reference) {
 TEST(SelfTuningRegulator, off_time_loop_tracks_y_rt_on_the_good_gap_model) {
   // Good gap (all sparks): y_t = K1·φe = ti/(ti + t_o), the paper's §4.4 model. β10 = −1/ti is
   // only its tangent, yet the loop's fixed point is exact: y_t = y_rt ⇒ t_o = ti·(1/y_rt − 1).
-  SelfTuningRegulatorParams p;
+  SelfTuningRegulatorParams p = both_loops_every_sample();
   p.ti_us = 100.0;
   Str str(p);
   for (int k = 0; k < 300; ++k) {
@@ -192,6 +202,154 @@ TEST(SelfTuningRegulator, clamps_and_faults) {
   EXPECT_EQ(str.step(std::nan("")), BlockStatus::kFault);
   EXPECT_FALSE(rt::validate_params(SelfTuningRegulatorParams{.beta00 = 0.0}).empty());
   EXPECT_FALSE(rt::validate_params(SelfTuningRegulatorParams{.u_v_initial = 5.0}).empty());
+}
+
+// §3: "an automatic gain K1 = ti/tp on the Us input". Over seeded random gap states, in both
+// loop schedules, Us = ti/(ti + t_o)·us_per_unit_v·u_v with the t_o output with it (and
+// us_per_unit_v·u_v without K1).
+TEST(SelfTuningRegulator, k1_scales_us_by_ti_over_tp_of_the_off_time_output_with_it) {
+  for (const bool k1 : {true, false}) {
+    for (const bool alternate : {true, false}) {
+      SelfTuningRegulatorParams p;
+      p.k1_on_us = k1;
+      p.alternate = alternate;
+      p.us_per_unit_v = 60.0;
+      Str str(p);
+      std::mt19937_64 rng(41U + (k1 ? 2U : 0U) + (alternate ? 1U : 0U));
+      std::uniform_real_distribution<double> u01(0.0, 1.0);
+      for (int k = 0; k < 400; ++k) {
+        const double e = u01(rng), t = 0.2 * u01(rng), a = 0.02 * u01(rng) * (k % 7 == 0);
+        const double sh = 0.3 * u01(rng) * (1.0 - e);
+        str.step(e, t, a, sh);
+        const double gain = k1 ? p.ti_us / (p.ti_us + str.out("off_time_us")) : 1.0;
+        ASSERT_NEAR(str.out("servo_ref_v"), gain * p.us_per_unit_v * str.out("u_v"), 1e-12)
+            << "k1 " << k1 << " alternate " << alternate << " sample " << k;
+      }
+    }
+  }
+}
+
+// The decoupling K1 is there for: the gap-voltage servo balances the period-mean voltage
+// Ūg = K1·U_p (U_p the mean voltage over the pulse width, which sets the gap state) against Us,
+// so U_p = Us/K1. With K1 on Us, U_p = us_per_unit_v·u_v whatever t_o is: a step of the
+// auxiliary loop's reference moves t_o and leaves y_v and u_v exactly where they were; without
+// it, the same step disturbs the main loop. Plant: y_v = 2 − U_p/40 (1 at 40 V), fed as φe = y_v
+// below 1 and φe = 2 − y_v, φs = y_v − 1 above (so that φe + 2φs = y_v); y_t = K1·φe.
+struct DecouplingRun {
+  double to_before{0.0}, to_after{0.0};
+  double max_yv_dev{0.0};  // max |y_v − y_v before the step| after it
+  double max_uv_dev{0.0};
+};
+DecouplingRun run_off_time_step(bool k1, bool alternate) {
+  SelfTuningRegulatorParams p;
+  p.k1_on_us = k1;
+  p.alternate = alternate;
+  p.us_per_unit_v = k1 ? 60.0 : 40.0;
+  p.delay_v = 0;  // the plant below answers within one sample
+  Str str(p);
+  auto plant_step = [&](double y_rt) {
+    str.refs(0.0, y_rt);
+    const double to = str.out("off_time_us");
+    const double k1_actual = p.ti_us / (p.ti_us + to);
+    const double u_p = str.out("servo_ref_v") / k1_actual;
+    const double y_v = std::clamp(2.0 - u_p / 40.0, 0.0, 2.0);
+    if (y_v <= 1.0) {
+      str.step(y_v);
+    } else {
+      str.step(2.0 - y_v, 0.0, 0.0, y_v - 1.0);
+    }
+  };
+  for (int k = 0; k < 3000; ++k) {
+    plant_step(0.6);
+  }
+  DecouplingRun r;
+  r.to_before = str.out("off_time_us");
+  const double yv0 = str.out("y_v"), uv0 = str.out("u_v");
+  for (int k = 0; k < 600; ++k) {
+    plant_step(0.75);
+    r.max_yv_dev = std::max(r.max_yv_dev, std::fabs(str.out("y_v") - yv0));
+    r.max_uv_dev = std::max(r.max_uv_dev, std::fabs(str.out("u_v") - uv0));
+  }
+  r.to_after = str.out("off_time_us");
+  return r;
+}
+
+TEST(SelfTuningRegulator, with_k1_on_us_an_off_time_step_leaves_the_main_loop_undisturbed) {
+  for (const bool alternate : {true, false}) {
+    const DecouplingRun with = run_off_time_step(true, alternate);
+    const DecouplingRun without = run_off_time_step(false, alternate);
+    for (const DecouplingRun& r : {with, without}) {
+      // y_t = K1·0.95 → 0.6, 0.75: t_o = ti·(0.95/y_rt − 1) = 58.3 µs, then 26.7 µs.
+      EXPECT_NEAR(r.to_before, 100.0 * (0.95 / 0.6 - 1.0), 0.5) << "alternate " << alternate;
+      EXPECT_NEAR(r.to_after, 100.0 * (0.95 / 0.75 - 1.0), 0.5) << "alternate " << alternate;
+    }
+    // (1e-6: what is left of the main loop's own settling after 3000 samples)
+    EXPECT_LT(with.max_yv_dev, 1e-6) << "alternate " << alternate;
+    EXPECT_LT(with.max_uv_dev, 1e-6) << "alternate " << alternate;
+    EXPECT_GT(without.max_yv_dev, 0.05) << "alternate " << alternate;
+    EXPECT_GT(without.max_uv_dev, 0.05) << "alternate " << alternate;
+  }
+}
+
+// §4: "本系统分时交替对两个模型进行计算和控制" — the two models are computed and controlled in
+// turn. With `alternate`, sample 0, 2, 4 … after activation runs the main loop alone (u_v and its
+// estimates β01, β0c may change; t_o and β1c are held) and sample 1, 3, 5 … the auxiliary loop
+// alone; without it both change every sample (seeded random gap states).
+TEST(SelfTuningRegulator, alternate_computes_one_loop_per_sample) {
+  for (const bool alternate : {true, false}) {
+    SelfTuningRegulatorParams p;
+    p.alternate = alternate;
+    Str str(p);
+    std::mt19937_64 rng(5U);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    double uv = str.out("u_v"), to = str.out("off_time_us"), b01 = str.out("beta01"),
+           b0c = str.out("beta0c"), b1c = str.out("beta1c");
+    for (int k = 0; k < 200; ++k) {
+      str.step(0.6 + 0.35 * u01(rng), 0.05 * u01(rng), 0.0, 0.05 * u01(rng));
+      const bool main_ran = str.out("beta0c") != b0c || str.out("beta01") != b01;
+      const bool aux_ran = str.out("beta1c") != b1c;
+      if (alternate) {
+        EXPECT_EQ(main_ran, k % 2 == 0) << "sample " << k;
+        EXPECT_EQ(aux_ran, k % 2 == 1) << "sample " << k;
+        if (k % 2 == 0) {
+          EXPECT_EQ(str.out("off_time_us"), to) << "t_o held on the main loop's sample " << k;
+        } else {
+          EXPECT_EQ(str.out("u_v"), uv) << "u_v held on the auxiliary loop's sample " << k;
+        }
+      } else {
+        EXPECT_TRUE(main_ran && aux_ran) << "sample " << k;
+      }
+      uv = str.out("u_v"), to = str.out("off_time_us"), b01 = str.out("beta01");
+      b0c = str.out("beta0c"), b1c = str.out("beta1c");
+    }
+  }
+}
+
+// In turn, the main model's k counts the main loop's own samples: on the paper's model
+// y_v(m) = β00·u(m−d−1) + β01·u(m−d−2) + β0c in main-loop samples m (the plant's y_v held over
+// the auxiliary loop's samples), the loop settles at u* = (y_r − β0c)/(β00 + β01) as with both
+// loops every sample.
+TEST(SelfTuningRegulator, in_turn_the_main_model_counts_main_loop_samples) {
+  SelfTuningRegulatorParams p;  // alternate, K1 on Us
+  p.delay_v = 1;
+  Str str(p);
+  str.refs(0.95, 0.0);
+  const double beta01 = 0.3, beta0c = 1.8;
+  std::deque<double> u(3, p.u_v_initial);  // u[0] = u(m−1), …
+  double y = 0.0;
+  for (int k = 0; k < 6000; ++k) {
+    if (k % 2 == 0) {
+      y = p.beta00 * u[1] + beta01 * u[2] + beta0c;
+    }
+    str.step(y);
+    if (k % 2 == 0) {
+      u.push_front(str.out("u_v"));
+      u.pop_back();
+    }
+  }
+  const double u_star = (0.95 - beta0c) / (p.beta00 + beta01);
+  EXPECT_NEAR(str.out("u_v"), u_star, 1e-6);
+  EXPECT_NEAR(y, 0.95, 1e-6);
 }
 
 }  // namespace

@@ -18,6 +18,13 @@
 // a stable arc (φa > stable_arc_limit) → y_rv, y_rt fall by ref_step per sample (floors y_rv_min,
 // y_rt_min) until φa returns to 0; transient arcs above the limit without a stable arc → hold.
 // The inputs y_rv_ref / y_rt_ref override the decision while > 0.
+// Decoupling gain (§3, k1_on_us): Us = K1·us_per_unit_v·u_v with K1 = ti/(ti + t_o) of the off time
+// output with it, so that the gap-voltage servo's balance Ūg = Us, Ūg ≈ K1·U_e in a good gap,
+// does not move when the auxiliary loop changes t_o (k1_on_us false: Us = us_per_unit_v·u_v).
+// Loops in turn (§4, alternate): "分时交替" — sample k computes the main loop alone when
+// k is even and the auxiliary loop alone when k is odd; the other loop holds its u, and the
+// main model's sample index (its regressor history and d_v) counts main-loop samples only
+// (alternate false: both loops every sample).
 //
 // Choices where the paper is silent (docs/controllers.md):
 // - u_v is in the paper's normalised D/A units (β00 = −1 because u_v ≈ 1.6 at full scale, like
@@ -28,8 +35,9 @@
 //   times this is the pulse-width ratio). Φ = K1·φ uses the off time commanded last sample.
 // - The regressor history before activate() is the initial u (the outputs held there).
 // - u_v and u_t are clamped to their ranges; the RLS sees the clamped values.
-// Status: kSaturated when a clamp cut a control value, kFault on a non-finite input (outputs held).
-// RT-safe: update(). Not thread-safe: the owning task calls every member except the pins.
+// Status: kSaturated when a clamp cut a control value (the last time its loop ran), kFault on a
+// non-finite input (outputs held). RT-safe: update(). Not thread-safe: the owning task calls every
+// member except the pins.
 
 #include <array>
 #include <cstdint>
@@ -71,6 +79,9 @@ struct SelfTuningRegulatorParams {
   double ref_step{0.05};            // decrease per sample while a stable arc lasts
   double y_rv_min{0.3};
   double y_rt_min{0.3};
+  // The paper's structure (both true as published).
+  bool k1_on_us{true};   // Us = K1·us_per_unit_v·u_v (false: us_per_unit_v·u_v)
+  bool alternate{true};  // the two loops computed in turn, one per sample (false: both)
 
   void visit(rt::ParamVisitor& v) {
     v.param("delay_v", delay_v,
@@ -140,6 +151,14 @@ struct SelfTuningRegulatorParams {
             {.unit = "1",
              .description = "floor of the y_t reference, <= y_rt_good",
              .range = rt::closed(0.0, 2.0)});
+    v.param("k1_on_us", k1_on_us,
+            {.unit = "",
+             .description = "decoupling gain K1 = ti/(ti+to) on Us (paper: true)",
+             .load_time_only = true});
+    v.param("alternate", alternate,
+            {.unit = "",
+             .description = "the two loops computed in turn, one per sample (paper: true)",
+             .load_time_only = true});
   }
   /// Rules a range cannot say: beta00 != 0, the min/initial/max orders, trace_max >= 2*p0.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
@@ -178,6 +197,9 @@ class SelfTuningRegulator final : public rt::BlockWithParams<SelfTuningRegulator
   RlsCore aux_;
   std::array<double, SelfTuningRegulatorParams::kMaxDelay + 2> hist_v_{};  // u_v(k−1−i)
   double u_t_{0.0};
+  bool aux_turn_{false};  // alternate: this sample is the auxiliary loop's
+  bool sat_v_{false};     // the clamp cut u_v when the main loop last ran
+  bool sat_t_{false};     // the clamp cut t_o when the auxiliary loop last ran
   double y_rv_{0.0};
   double y_rt_{0.0};
 };
