@@ -27,8 +27,9 @@
 // m ≥ 32 makes every latched window consist only of pulses that arrived after the previous latch
 // (the paper's "all-new pulses").
 //
-// Deviation (the one a PLC cannot avoid): a PLC cycle sees many pulses (about 26 per 1 ms cycle
-// on the drill preset) and the bitmasks only at the cycle's end, so a latch falls at the end of
+// Deviation (the one a PLC cannot avoid): a PLC cycle sees many pulses (9 … 21, 14 on average,
+// per 1 ms cycle under B1's fuzzy servo on the drill preset) and the bitmasks only at the cycle's
+// end, so a latch falls at the end of
 // the first cycle in which the m-th pulse since the previous latch arrived, not at that pulse:
 // latches are at most one per cycle and m … m + T − 1 pulses apart. With m ≤ T the block latches
 // every cycle with pulses (the paper's m = 1 behaviour: the newest pulses plus old ones).
