@@ -94,13 +94,21 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
     return rt::BlockStatus::kOk;
   }
 
-  // Reference decision (§3).
+  // Reference decision (§3): each loop's on its own samples (in turn, every other sample).
   if (phi_a > p.stable_arc_limit) {
-    y_rv_ = std::max(p.y_rv_min, y_rv_ - p.ref_step);
-    y_rt_ = std::max(p.y_rt_min, y_rt_ - p.ref_step);
+    if (do_main) {
+      y_rv_ = std::max(p.y_rv_min, y_rv_ - p.ref_step);
+    }
+    if (do_aux) {
+      y_rt_ = std::max(p.y_rt_min, y_rt_ - p.ref_step);
+    }
   } else if (phi_e2 < p.transient_arc_limit) {
-    y_rv_ += p.ref_rise * (p.y_rv_good - y_rv_);
-    y_rt_ += p.ref_rise * (p.y_rt_good - y_rt_);
+    if (do_main) {
+      y_rv_ += p.ref_rise * (p.y_rv_good - y_rv_);
+    }
+    if (do_aux) {
+      y_rt_ += p.ref_rise * (p.y_rt_good - y_rt_);
+    }
   }
   const double y_rv = rv_in > 0.0 ? rv_in : y_rv_;
   const double y_rt = rt_in > 0.0 ? rt_in : y_rt_;

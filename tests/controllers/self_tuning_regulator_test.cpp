@@ -148,7 +148,7 @@ TEST(SelfTuningRegulator, off_time_loop_tracks_y_rt_on_the_good_gap_model) {
 }
 
 TEST(SelfTuningRegulator, reference_decision_lowers_on_stable_arcs_and_returns_when_good) {
-  SelfTuningRegulatorParams p;
+  SelfTuningRegulatorParams p = both_loops_every_sample();
   Str str(p);
   // A stable arc: both references fall by ref_step per sample.
   for (int k = 1; k <= 4; ++k) {
@@ -305,9 +305,17 @@ TEST(SelfTuningRegulator, alternate_computes_one_loop_per_sample) {
     double uv = str.out("u_v"), to = str.out("off_time_us"), b01 = str.out("beta01"),
            b0c = str.out("beta0c"), b1c = str.out("beta1c");
     for (int k = 0; k < 200; ++k) {
-      str.step(0.6 + 0.35 * u01(rng), 0.05 * u01(rng), 0.0, 0.05 * u01(rng));
+      // A stable arc every fifth sample moves both reference decisions as well.
+      const double arc = k % 5 == 0 ? 0.02 : 0.0;
+      const double rv = str.out("y_rv"), rt = str.out("y_rt");
+      str.step(0.6 + 0.35 * u01(rng), 0.05 * u01(rng), arc, 0.05 * u01(rng));
       const bool main_ran = str.out("beta0c") != b0c || str.out("beta01") != b01;
       const bool aux_ran = str.out("beta1c") != b1c;
+      if (alternate) {
+        // Each reference decision on its own loop's samples.
+        EXPECT_EQ(str.out("y_rv") != rv, k % 2 == 0 && (arc > 0.0 || rv != 0.95)) << k;
+        EXPECT_EQ(str.out("y_rt") != rt, k % 2 == 1 && (arc > 0.0 || rt != 0.9)) << k;
+      }
       if (alternate) {
         EXPECT_EQ(main_ran, k % 2 == 0) << "sample " << k;
         EXPECT_EQ(aux_ran, k % 2 == 1) << "sample " << k;

@@ -23,7 +23,8 @@
 // does not move when the auxiliary loop changes t_o (k1_on_us false: Us = us_per_unit_v·u_v).
 // Loops in turn (§4, alternate): "分时交替" — sample k computes the main loop alone when
 // k is even and the auxiliary loop alone when k is odd; the other loop holds its u, and the
-// main model's sample index (its regressor history and d_v) counts main-loop samples only
+// main model's sample index (its regressor history and d_v) counts main-loop samples only, and
+// each reference decision (y_rv's, y_rt's) also runs on its own loop's samples
 // (alternate false: both loops every sample).
 //
 // Choices where the paper is silent (docs/controllers.md):
