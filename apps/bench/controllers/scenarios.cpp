@@ -78,13 +78,18 @@ std::vector<Variant> wire_variants(const WireCase& c, bool quick) {
   RunSpec before = grey;
   before.edits.push_back({"paper_exp: true", "paper_exp: false"});
   before.edits.push_back({"overload_error: 0.01", "overload_error: -0.01"});
+  // Eq. 8 unfloored, as printed: Ψ < 0 when the prediction runs more than 0.01 below the
+  // filtered value, which reverses the action (shipped: floored at 0).
+  RunSpec unfloored = grey;
+  unfloored.edits.push_back({"overload_error: 0.01,", "overload_error: 0.01, psi_min: -1e9,"});
   return {{"no control (fixed settings)", fixed},
           {"STFPI + grey as printed (p 37), from the first sample", grey},
           {"STFPI + grey as printed, p 17 (edm-greyhorizon)", p17},
           {"STFPI + grey, start-up excluded: held 200 samples at the fixed settings", settled},
           {"STFPI + grey, start-up excluded: held 200 samples at 50 µs / 70 V", settled_safe},
           {"STFPI, no predictor", nogrey},
-          {"STFPI + grey before issue 20 (rho, Psi for e < -0.01)", before}};
+          {"STFPI + grey before issue 20 (rho, Psi for e < -0.01)", before},
+          {"STFPI + grey as printed, Psi unfloored (psi_min -1e9)", unfloored}};
 }
 
 // Rab figures over the whole run, the start-up transient included: 1 s means of io.rab from
