@@ -22,6 +22,8 @@
 //             last `--window-ms`; dY_i = Y_i − (Y_i−1 + Y_i+1)/2, dZ_i likewise (the surface
 //             z_p recedes about linearly over three halves, so it cancels), kδ = Σ|dY| / Σ|dZ|
 //             with signs kept (Σ dY·s_i / Σ dZ·s_i, s_i = ±1 the half's side).
+// (The estimators are in ilc_identify.hpp, tested on synthetic records in
+// tests/controllers/ilc_identify_test.cpp.)
 // Gains: eq. 1 with the identified p0, kδ and the poles (--q-pole, --lambda1..3).
 // --learn: the cold-start learning of sink-ilc.yaml (as shipped, or with text edits --edit
 // 'FROM=>TO', e.g. other poles) on seeds --seed … (the benchmark's: 1-20), the jump forced as the
@@ -50,6 +52,7 @@
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/scheduler.hpp"
+#include "ilc_identify.hpp"
 
 namespace {
 
@@ -64,11 +67,11 @@ constexpr const char* kUsage =
     "                     [--lambda3 l] [--learn [--edit F=>T]...\n"
     "                     [--cycles C]]";
 
-constexpr double kYRef = 45.0;             // V, the ILC's y_ref and the voltage servo's reference
-constexpr double kServoGain = 0.02;        // mm/s/V, sink-sim.yaml's voltage servo
-constexpr double kServoMin = -0.5;         // mm/s
-constexpr double kServoMax = 5.0;          // mm/s
-constexpr std::int64_t kResponseLen = 40;  // samples of the step response kept
+constexpr double kYRef = 45.0;            // V, the ILC's y_ref and the voltage servo's reference
+constexpr double kServoGain = 0.02;       // mm/s/V, sink-sim.yaml's voltage servo
+constexpr double kServoMin = -0.5;        // mm/s
+constexpr double kServoMax = 5.0;         // mm/s
+constexpr std::size_t kResponseLen = 40;  // samples of the step response kept
 
 // One simulated machine from a config text, stepped in 1 ms slices.
 class Machine {
@@ -155,60 +158,37 @@ IdentResult identify(const std::string& text, const std::string& name, std::int6
   // Feed rate of the last second [mm/ms].
   double feed = (r_hist.back() - r_hist[r_hist.size() - 1001]) / 1000.0;
   double c = r;
-  IdentResult out;
-  out.s.assign(kResponseLen, 0.0);
-  std::vector<double> ys, zs, sides;  // per half: mean y, mean z over its window, side ±1
-  double ysum_all = 0, yn_all = 0;
+  std::vector<double> zs, ys;  // the square-wave record (ilc_identify.hpp's convention)
   const std::int64_t halves = 2 * o.periods;
   double period_y = 0, period_n = 0;
   for (std::int64_t h = 0; h < halves; ++h) {
     const double side = h % 2 == 0 ? 1.0 : -1.0;
-    double z0 = 0.0, ywin = 0, zwin = 0, nwin = 0;
-    std::vector<double> zr;
-    zr.reserve(kResponseLen);
     for (std::int64_t i = 0; i < o.half_ms; ++i) {
       c += feed;
       m.force(ref, c + side * 0.5 * o.amplitude_mm);
       m.step();
-      const double zi = rt::read_pin_as_double(z), yi = rt::read_pin_as_double(y);
-      // The cycle that applies the new reference reads z before it acts (z0, s(0) = 0); the
-      // next one reads the first millisecond of its motion, s(1) = p0 as the block sees it.
-      if (i == 0) {
-        z0 = zi;
-      } else if (i < kResponseLen) {
-        zr.push_back(zi);
-      }
-      if (i >= o.half_ms - o.window_ms) {
-        ywin += yi, zwin += zi, nwin += 1;
-      }
-      period_y += yi, period_n += 1;
-      ysum_all += yi, yn_all += 1;
+      zs.push_back(rt::read_pin_as_double(z));
+      ys.push_back(rt::read_pin_as_double(y));
+      period_y += ys.back(), period_n += 1;
     }
-    if (h > 0) {  // the first edge comes from the approach, not from the other side
-      const double dr = side * o.amplitude_mm;
-      for (std::size_t i = 0; i < zr.size(); ++i) {
-        out.s[i + 1] += (zr[i] - z0) / dr;
-      }
-      ++out.edges;
-    }
-    ys.push_back(ywin / nwin);
-    zs.push_back(zwin / nwin);
-    sides.push_back(side);
     if (h % 2 == 1) {  // once a period: steer the mean y back to y_ref (≈ 0.5 µm/s per V)
       feed -= 0.5e-6 * (period_y / period_n - kYRef);
       period_y = period_n = 0;
     }
   }
-  for (double& v : out.s) {
-    v /= static_cast<double>(out.edges);
+  IdentResult out;
+  const auto half = static_cast<std::size_t>(o.half_ms);
+  out.s = edm::ilcdesign::step_response(zs, half, o.amplitude_mm, kResponseLen);
+  const auto k = edm::ilcdesign::k_delta_sums(zs, ys, half, static_cast<std::size_t>(o.window_ms));
+  out.sum_dy = k.dy;
+  out.sum_dz = k.dz;
+  out.halves = static_cast<std::int64_t>(k.halves);
+  out.edges = halves - 1;
+  double ysum_all = 0;
+  for (double v : ys) {
+    ysum_all += v;
   }
-  for (std::size_t i = 1; i + 1 < ys.size(); ++i) {
-    const double dy = ys[i] - 0.5 * (ys[i - 1] + ys[i + 1]);
-    const double dz = zs[i] - 0.5 * (zs[i - 1] + zs[i + 1]);
-    out.sum_dy += dy * sides[i];
-    out.sum_dz += dz * sides[i];
-    ++out.halves;
-  }
+  const double yn_all = static_cast<double>(ys.size());
   out.y_mean = ysum_all / yn_all;
   return out;
 }
