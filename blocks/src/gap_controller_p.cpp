@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/blocks/validation.hpp"
+
 namespace edm::blocks {
 
 std::vector<rt::ParamError> GapControllerPParams::validate() const {
@@ -15,9 +17,17 @@ std::vector<rt::ParamError> GapControllerPParams::validate() const {
   return errs;
 }
 
+std::vector<rt::ParamError> GapControllerP::configure(const rt::BlockSetup& setup) {
+  std::vector<rt::ParamError> errs;
+  require_task_period(errs, setup.period);
+  dt_s_ = rt::to_seconds(setup.period);
+  return errs;
+}
+
 void GapControllerP::activate() noexcept {
   vz_mm_s.set(0.0);
   saturated.set(false);
+  integral_us_s_ = 0.0;
 }
 
 rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept {
@@ -34,14 +44,17 @@ rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept
     return rt::BlockStatus::kOk;
   }
   double vz = p.idle_feed_mm_s;
-  if (valid.get()) {
+  double error_us = 0.0;  // Tdr − Td while the P law runs
+  const bool law = valid.get();
+  if (law) {
     const double td = td_us.get();
     const double tdr_in = tdr_us.get();
     if (!std::isfinite(td) || !std::isfinite(tdr_in) || tdr_in < 0.0) {
       return rt::BlockStatus::kFault;
     }
     const double tdr = tdr_in > 0.0 ? tdr_in : p.tdr_default_us;
-    vz = p.kg * (tdr - td);
+    error_us = tdr - td;
+    vz = p.kg * error_us + p.ki * integral_us_s_;
     if (!std::isfinite(vz)) {  // finite inputs, but kg·error overflowed
       return rt::BlockStatus::kFault;
     }
@@ -49,6 +62,11 @@ rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept
   // max/min rather than std::clamp: no undefined behaviour for limits that bypassed validate().
   const double limited = std::min(std::max(vz, -p.v_feed_max_mm_s), p.v_retract_max_mm_s);
   const bool saturated_now = limited != vz;
+  // Conditional integration: not while clamped with the error pushing the same way.
+  if (law && p.ki > 0.0 && !(saturated_now && (error_us > 0.0) == (vz > 0.0))) {
+    const double next = integral_us_s_ + error_us * dt_s_;
+    if (std::isfinite(next)) integral_us_s_ = next;
+  }
   vz_mm_s.set(limited);
   saturated.set(saturated_now);
   return saturated_now ? rt::BlockStatus::kSaturated : rt::BlockStatus::kOk;

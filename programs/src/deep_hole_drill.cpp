@@ -26,6 +26,11 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
           {.unit = "mm/s",
            .description = "feed down until the first sparks (at most the gap feed limit)",
            .range = rt::open_closed(0.0, kMaxApproachSpeed)});
+  v.param("spark_gap_offset_um", spark_gap_offset_um,
+          {.unit = "um",
+           .description = "frontal gap at the first sparks less the working gap: the hole is "
+                          "this much shallower than the front's travel from the touch",
+           .range = rt::closed(-1000.0, 1000.0)});
   v.param("touch_cycles", touch_cycles,
           {.unit = "cycles",
            .description = "consecutive cycles with sparks that count as touching the work",
@@ -279,10 +284,13 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       reset_wear.set(false);
     }
     // The electrode front is z − accumulated wear: the compensated axis travels further than the
-    // front by the length the compensator has added for the wear, so the front (≈ the hole
-    // bottom, one working gap away) has gone (touch_z − z) − wear_mm below the touch point.
+    // front by the length the compensator has added for the wear, so the front has gone
+    // (touch_z − z) − wear_mm below the touch point. The front touched at the gap where the
+    // first sparks strike and drills one working gap above the bottom: the hole is deeper than
+    // the front's travel by the working gap and shallower by the first-spark gap,
+    //   depth = (touch_z − z) − wear_mm − spark_gap_offset_um·1e-3   (first-spark − working gap).
     const double wear_now = comp ? wear_.wear_mm.get() : 0.0;
-    const double depth = (touch_z_mm.get() - z) - wear_now;
+    const double depth = (touch_z_mm.get() - z) - wear_now - params_.spark_gap_offset_um * 1e-3;
     depth_reached_mm.set(depth);
     wear_mm.set(wear_now);
     dark_cycles_ = pulses.td_count.get() > 0 ? 0 : dark_cycles_ + 1;

@@ -213,5 +213,77 @@ TEST(GapControllerPParamsTest, validate_refuses_bad_values) {
   EXPECT_FALSE(with([](auto& p) { p.v_feed_max_mm_s = kInf; }).empty());
 }
 
+// The integral option (ki > 0): with a constant error the command is Kg·e + ki·e·t exactly
+// (t = cycles·dt), and ki = 0 is the P law.
+TEST(GapControllerPIntegral, ConstantErrorRampsTheCommandAsKgEPlusKiET) {
+  BlockHarness<GapControllerP> h;  // 1 ms
+  GapControllerPParams p;
+  p.kg = 0.05;
+  p.ki = 0.02;
+  p.v_feed_max_mm_s = 100.0;
+  ASSERT_TRUE(h.start(p).empty());
+  h.source<double>("tdr_us").set(8.0);
+  h.source<double>("td_us").set(18.0);  // e = −10 µs
+  for (int n = 0; n < 500; ++n) {
+    ASSERT_EQ(h.step(), BlockStatus::kOk);
+    // The integral is updated after the output of cycle n: n cycles of error are in it.
+    EXPECT_NEAR(h.out("vz_mm_s"), 0.05 * -10.0 + 0.02 * -10.0 * 1e-3 * n, 1e-12) << n;
+  }
+}
+
+// Closed loop on a ramp: the hole bottom recedes at v_b, the gap grows with the axis' upward
+// speed (gap' = Vz + v_b) and Td = Tdr0 + s·(gap − g0). The P law settles with Td − Tdr = v_b/Kg
+// (seed 004's steady offset); with ki > 0 the offset goes to 0.
+double settled_offset_us(double ki) {
+  BlockHarness<GapControllerP> h;  // 1 ms
+  GapControllerPParams p;
+  p.kg = 0.05;
+  p.ki = ki;
+  EXPECT_TRUE(h.start(p).empty());
+  const double v_b = 0.5, s_us_per_mm = 500.0, dt = 1e-3;
+  double gap_mm = 0.03;
+  h.source<double>("tdr_us").set(8.0);
+  double td = 0.0;
+  for (int n = 0; n < 60000; ++n) {
+    td = 8.0 + s_us_per_mm * (gap_mm - 0.03);
+    h.source<double>("td_us").set(td);
+    h.step();
+    gap_mm += (h.out("vz_mm_s") + v_b) * dt;
+  }
+  return td - 8.0;
+}
+
+TEST(GapControllerPIntegral, PLawKeepsTheRampOffsetAndTheIntegralRemovesIt) {
+  EXPECT_NEAR(settled_offset_us(0.0), 0.5 / 0.05, 1e-6) << "Td − Tdr = v_b/Kg";
+  EXPECT_NEAR(settled_offset_us(0.05), 0.0, 1e-3);
+}
+
+// Saturated with the error pushing further: the integral does not grow, so the command leaves the
+// clamp as soon as the error reverses (no wind-up).
+TEST(GapControllerPIntegral, NoWindUpWhileClamped) {
+  BlockHarness<GapControllerP> h;
+  GapControllerPParams p;
+  p.kg = 0.05;
+  p.ki = 0.5;
+  p.v_feed_max_mm_s = 1.0;
+  ASSERT_TRUE(h.start(p).empty());
+  h.source<double>("tdr_us").set(8.0);
+  h.source<double>("td_us").set(100.0);  // Kg·e = −4.6 mm/s: clamped at −1
+  for (int n = 0; n < 5000; ++n) h.step();
+  EXPECT_EQ(h.out("vz_mm_s"), -1.0);
+  h.source<double>("td_us").set(4.0);  // e = +4 µs: back off
+  EXPECT_EQ(h.step(), BlockStatus::kOk);
+  EXPECT_GT(h.out("vz_mm_s"), 0.0) << "the integral did not wind up while clamped";
+  // Hold freezes it, activate() clears it.
+  h.source<bool>("hold").set(true);
+  EXPECT_EQ(h.step(), BlockStatus::kOk);
+  EXPECT_EQ(h.out("vz_mm_s"), 0.0);
+  h.source<bool>("hold").set(false);
+  h.block().activate();
+  h.source<double>("td_us").set(8.0);
+  h.step();
+  EXPECT_EQ(h.out("vz_mm_s"), 0.0);
+}
+
 }  // namespace
 }  // namespace edm::blocks

@@ -34,7 +34,8 @@ TEST(MachineConfig, ReadsTheShippedDrillMachine) {
   ASSERT_NE(e1, nullptr);
   EXPECT_EQ(e1->name, "drill-rough");
   EXPECT_EQ(e1->polarity, Polarity::kNegative);
-  EXPECT_EQ(e1->wear_ratio, 0.6195);  // the calibrated effective ratio (docs/blocks.md)
+  EXPECT_EQ(e1->wear_ratio, 0.6189);  // the calibrated effective ratio (docs/blocks.md)
+  EXPECT_EQ(e1->area_ratio, 1.3297);  // A_hole/A_e of the Ø1.0/0.3 tube in its Ø1.1 hole
   EXPECT_EQ(e1->tdr_us, 8.0);
   const Condition* e2 = t.condition(2);
   ASSERT_NE(e2, nullptr);

@@ -87,7 +87,8 @@ TEST_P(JobSeeds, DrillThenFinishFromTheJobStore) {
       GetParam(), j.finished, j.time_s, j.depth_mm, j.r_min_mm, j.r_max_mm, j.r0_mm, j.z_end_mm,
       100 * j.short_fraction);
   ASSERT_TRUE(j.finished);
-  EXPECT_NEAR(j.depth_mm, 20.0, 0.02);
+  // The depth benchmark's bound (docs/benchmarks.md "Depth accuracy": up to +24 µm at 15-25 mm).
+  EXPECT_NEAR(j.depth_mm, 20.0, 0.03);
   EXPECT_NEAR(j.r_min_mm, j.r0_mm + 0.05, 0.005);
   EXPECT_NEAR(j.r_max_mm, j.r0_mm + 0.05, 0.005);
   EXPECT_NEAR(j.z_end_mm, 5.0, 0.05) << "the last rapid was executed";

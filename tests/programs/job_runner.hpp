@@ -39,8 +39,11 @@ inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& pr
   JobResult res;
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(seed);
-  auto r = build_sim_machine(
-      rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/" + machine), opts);
+  // `machine`: a file of config/machines/, or a path (an experiment's own config).
+  const std::string path = machine.find('/') != std::string::npos
+                               ? machine
+                               : std::string(EDM_SOURCE_DIR) + "/config/machines/" + machine;
+  auto r = build_sim_machine(rt::parse_config_file(path), opts);
   const auto issues = machining::check_program(program, r->tables(), start);
   EXPECT_TRUE(issues.empty()) << issues[0].message;
   EXPECT_EQ(r->job().load(program), rt::LoadResult::kOk);

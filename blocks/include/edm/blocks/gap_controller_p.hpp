@@ -3,6 +3,16 @@
 //
 //   Vz = Kg·(Tdr − Td)      clamped to [−v_feed_max_mm_s, +v_retract_max_mm_s]
 //
+// The steady offset (paper-faithful). While the hole deepens at v_b the P law can only command
+// Vz = −v_b with an error: Td − Tdr = v_b/Kg (the real-time wear compensator adds its Vd on top,
+// so v_b is the bottom's speed alone). On the drill preset (v_b ≈ 0.5 mm/s, Kg 0.05) Td sits near
+// 18 µs against Tdr = 8 µs. That is seed 004's controller as published, and the default.
+// The standard remedy, an option: an integral term (ki > 0, 0 = the paper's P law),
+//   Vz = Kg·(Tdr − Td) + ki·∫(Tdr − Td) dt,
+// integrated only while the P law runs (not in retract, hold, disable or while Td is not valid,
+// which freeze it) and not while the output is clamped with the error pushing further
+// (conditional integration: no wind-up). activate() clears it. docs/benchmarks.md has its row.
+//
 // Z is positive upward and the electrode drills downward: a gap that is too large (Td > Tdr)
 // gives Vz < 0 (feed down into the work), a gap that is too small (Td < Tdr) gives Vz > 0 (back
 // off). Tdr is the input tdr_us when it is > 0 (the active condition sets it), else the
@@ -35,6 +45,7 @@ struct GapControllerPParams {
   double v_retract_max_mm_s{5.0};  // [mm/s] > 0, largest upward speed (Vz ≤ +this)
   double retract_speed_mm_s{2.0};  // [mm/s] in (0, v_retract_max_mm_s], Vz while retract
   double idle_feed_mm_s{0.0};      // [mm/s] in [−v_feed_max_mm_s, 0], Vz while valid = false
+  double ki{0.0};                  // [mm/s per µs·s] ≥ 0, integral gain (0: the paper's P law)
 
   void visit(rt::ParamVisitor& v) {
     v.param("kg", kg,
@@ -57,6 +68,11 @@ struct GapControllerPParams {
             {.unit = "mm/s",
              .description = "speed while no valid Td, >= -v_feed_max_mm_s",
              .range = rt::at_most(0.0)});
+    v.param("ki", ki,
+            {.unit = "mm/s/(us*s)",
+             .description = "integral gain on the Td error; 0 = seed 004's P law (steady Td "
+                            "offset v_b/Kg while drilling)",
+             .range = rt::kNonNegative});
   }
   /// Cross-field rules: retract_speed <= v_retract_max, idle_feed >= -v_feed_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
@@ -64,7 +80,9 @@ struct GapControllerPParams {
 
 class GapControllerP final : public rt::BlockWithParams<GapControllerPParams> {
  public:
-  /// Non-RT. vz_mm_s = 0, saturated = false.
+  /// Non-RT. Needs a task period > 0 (the integral's dt).
+  std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
+  /// Non-RT. vz_mm_s = 0, saturated = false, integral 0.
   void activate() noexcept override;
   /// RT-safe. kOk, kSaturated (clamped), or kFault (broken Td or Tdr while the P law runs).
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
@@ -81,6 +99,8 @@ class GapControllerP final : public rt::BlockWithParams<GapControllerPParams> {
   rt::Output<bool> saturated{pins_, "saturated"};
 
  private:
+  double dt_s_{0.0};
+  double integral_us_s_{0.0};  // ∫(Tdr − Td) dt [µs·s]
 };
 
 }  // namespace edm::blocks

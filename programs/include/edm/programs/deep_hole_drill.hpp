@@ -20,6 +20,9 @@
 //               broken signal: the feed stops (vz 0 into wear) and update() returns kFault.
 //               Hole depth estimate (the electrode front is z − accumulated wear):
 //                 depth_reached_mm = (touch_z_mm − z_mm) − (enable_wear_comp ? wear.wear_mm : 0)
+//                                    − spark_gap_offset_um·1e-3
+//                 (the front touches at the first-spark gap and drills one working gap above
+//                 the bottom; spark_gap_offset_um is their difference, docs/blocks.md)
 //                 (output wear_mm: that estimated electrode wear of this cycle)
 //               When it reaches the target → RETRACT. With `through` set, breakthrough_cycles
 //               consecutive cycles without an ignited pulse (td_count = 0) once depth ≥
@@ -100,6 +103,7 @@ namespace edm::programs {
 struct DeepHoleDrillParams {
   double depth_default_mm{20.0};          // [mm] target hole depth while the depth_mm input is 0
   double approach_speed_mm_s{0.5};        // [mm/s] feed down until the first sparks
+  double spark_gap_offset_um{0.0};        // [um] first-spark gap − working gap (depth origin)
   std::int64_t touch_cycles{3};           // consecutive cycles with sparks = touch
   double retract_speed_mm_s{5.0};         // [mm/s]
   double clearance_mm{1.0};               // [mm] retract to touch_z + this
