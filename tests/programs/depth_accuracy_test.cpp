@@ -107,30 +107,48 @@ std::vector<int> seeds_from_env(const char* name, std::vector<int> fallback) {
   return out;
 }
 
-TEST(DepthAccuracy, BlindHolesAtFiveDepthsEndWithinThirtyMicrometres) {
-  const std::vector<int> seeds = seeds_from_env("EDM_DEPTH_SEEDS", {1, 2, 3, 4, 5});
-  std::vector<double> depths = {3.0, 8.0, 15.0, 25.0, 30.0};
-  if (const char* d = std::getenv("EDM_DEPTH_ONLY")) depths = {std::atof(d)};  // experiments
-  for (const double depth : depths) {
-    double sum = 0.0, worst = 0.0;
-    for (const int seed : seeds) {
-      const Hole h = drill(seed, depth);
-      ASSERT_TRUE(h.finished) << depth << " mm, seed " << seed;
-      const double err_um = (h.depth_mm - depth) * 1000.0;
-      std::printf(
-          "[depth] %5.1f mm seed %4d: %8.4f mm (%+6.1f um) in %.1f s; Z travel %.3f mm, "
-          "planned lz' %.3f mm; gap touch %.1f end %.1f um, wear true %.4f est %.4f mm; "
-          "RMS(Td-Tdr) %.2f us\n",
-          depth, seed, h.depth_mm, err_um, h.time_s, h.travel_mm, h.planned_travel_mm,
-          h.gap_touch_um, h.gap_end_um, h.wear_true_mm, h.wear_est_mm, h.td_rms_us);
-      sum += err_um;
-      if (std::abs(err_um) > std::abs(worst)) worst = err_um;
-      EXPECT_NEAR(h.depth_mm, depth, 0.030) << depth << " mm, seed " << seed;
-    }
-    std::printf("[depth] %5.1f mm: mean %+6.1f um, worst %+6.1f um over %zu seeds\n", depth,
-                sum / static_cast<double>(seeds.size()), worst, seeds.size());
+// Scoring seeds 1-5; one under a sanitizer (about 10x slower: five seeds of a 30 mm hole would
+// pass ctest's 300 s timeout there, and the sanitizers look for memory errors, not figures).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+const std::vector<int> kScoringSeeds = {1};
+#else
+const std::vector<int> kScoringSeeds = {1, 2, 3, 4, 5};
+#endif
+
+class DepthAccuracy : public ::testing::TestWithParam<double> {};
+
+TEST_P(DepthAccuracy, BlindHoleEndsWithinThirtyMicrometres) {
+  const std::vector<int> seeds = seeds_from_env("EDM_DEPTH_SEEDS", kScoringSeeds);
+  double depth = GetParam();
+  if (const char* d = std::getenv("EDM_DEPTH_ONLY")) {  // experiments: one depth
+    if (depth != 3.0) GTEST_SKIP() << "EDM_DEPTH_ONLY";
+    depth = std::atof(d);
   }
+  double sum = 0.0, worst = 0.0;
+  for (const int seed : seeds) {
+    const Hole h = drill(seed, depth);
+    ASSERT_TRUE(h.finished) << depth << " mm, seed " << seed;
+    const double err_um = (h.depth_mm - depth) * 1000.0;
+    std::printf(
+        "[depth] %5.1f mm seed %4d: %8.4f mm (%+6.1f um) in %.1f s; Z travel %.3f mm, "
+        "planned lz' %.3f mm; gap touch %.1f end %.1f um, wear true %.4f est %.4f mm; "
+        "RMS(Td-Tdr) %.2f us\n",
+        depth, seed, h.depth_mm, err_um, h.time_s, h.travel_mm, h.planned_travel_mm, h.gap_touch_um,
+        h.gap_end_um, h.wear_true_mm, h.wear_est_mm, h.td_rms_us);
+    sum += err_um;
+    if (std::abs(err_um) > std::abs(worst)) worst = err_um;
+    EXPECT_NEAR(h.depth_mm, depth, 0.030) << depth << " mm, seed " << seed;
+    // Eq. 9-11 and eq. 8 agree: Z travels the planned lz' (the wear counted once).
+    EXPECT_NEAR(h.travel_mm, h.planned_travel_mm, 0.05) << depth << " mm, seed " << seed;
+  }
+  std::printf("[depth] %5.1f mm: mean %+6.1f um, worst %+6.1f um over %zu seeds\n", depth,
+              sum / static_cast<double>(seeds.size()), worst, seeds.size());
 }
+
+INSTANTIATE_TEST_SUITE_P(Depths, DepthAccuracy, ::testing::Values(3.0, 8.0, 15.0, 25.0, 30.0),
+                         [](const auto& p) {
+                           return std::to_string(static_cast<int>(p.param)) + "mm";
+                         });
 
 }  // namespace
 }  // namespace edm::test
