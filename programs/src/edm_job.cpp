@@ -81,6 +81,7 @@ void EdmJob::bind_self() {
   finish_.start.connect(finish_start);
   finish_.final_offset_mm.connect(finish_final_offset_mm);
   finish_.start_offset_mm.connect(finish_start_offset_mm);
+  finish_.feed_mm_min.connect(finish_feed_mm_min);
 
   lin_.start.connect(lin_start);
   lin_.hold.connect(lin_hold);
@@ -294,6 +295,7 @@ bool EdmJob::run_finish(const MotionBlock& b, bool hold) noexcept {
   if (step_ == Step::kEnter) {
     finish_final_offset_mm.set(b.final_radius_mm - params_.orbit_radius_offset_mm);
     finish_start_offset_mm.set(std::min(0.01, b.final_radius_mm - params_.orbit_radius_offset_mm));
+    finish_feed_mm_min.set(b.feed_mm_s > 0.0 ? b.feed_mm_s * 60.0 : 0.0);  // G160's F (0: default)
     finish_start.set(true);
     step_ = Step::kBusy;
     return false;

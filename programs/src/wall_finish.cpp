@@ -13,12 +13,16 @@ namespace edm::programs {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kMinBaseRadiusMm = 1e-3;  // the arc's radius when the final offset is ~0
 
 }  // namespace
 
 void WallFinishParams::visit(rt::ParamVisitor& v) {
-  v.param("orbit_period_s", orbit_period_s,
-          {.unit = "s", .description = "time of one orbit revolution", .range = rt::kPositive});
+  v.param("feed_default_mm_min", feed_default_mm_min,
+          {.unit = "mm/min",
+           .description = "orbit feed fr along the arc's radius (the final offset) while the "
+                          "feed_mm_min input is <= 0",
+           .range = rt::kPositive});
   v.param("radial_speed_mm_s", radial_speed_mm_s,
           {.unit = "mm/s",
            .description = "slew rate of the reference orbit radius",
@@ -42,6 +46,7 @@ WallFinish::WallFinish()
     : pol_(add_child<blocks::PolaritySwitch>("pol")),
       td_(add_child<blocks::TdDetector>("td")),
       orbit_(add_child<blocks::OrbitExpander>("orbit")),
+      arc_(add_child<blocks::CircularInterpolator>("arc")),
       px_(add_child<blocks::PositionLoop>("px")),
       py_(add_child<blocks::PositionLoop>("py")),
       retract_(add_child<blocks::ShortRetract>("retract")) {
@@ -51,7 +56,9 @@ WallFinish::WallFinish()
   pol_.set_params(pp);
   blocks::OrbitExpanderParams op;
   op.kr = 0.0001;
-  op.dr_max_mm = 0.002;
+  // Eq. 21 live: Td ≤ the open threshold (100 µs on the presets) keeps kr·Tdm ≤ 0.01 mm, so this
+  // limit only guards against a misconfigured kr (it clamped every step at 0.002 before issue 20).
+  op.dr_max_mm = 0.01;
   op.samples_per_rev = 0;  // revolutions from rev_pulse
   orbit_.set_params(op);
   for (blocks::PositionLoop* l : {&px_, &py_}) {
@@ -89,6 +96,16 @@ void WallFinish::bind_self() {
   orbit_.rev_pulse.connect(rev_pulse);
   orbit_.td_us.connect(td_.td_us);
   orbit_.valid.connect(td_.valid);
+  arc_.start.connect(arc_start);
+  arc_.load.connect(arc_load);
+  arc_.load_x_mm.connect(arc_load_x_mm);
+  arc_.load_y_mm.connect(arc_load_y_mm);
+  arc_.i_mm.connect(arc_i_mm);
+  arc_.j_mm.set_constant(0.0);
+  arc_.cw.set_constant(false);  // G03
+  arc_.full_circle.set_constant(true);
+  arc_.turns.set_constant(blocks::CircularInterpolator::kMaxTurns);
+  arc_.feed_mm_min.connect(arc_feed_mm_min);
   px_.x_ref_mm.connect(x_ref_mm);
   px_.v_ff_mm_s.connect(vx_ff_mm_s);
   px_.x_mm.follow(x_mm);
@@ -106,7 +123,10 @@ void WallFinish::bind_self() {
 void WallFinish::activate_self() noexcept {
   prev_start_ = false;
   x0_ = y0_ = 0.0;
-  rho_ = theta_ = 0.0;
+  rho_ = theta_ = r_base_ = 0.0;
+  arc_turns_ = 0;
+  arc_start.set(false);
+  arc_load.set(false);
   revs_ = 0;
   spark_out_left_ = 0;
   spark_out_ = false;
@@ -232,6 +252,19 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     orbit_enable.set(false);
     rev_pulse.set(false);
     generator_request.set(true);
+    // The arc: full circles of radius R_b (the final offset) about the centre, from angle 0.
+    r_base_ = std::max(orbit_final_mm.get(), kMinBaseRadiusMm);
+    arc_load_x_mm.set(x0_ + r_base_);
+    arc_load_y_mm.set(y0_);
+    arc_i_mm.set(-r_base_);
+    const double fr = feed_mm_min.get();
+    arc_feed_mm_min.set(fr > 0.0 && std::isfinite(fr) ? fr : params_.feed_default_mm_min);
+    arc_load.set(true);
+    arc_start.set(false);
+    status = rt::worst(status, step(arc_, ctx));  // at the load point
+    arc_load.set(false);
+    arc_turns_ = 0;
+    theta_ = 0.0;
     set_state(State::kOrbit);
   }
 
@@ -255,13 +288,12 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       // Revolutions count (and Td is collected) only once the reference radius has reached the
       // orbit radius: the entry from the centre is not a machining revolution.
       const bool on_radius = rho_ == radius;
-      const double prev_theta = theta_;
-      theta_ += kTwoPi * dt / params_.orbit_period_s;
-      bool wrapped = false;
-      if (theta_ >= kTwoPi) {
-        theta_ -= kTwoPi;
-        wrapped = prev_theta < kTwoPi;
-      }
+      arc_start.set(true);  // a rising edge the first time: the arc latches its circle
+      status = rt::worst(status, step(arc_, ctx));
+      theta_ = arc_.angle_rad.get();
+      const auto turns_done = static_cast<std::int64_t>(std::floor(arc_.swept_rad.get() / kTwoPi));
+      const bool wrapped = turns_done > arc_turns_;
+      arc_turns_ = turns_done;
       orbit_enable.set(on_radius);
       rev_pulse.set(wrapped && on_radius);
       if (wrapped && on_radius) {
@@ -300,8 +332,9 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       const double slew = params_.radial_speed_mm_s * dt;
       rho_ =
           rho_ < rho_target ? std::min(rho_ + slew, rho_target) : std::max(rho_ - slew, rho_target);
-      xr = x0_ + rho_ * std::cos(theta_);
-      yr = y0_ + rho_ * std::sin(theta_);
+      // Fig. 1: the interpolator's point, plus the orbit compensation along the radius.
+      xr = arc_.rx_mm.get() + (rho_ - r_base_) * std::cos(theta_);
+      yr = arc_.ry_mm.get() + (rho_ - r_base_) * std::sin(theta_);
     }
     vx_ff_mm_s.set(dt > 0.0 ? (xr - x_ref_) / dt : 0.0);
     vy_ff_mm_s.set(dt > 0.0 ? (yr - y_ref_) / dt : 0.0);

@@ -43,7 +43,7 @@ struct OrbitRig : CompositeRig<WallFinish> {
   }
   static programs::WallFinishParams WallFinishParams() {
     programs::WallFinishParams p;
-    p.orbit_period_s = 1.0;  // 1.3 mm/s along a 0.2 mm orbit
+    p.feed_default_mm_min = 79.2;  // 1.3 mm/s along the 0.21 mm final orbit: ≈ 1 s a revolution
     p.spark_out_revs = 2;
     return p;
   }

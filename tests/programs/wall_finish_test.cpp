@@ -59,7 +59,7 @@ struct Rig : CompositeRig<WallFinish> {
 
 programs::WallFinishParams params() {
   programs::WallFinishParams p;
-  p.orbit_period_s = 0.2;
+  p.feed_default_mm_min = 20.0;  // ≈ 0.2 s a revolution at the 0.0105 mm final offset
   p.radial_speed_mm_s = 0.05;
   p.spark_out_revs = 2;
   return p;
@@ -69,7 +69,7 @@ TEST(WallFinish, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("Wal
 
 TEST(WallFinish, RejectsBadParameters) {
   programs::WallFinishParams p = params();
-  p.orbit_period_s = 0.0;
+  p.feed_default_mm_min = 0.0;
   p.spark_out_revs = -1;
   EXPECT_EQ(rt::validate_params(p).size(), 2u);
   programs::WallFinish wf;
@@ -144,6 +144,42 @@ TEST(WallFinish, FullCyclePolarityThenGrowingOrbitThenBackToCentre) {
   EXPECT_EQ(rig.out<double>("vy_cmd_mm_s"), 0.0);
   for (int i = 0; i < 100; ++i) rig.step();
   EXPECT_EQ(rig.state(), 4);
+}
+
+// Seed 004 Fig. 1: the orbit is the circular interpolator's circle (eq. 14–19) at the orbit feed
+// fr, plus the radial compensation. On the final radius R_b the reference moves at fr along the
+// circle, and the feed_mm_min input (G160's F through EdmJob) replaces the parameter.
+TEST(WallFinish, OrbitReferenceRunsAtTheFeedOnTheFinalRadius) {
+  for (const double feed_in : {0.0, 45.0}) {
+    Rig rig(params());  // feed_default_mm_min 20
+    rt::Output<double> feed;
+    feed.set(feed_in);
+    rig.in<double>("feed_mm_min").connect(feed);
+    rig.start_offset.set(0.02);
+    rig.final_offset.set(0.02);  // no growth: R_b = ρ = 0.02 mm from the first revolution
+    rig.start.set(true);
+    const double fr_mm_s = (feed_in > 0.0 ? feed_in : 20.0) / 60.0;
+    double px = 0.0, py = 0.0, max_dev = 0.0;
+    int samples = 0;
+    bool have = false;
+    for (int k = 0; k < 20000 && rig.state() != 3; ++k) {
+      rig.step();
+      const double xr = rig.out<double>("x_ref_mm"), yr = rig.out<double>("y_ref_mm");
+      const bool on_radius = rig.state() == 2 && rig.out<double>("rho_mm") == 0.02;
+      if (on_radius && have) {
+        const double speed = std::hypot(xr - px, yr - py) / 1e-3;  // chord per 1 ms cycle
+        max_dev = std::max(max_dev, std::abs(speed - fr_mm_s));
+        // The reference lies on the orbit circle about the centre (3, -2).
+        EXPECT_NEAR(std::hypot(xr - 3.0, yr + 2.0), 0.02, 1e-12) << k;
+        ++samples;
+      }
+      have = on_radius;
+      px = xr;
+      py = yr;
+    }
+    EXPECT_GT(samples, 200) << feed_in;  // the spark-out revolutions
+    EXPECT_LT(max_dev, fr_mm_s * 1e-3) << "the path speed is the feed (chord vs arc: 1e-3)";
+  }
 }
 
 TEST(WallFinish, GrowthPerRevolutionIsClampedToDrMax) {

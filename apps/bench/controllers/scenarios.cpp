@@ -220,15 +220,18 @@ std::vector<Scenario> make_scenarios(bool quick) {
     w.done_var = "cycle.finish.state";
     w.done_value = 4.0;
     w.wall_growth_mm = 0.05;
-    // As shipped, kr·Tdm (Tdm ≈ 50 µs) is above dr_max every revolution: a fixed 2 µm step
-    // (kr 1 gave identical figures on seeds 1-2). kr 2e-5 keeps dr = kr·Tdm ≈ 1 µm below dr_max, so
-    // the step follows Tdm; the coarse fixed step is 10 µm per revolution.
+    // As shipped (issue 20), eq. 21 is live: dr = kr·Tdm with kr 1e-4 mm/µs (Tdm ≤ 100 µs keeps it
+    // under dr_max 10 µm). Before issue 20 dr_max 2 µm clamped every step (Tdm ≈ 50 µs): that
+    // fixed step is a variant, as is a smaller kr and the coarse fixed step of 10 µm/rev.
     RunSpec adaptive = w;
     adaptive.edits = {{"kr: 0.0001,", "kr: 0.00002,"}};
+    RunSpec fixed2 = w;
+    fixed2.edits = {{"dr_max_mm: 0.01", "dr_max_mm: 0.002"}};
     RunSpec coarse = w;
-    coarse.edits = {{"kr: 0.0001, dr_max_mm: 0.002", "kr: 1.0, dr_max_mm: 0.01"}};
-    s.variants = {{"WallFinish as shipped (kr 1e-4 mm/µs, dr_max 2 µm: 2 µm/rev)", w},
+    coarse.edits = {{"kr: 0.0001, dr_max_mm: 0.01", "kr: 1.0, dr_max_mm: 0.01"}};
+    s.variants = {{"WallFinish as shipped (eq. 21 live: dr = kr·Tdm, kr 1e-4 mm/µs)", w},
                   {"WallFinish, kr 2e-5 (dr = kr·Tdm ≈ 1 µm/rev)", adaptive},
+                  {"fixed 2 µm step (dr_max 2 µm clamps every step; before issue 20)", fixed2},
                   {"fixed coarse step (kr 1, dr_max 10 µm: 10 µm/rev)", coarse}};
     s.columns = {col("done", &Outcome::reached),
                  col("radius error µm", &Outcome::wall_err_um, 1),

@@ -118,6 +118,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<double> tdr_us{pins_, "tdr_us", "us"};
   rt::Output<double> finish_final_offset_mm{pins_, "finish_final_offset_mm", "mm"};
   rt::Output<double> finish_start_offset_mm{pins_, "finish_start_offset_mm", "mm"};
+  rt::Output<double> finish_feed_mm_min{pins_, "finish_feed_mm_min", "mm/min"};
   rt::Output<bool> lin_start{pins_, "lin_start"};
   rt::Output<bool> lin_hold{pins_, "lin_hold"};
   rt::Output<bool> lin_load{pins_, "lin_load"};

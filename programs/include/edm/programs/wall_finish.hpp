@@ -8,19 +8,25 @@
 //   td     TdDetector      mean ignition delay from the pulse counters
 //   orbit  OrbitExpander   orbit offset r: r0 = start_offset_mm, grows by clamp(kr·Tdm) per
 //                          revolution up to final_offset_mm (exactly)
+//   arc    CircularInterpolator  the orbit's path (eq. 14–19): full circles of radius R_b (the
+//                          final offset) about the hole centre at the orbit feed fr
 //   px/py  PositionLoop    X/Y position loops: (x_ref, v_ff, x) → v_cmd
-// The circle is computed here (no CircularInterpolator: the radius changes every revolution).
 //
 // Sequence (output `state`):
 //   0 IDLE      generator off, v = 0. A rising edge of `start` latches the hole centre
 //               (x0, y0) = (x_mm, y_mm), start_offset_mm and final_offset_mm → POLARITY.
 //   1 POLARITY  generator off; pol.request_positive = true; when pol reports positive polarity and
 //               no longer switching → ORBIT (orbit child started with r0 = start_offset_mm).
-//   2 ORBIT     generator on (through pol). Reference point:
-//                 x_ref = x0 + ρ·cos θ,  y_ref = y0 + ρ·sin θ,  θ += 2π·dt/orbit_period_s
-//               ρ slews toward the orbit child's radius_mm at ≤ radial_speed_mm_s (the entry
-//               from the centre, and each per-revolution step). One revolution = θ crossing a
-//               multiple of 2π; it pulses orbit.rev_pulse. Td samples are collected only while
+//   2 ORBIT     generator on (through pol). The circular interpolator (arc) runs full circles
+//               of radius R_b = the final offset about the centre at the orbit feed fr (the
+//               feed_mm_min input when > 0, e.g. G160's F, else the parameter); seed 004's
+//               Fig. 1 adds the orbit compensation along the radial direction u = (cos θ, sin θ),
+//               θ = arc.angle_rad:
+//                 x_ref = arc.rx + (ρ − R_b)·cos θ,  y_ref = arc.ry + (ρ − R_b)·sin θ
+//               (= centre + ρ·u). ρ slews toward the orbit child's radius_mm at
+//               ≤ radial_speed_mm_s (the entry from the centre, and each per-revolution step).
+//               One revolution = arc.swept_rad crossing a multiple of 2π; it pulses
+//               orbit.rev_pulse. Td samples are collected only while
 //               ρ has reached the radius. When the orbit child is done (radius = final), the
 //               electrode makes spark_out_revs more revolutions at the final radius → BACK.
 //   3 BACK      generator off, ρ slews to 0; once |(x, y) − (x0, y0)| ≤ centre_tol_mm → DONE.
@@ -32,8 +38,9 @@
 //
 // The children's parameters are set in YAML under this block's params (`orbit: {kr: 1e-4}`,
 // `px: {kv: 20}`, `pol: {settle: 20ms}`, `td: {window: 8}`). This program's defaults for them:
-// orbit.kr = 1e-4 mm/µs, orbit.dr_max_mm = 0.002 mm (calibrated on the simulator's drill preset,
-// config/machines/finish-sim-program.yaml), orbit.samples_per_rev = 0 (revolutions come from the
+// orbit.kr = 1e-4 mm/µs and orbit.dr_max_mm = 0.01 mm (eq. 21 live: Td ≤ the open threshold of
+// 100 µs keeps kr·Tdm under the limit, so the step is kr·Tdm every revolution; before issue 20 a
+// 0.002 mm limit clamped every step), orbit.samples_per_rev = 0 (revolutions come from the
 // orbit phase: another value is refused), pol.initial_positive = false, px/py.v_max_mm_s = 5.
 // Connected by member in bind_self(): td's counters and px/py's positions follow this block's
 // inputs; orbit.td_us/valid ← td; the rest come from this block's outputs below.
@@ -55,6 +62,7 @@
 #include <string>
 #include <vector>
 
+#include "edm/blocks/circular_interpolator.hpp"
 #include "edm/blocks/orbit_expander.hpp"
 #include "edm/blocks/polarity_switch.hpp"
 #include "edm/blocks/position_loop.hpp"
@@ -68,10 +76,10 @@
 namespace edm::programs {
 
 struct WallFinishParams {
-  double orbit_period_s{0.5};      // [s] time of one revolution
-  double radial_speed_mm_s{0.05};  // [mm/s] slew of the reference radius
-  std::int64_t spark_out_revs{4};  // revolutions at the final radius before BACK
-  double centre_tol_mm{0.002};     // [mm] BACK ends within this of the centre
+  double feed_default_mm_min{30.0};  // [mm/min] orbit feed fr along R_b (feed_mm_min input ≤ 0)
+  double radial_speed_mm_s{0.05};    // [mm/s] slew of the reference radius
+  std::int64_t spark_out_revs{4};    // revolutions at the final radius before BACK
+  double centre_tol_mm{0.002};       // [mm] BACK ends within this of the centre
   // ORBIT without a single ignited or shorted pulse for this long (outside spark-out) is a fault:
   // no work, no generator, a wrong offset. 0 s: off.
   rt::Duration no_spark_timeout{std::chrono::seconds(30)};
@@ -95,7 +103,8 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Input<bool> start{pins_, "start"};
   rt::Input<double> start_offset_mm{pins_, "start_offset_mm", "mm"};
   rt::Input<double> final_offset_mm{pins_, "final_offset_mm", "mm"};
-  rt::Input<bool> hold{pins_, "hold"};           // feed hold in the orbit
+  rt::Input<bool> hold{pins_, "hold"};                            // feed hold in the orbit
+  rt::Input<double> feed_mm_min{pins_, "feed_mm_min", "mm/min"};  // > 0: the orbit feed fr
   rt::Output<bool> no_spark{pins_, "no_spark"};  // the no-spark timeout tripped (a fault)
   rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
   rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
@@ -114,6 +123,12 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<bool> rev_pulse{pins_, "rev_pulse"};
   rt::Output<double> orbit_r0_mm{pins_, "orbit_r0_mm", "mm"};
   rt::Output<double> orbit_final_mm{pins_, "orbit_final_mm", "mm"};
+  rt::Output<bool> arc_start{pins_, "arc_start"};
+  rt::Output<bool> arc_load{pins_, "arc_load"};
+  rt::Output<double> arc_load_x_mm{pins_, "arc_load_x_mm", "mm"};
+  rt::Output<double> arc_load_y_mm{pins_, "arc_load_y_mm", "mm"};
+  rt::Output<double> arc_i_mm{pins_, "arc_i_mm", "mm"};
+  rt::Output<double> arc_feed_mm_min{pins_, "arc_feed_mm_min", "mm/min"};
   rt::Output<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
   rt::Output<double> y_ref_mm{pins_, "y_ref_mm", "mm"};
   rt::Output<double> vx_ff_mm_s{pins_, "vx_ff_mm_s", "mm/s"};
@@ -143,6 +158,7 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   blocks::PolaritySwitch& pol_;
   blocks::TdDetector& td_;
   blocks::OrbitExpander& orbit_;
+  blocks::CircularInterpolator& arc_;
   blocks::PositionLoop& px_;
   blocks::PositionLoop& py_;
   blocks::ShortRetract& retract_;
@@ -156,7 +172,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   double x0_{0.0}, y0_{0.0};
   double x_ref_{0.0}, y_ref_{0.0};  // the reference point last given to the loops
   double rho_{0.0};                 // [mm] reference radius
-  double theta_{0.0};               // [rad] in [0, 2π)
+  double theta_{0.0};               // [rad] the arc's polar angle (radial direction)
+  double r_base_{0.0};              // [mm] R_b, the arc's radius
+  std::int64_t arc_turns_{0};       // whole turns the arc has swept
   std::int64_t revs_{0};
   std::int64_t spark_out_left_{0};
   bool spark_out_{false};
