@@ -11,16 +11,12 @@
 
 #include "blocks/block_harness.hpp"
 #include "edm/blocks/fuzzy_mamdani.hpp"
+#include "fuzzy_variables.hpp"
 
 namespace edm::blocks {
 namespace {
 
-fuzzy::Variable variable(const std::string& name, const std::string& text) {
-  fuzzy::SyntaxError err;
-  auto terms = fuzzy::parse_terms(text, err);
-  EXPECT_TRUE(terms.has_value()) << err.message;
-  return {name, terms.value_or(std::vector<fuzzy::Term>{})};
-}
+using test::variable;
 
 TEST(FuzzyServoLUT, default_open_terms_match_the_papers_example) {
   // Paper, Fig. 3: an open count of 23 is 50 % "open", 32 is 100 %.

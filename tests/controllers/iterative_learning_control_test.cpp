@@ -15,6 +15,15 @@
 namespace edm::blocks {
 namespace {
 
+// ‖e − mean(e)‖₂: the repeating error's shape, without its mean.
+double centred_norm(const std::vector<double>& e) {
+  double mean = 0.0;
+  for (double v : e) mean += v / static_cast<double>(e.size());
+  double s = 0.0;
+  for (double v : e) s += (v - mean) * (v - mean);
+  return std::sqrt(s);
+}
+
 // The paper's process: z_j = P·u_j with P first-sample anchored (row i: 1 − Σ_{m<i} p_m on the
 // first column, p_{i−c} on column c ≥ 1), p_m = (1 − b)·b^m (a first-order closed axis loop,
 // p0 = 1 − b); y = kδ·(z − z_p) + b_y + n; the surface is constant over a cycle and recedes by
@@ -163,17 +172,7 @@ TEST(IterativeLearningControl, a_repeating_error_shape_contracts_by_lambda3_per_
   const auto p = params(plant.n, 1.0, plant.k_delta, 0.0, 0.5, 0.5, lambda3);
   const double y_ref = plant.k_delta * 0.05 + plant.b_y;
   const CycleLog r = run(p, plant, -0.05, y_ref, 12);
-  auto shape_norm = [](const std::vector<double>& e) {
-    double mean = 0.0;
-    for (double v : e) {
-      mean += v / static_cast<double>(e.size());
-    }
-    double s = 0.0;
-    for (double v : e) {
-      s += (v - mean) * (v - mean);
-    }
-    return std::sqrt(s);
-  };
+  auto shape_norm = [](const std::vector<double>& e) { return centred_norm(e); };
   ASSERT_GT(shape_norm(r.errors[0]), 0.1);
   for (std::size_t j = 0; j + 1 < r.errors.size(); ++j) {
     EXPECT_NEAR(shape_norm(r.errors[j + 1]) / shape_norm(r.errors[j]), lambda3, 1e-9) << j;
@@ -235,15 +234,7 @@ TEST(IterativeLearningControl,
   const double p0 = plant.impulse[0];
   const double q0 = 0.1;
   auto zero_mean_rms = [](const std::vector<double>& e) {
-    double mean = 0.0;
-    for (double v : e) {
-      mean += v / static_cast<double>(e.size());
-    }
-    double s = 0.0;
-    for (double v : e) {
-      s += (v - mean) * (v - mean);
-    }
-    return std::sqrt(s / static_cast<double>(e.size()));
+    return centred_norm(e) / std::sqrt(static_cast<double>(e.size()));
   };
   const double y_ref = plant.k_delta * 0.05 + plant.b_y;
   // The earlier poles: kδ·l1 = (q0 − λ3)/(q0·p0) = 10.

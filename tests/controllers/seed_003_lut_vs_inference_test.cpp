@@ -27,16 +27,12 @@
 #include "blocks/block_harness.hpp"
 #include "edm/blocks/fuzzy_mamdani.hpp"
 #include "edm/blocks/fuzzy_servo_lut.hpp"
+#include "fuzzy_variables.hpp"
 
 namespace edm::blocks {
 namespace {
 
-fuzzy::Variable variable(const std::string& name, const std::string& text) {
-  fuzzy::SyntaxError err;
-  auto terms = fuzzy::parse_terms(text, err);
-  EXPECT_TRUE(terms.has_value()) << err.message;
-  return {name, terms.value_or(std::vector<fuzzy::Term>{})};
-}
+using test::variable;
 
 fuzzy::MamdaniEngine engine_from(const FuzzyServoLUTParams& p) {
   std::vector<fuzzy::Variable> in{

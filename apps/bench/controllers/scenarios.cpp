@@ -109,6 +109,27 @@ double rab_above_from_start(const Outcome& o, double ref) {
   return m;
 }
 
+// B5's machine: the voltage servo on the sink preset, with a forced jump every 1.5 s.
+RunSpec sink_with_jumps(bool quick) {
+  RunSpec v;
+  v.config = "config/machines/sink-sim.yaml";
+  v.limit_s = quick ? 15.0 : 45.0;
+  v.jump_period_s = 1.5;
+  return v;
+}
+
+// The self-tuning regulator (seed 001) on `v`'s run, its loop watched, paused over each jump.
+RunSpec str_of(const RunSpec& v) {
+  RunSpec str = v;
+  str.config = "config/machines/sink-str-sim.yaml";
+  str.loop_y_var = "adapt.str.y_v";
+  str.loop_ref_var = "adapt.str.y_rv";
+  str.jump_hold_var = "adapt.str.enable";
+  str.jump_hold_value = 0.0;
+  str.jump_hold_extra_ms = 200.0;
+  return str;
+}
+
 }  // namespace
 
 std::vector<Scenario> make_scenarios(bool quick) {
@@ -249,17 +270,8 @@ std::vector<Scenario> make_scenarios(bool quick) {
     s.id = "B5";
     s.title =
         "die sinking 10 × 10 mm, jump every 1.5 s (≈ 1 mm up at 30 mm/s, back to ≈ 0.15 mm above)";
-    RunSpec v;
-    v.config = "config/machines/sink-sim.yaml";
-    v.limit_s = quick ? 15.0 : 45.0;
-    v.jump_period_s = 1.5;
-    RunSpec str = v;
-    str.config = "config/machines/sink-str-sim.yaml";
-    str.loop_y_var = "adapt.str.y_v";
-    str.loop_ref_var = "adapt.str.y_rv";
-    str.jump_hold_var = "adapt.str.enable";
-    str.jump_hold_value = 0.0;
-    str.jump_hold_extra_ms = 200.0;
+    const RunSpec v = sink_with_jumps(quick);
+    const RunSpec str = str_of(v);
     RunSpec ilc = v;
     ilc.config = "config/bench/controllers/sink-ilc.yaml";
     ilc.jump_cycle_var = "gap.ilc.cycle_start";
@@ -295,19 +307,10 @@ std::vector<Scenario> make_scenarios(bool quick) {
     Scenario s;
     s.id = "B5p";
     s.title = "B5 with seeds 001/002 as published (issue 20)";
-    RunSpec v;
-    v.config = "config/machines/sink-sim.yaml";
-    v.limit_s = quick ? 15.0 : 45.0;
-    v.jump_period_s = 1.5;
+    const RunSpec v = sink_with_jumps(quick);
     // sink-str-sim.yaml as shipped: K1 = ti/tp on Us, the two loops computed in turn (the STR
     // task at 25 ms, each loop every 50 ms: the paper's T with d_v = 1), y_rt_good 0.7.
-    RunSpec str = v;
-    str.config = "config/machines/sink-str-sim.yaml";
-    str.loop_y_var = "adapt.str.y_v";
-    str.loop_ref_var = "adapt.str.y_rv";
-    str.jump_hold_var = "adapt.str.enable";
-    str.jump_hold_value = 0.0;
-    str.jump_hold_extra_ms = 200.0;
+    const RunSpec str = str_of(v);
     // The paper's y_rt = 0.9.
     RunSpec paper = str;
     paper.edits = {{"y_rt_good: 0.7", "y_rt_good: 0.9"}};
