@@ -70,6 +70,7 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_status(const edm::hmi::ConnectionSettings& settings);
 int cmd_stats(const edm::hmi::ConnectionSettings& settings);
 int cmd_machine(std::string_view command, const edm::hmi::ConnectionSettings& settings);
+int cmd_override(double percent, const edm::hmi::ConnectionSettings& settings);
 int cmd_watch(const WatchArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_trace(const TraceArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings);

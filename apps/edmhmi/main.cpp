@@ -81,6 +81,11 @@ int run(int argc, char** argv) {
   for (const char* m : {"hold", "resume", "stop", "estop", "reset"}) {
     app.add_subcommand(m, "machine command");
   }
+  double override_pct = 100.0;
+  CLI::App* ov = app.add_subcommand("override", "feed override, 0 to 150 % (operator)");
+  ov->add_option("PERCENT", override_pct, "percent of the programmed feed")
+      ->required()
+      ->check(CLI::Range(0.0, 150.0));
 
   ServeArgs serve;
   CLI::App* s = app.add_subcommand("serve", "the operator's page in a browser (docs/web.md)");
@@ -121,6 +126,7 @@ int run(int argc, char** argv) {
     }
     return cmd_serve(serve, settings);
   }
+  if (command == "override") return cmd_override(override_pct, settings);
   return cmd_machine(command, settings);
 }
 

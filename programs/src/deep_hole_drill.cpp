@@ -132,6 +132,11 @@ void DeepHoleDrill::activate_self() noexcept {
   set_state(State::kIdle);
 }
 
+double DeepHoleDrill::feed_scale() const noexcept {
+  const double ov = feed_override.get();
+  return std::isfinite(ov) ? std::clamp(ov, 0.0, rt::Machine::kMaxFeedOverride) : 0.0;
+}
+
 void DeepHoleDrill::set_state(State s) noexcept {
   state_value_ = s;
   state.set(static_cast<std::int64_t>(s));
@@ -253,7 +258,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       set_state(State::kDrill);
     } else {
       gen_on.set(true);
-      vz_cmd_mm_s.set(-params_.approach_speed_mm_s);
+      vz_cmd_mm_s.set(-params_.approach_speed_mm_s * feed_scale());
     }
   }
 
@@ -279,6 +284,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
         }
       }
       v *= retract_.v_scale.get();
+      v = std::max(v, -gap_.params().v_feed_max_mm_s * feed_scale());  // the override's cap
       vz_servo_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
       status = rt::worst(status, step(wear_, ctx));
       reset_wear.set(false);
@@ -319,7 +325,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     if (z <= breakthrough_z_mm_ - params_.overtravel_mm) {
       begin_retract(touch_z_mm.get() + params_.clearance_mm);
     } else {
-      vz_cmd_mm_s.set(-params_.approach_speed_mm_s);
+      vz_cmd_mm_s.set(-params_.approach_speed_mm_s * feed_scale());
     }
   }
 

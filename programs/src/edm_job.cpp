@@ -93,6 +93,7 @@ void EdmJob::bind_self() {
   lin_.ly_mm.connect(lin_ly_mm);
   lin_.lz_mm.connect(lin_lz_mm);
   lin_.feed_mm_min.connect(lin_feed_mm_min);
+  lin_.feed_override.connect(lin_override);
   arc_.start.connect(arc_start);
   arc_.hold.connect(arc_hold);
   arc_.load.connect(arc_load);
@@ -106,6 +107,9 @@ void EdmJob::bind_self() {
   arc_.ex_mm.connect(arc_ex_mm);
   arc_.ey_mm.connect(arc_ey_mm);
   arc_.feed_mm_min.connect(arc_feed_mm_min);
+  arc_.feed_override.connect(feed_override);
+  drill_.feed_override.connect(feed_override);
+  finish_.feed_override.connect(feed_override);
 
   px_.x_ref_mm.connect(x_ref_mm);
   py_.x_ref_mm.connect(y_ref_mm);
@@ -218,6 +222,9 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
     lin_start.set(false);
   }
   lin_hold.set(hold);
+  // Rapids are never sped beyond their programmed speed (the loops' margin is sized for it).
+  lin_override.set(b.kind == MotionKind::kRapid ? std::min(feed_override.get(), 1.0)
+                                                : feed_override.get());
   status = rt::worst(status, step(lin_, ctx));
   set_reference(lin_.rx_mm.get(), lin_.ry_mm.get(), lin_.rz_mm.get(), lin_.vx_mm_s.get(),
                 lin_.vy_mm_s.get(), lin_.vz_mm_s.get());
@@ -360,6 +367,8 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
 
 rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
+  // The operator's feed override, read once a cycle for every child that moves.
+  feed_override.set(machine_ != nullptr ? machine_->feed_override() : 1.0);
   const double x = x_mm.get(), y = y_mm.get(), z = z_mm.get();
 
   const rt::MachineState ms = ctx.state;

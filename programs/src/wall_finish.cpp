@@ -106,6 +106,7 @@ void WallFinish::bind_self() {
   arc_.full_circle.set_constant(true);
   arc_.turns.set_constant(blocks::CircularInterpolator::kMaxTurns);
   arc_.feed_mm_min.connect(arc_feed_mm_min);
+  arc_.feed_override.follow(feed_override);
   px_.x_ref_mm.connect(x_ref_mm);
   px_.v_ff_mm_s.connect(vx_ff_mm_s);
   px_.x_mm.follow(x_mm);

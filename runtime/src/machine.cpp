@@ -89,6 +89,12 @@ bool Machine::transition(MachineState from, MachineState to, AlarmCode cause) no
   return true;
 }
 
+bool Machine::set_feed_override(double ratio) noexcept {
+  if (!(ratio >= 0.0 && ratio <= kMaxFeedOverride)) return false;  // NaN fails both
+  feed_override_.store(ratio, std::memory_order_relaxed);
+  return true;
+}
+
 CommandResult Machine::command(MachineCommand c, TimePoint now) noexcept {
   // Retry on races with other threads (an RT fault landing between load and CAS).
   for (;;) {

@@ -52,6 +52,35 @@ TEST_F(Bridge, without_tokens_loopback_clients_are_operators_after_hello) {
   EXPECT_TRUE(s.body["vars"].is_object());
 }
 
+// feed.override (issue 21): operator only, 0..150 %, the machine's override changes; a refused
+// value changes nothing.
+TEST_F(Bridge, feed_override_is_an_operator_op_within_0_to_150_percent) {
+  ServerOptions o;
+  o.token_file = dir_.file("op.token");
+  o.viewer_token_file = dir_.file("viewer.token");
+  write_token(o.token_file, "op-secret-0123456789", 0600);
+  write_token(o.viewer_token_file, "viewer-secret-0123456789", 0600);
+  start(o);
+  Client op;
+  ASSERT_EQ(op.connect(client_opts("op-secret-0123456789")), Role::kOperator);
+  const auto r = op.request("feed.override", {{"percent", 75}});
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r.body.value("percent", 0.0), 75.0);
+  EXPECT_DOUBLE_EQ(rt_->machine().feed_override(), 0.75);
+  for (const Json& bad : {Json(150.5), Json(-1), Json("80"), Json(nullptr), Json(1e308)}) {
+    expect_error(op.request("feed.override", {{"percent", bad}}), ErrorCode::kBadRequest);
+  }
+  expect_error(op.request("feed.override"), ErrorCode::kBadRequest);
+  EXPECT_DOUBLE_EQ(rt_->machine().feed_override(), 0.75) << "refused values change nothing";
+  EXPECT_TRUE(op.request("feed.override", {{"percent", 0}}));
+  EXPECT_TRUE(op.request("feed.override", {{"percent", 150}}));
+  EXPECT_DOUBLE_EQ(rt_->machine().feed_override(), 1.5);
+  Client viewer;
+  ASSERT_EQ(viewer.connect(client_opts("viewer-secret-0123456789")), Role::kViewer);
+  expect_error(viewer.request("feed.override", {{"percent", 10}}), ErrorCode::kForbidden);
+  EXPECT_DOUBLE_EQ(rt_->machine().feed_override(), 1.5);
+}
+
 TEST_F(Bridge, every_error_code_is_reachable) {
   ServerOptions o;
   o.token_file = dir_.file("op.token");

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "edm/machining/motion_block.hpp"
@@ -32,10 +33,11 @@ struct JobResult {
 
 // Runs `program` on the machine of config/machines/<machine> (1 ms motion task, 10 ms supervisor)
 // until the job finishes or the machine faults; `on_cycle` sees the variables after every
-// motion cycle.
-template <class OnCycle>
+// motion cycle; `before_start` sees the machine once it is built (e.g. to set the feed override).
+template <class OnCycle, class BeforeStart>
 inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& program,
-                         machining::Vec3 start, const std::string& machine, OnCycle&& on_cycle) {
+                         machining::Vec3 start, const std::string& machine, OnCycle&& on_cycle,
+                         BeforeStart&& before_start) {
   JobResult res;
   rt::BuildOptions opts;
   opts.seed = static_cast<std::uint64_t>(seed);
@@ -48,6 +50,7 @@ inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& pr
   EXPECT_TRUE(issues.empty()) << issues[0].message;
   EXPECT_EQ(r->job().load(program), rt::LoadResult::kOk);
   r->machine().command(rt::MachineCommand::kPowerOn);
+  before_start(*r);
   EXPECT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   const sim::Plant& plant = dynamic_cast<sim::SimDriver&>(r->driver()).plant();
   res.r0_mm = plant.wall_bin_radius_mm(0);
@@ -93,6 +96,13 @@ inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& pr
   }
   EXPECT_EQ(r->machine().state(), rt::MachineState::kReady) << "the job stops the machine";
   return res;
+}
+
+template <class OnCycle>
+inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& program,
+                         machining::Vec3 start, const std::string& machine, OnCycle&& on_cycle) {
+  return run_job(seed, program, start, machine, std::forward<OnCycle>(on_cycle),
+                 [](rt::Runtime&) {});
 }
 
 inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& program,

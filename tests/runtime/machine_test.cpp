@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <map>
 #include <thread>
 
@@ -77,6 +78,20 @@ TEST(Machine, EveryStateCommandPairFollowsTheDocumentedTable) {
         EXPECT_EQ(m.state(), it->second);
       }
     }
+  }
+}
+
+// The feed override (issue 21): 0 … 1.5, anything else (negative, above, NaN) refused unchanged.
+TEST(Machine, FeedOverrideAcceptsZeroToOneAndAHalfOnly) {
+  rt::Machine m;
+  EXPECT_EQ(m.feed_override(), 1.0) << "as programmed by default";
+  EXPECT_TRUE(m.set_feed_override(0.0));
+  EXPECT_EQ(m.feed_override(), 0.0);
+  EXPECT_TRUE(m.set_feed_override(rt::Machine::kMaxFeedOverride));
+  for (const double bad : {-0.01, 1.5000001, std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::infinity()}) {
+    EXPECT_FALSE(m.set_feed_override(bad)) << bad;
+    EXPECT_EQ(m.feed_override(), 1.5) << bad;
   }
 }
 

@@ -478,6 +478,19 @@ Body op_trace_stop(Session& s) {
   return Json::object();
 }
 
+/// feed.override {percent: 0…150}: the machine's feed override (Machine::set_feed_override).
+Body op_feed_override(Session& s, const Json& msg) {
+  const auto it = msg.find("percent");
+  if (it == msg.end() || !it->is_number()) {
+    return error(ErrorCode::kBadRequest, "'percent' must be a number, 0 to 150");
+  }
+  const double pct = it->get<double>();
+  if (!s.server().rt.machine().set_feed_override(pct / 100.0)) {
+    return error(ErrorCode::kBadRequest, "'percent' must be in 0..150, got " + it->dump());
+  }
+  return Json{{"percent", pct}};
+}
+
 Body dispatch(Session& s, const std::string& op, const Json& msg) {
   if (op == "ping") {
     return Json{{"pong", true}};
@@ -537,6 +550,9 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
   }
   if (op == "trace.stop") {
     return op_trace_stop(s);
+  }
+  if (op == "feed.override") {
+    return op_feed_override(s, msg);
   }
   if (op == "machine.info") {
     const rt::Runtime& rt = s.server().rt;

@@ -142,6 +142,9 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<double> tdr_us{pins_, "tdr_us", "us"};  // ≤ 0 (unwired): the gap child's tdr_default_us
   rt::Input<bool> through{pins_, "through"};        // a through hole: detect the breakthrough
   rt::Input<bool> hold{pins_, "hold"};
+  // Feed override 0 … 1.5 (unwired 1): scales the approach and the downward feed cap, never a
+  // retract or backing off.
+  rt::Input<double> feed_override{pins_, "feed_override", "", 1.0};
   rt::Input<double> vz_servo_mm_s{
       pins_, "vz_servo_mm_s", "mm/s"};  // wired: an external gap servo replaces gap's Vz in DRILL
   rt::Output<double> vz_cmd_mm_s{pins_, "vz_cmd_mm_s", "mm/s"};
@@ -173,6 +176,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::BlockStatus update_self(const rt::CycleContext& ctx) noexcept override;
 
  private:
+  /// The feed override input, clamped to [0, 1.5]; not finite: 0 (stop feeding). RT-safe.
+  [[nodiscard]] double feed_scale() const noexcept;
   void set_state(State s) noexcept;
   void begin_cycle() noexcept;
   void begin_retract(double target_z) noexcept;

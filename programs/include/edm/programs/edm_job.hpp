@@ -119,6 +119,10 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<double> finish_final_offset_mm{pins_, "finish_final_offset_mm", "mm"};
   rt::Output<double> finish_start_offset_mm{pins_, "finish_start_offset_mm", "mm"};
   rt::Output<double> finish_feed_mm_min{pins_, "finish_feed_mm_min", "mm/min"};
+  // The operator's feed override (Machine::feed_override): rapids, feeds, the orbit feed and the
+  // drilling feed cap.
+  rt::Output<double> feed_override{pins_, "feed_override", "", 1.0};
+  rt::Output<double> lin_override{pins_, "lin_override", "", 1.0};  // rapids: at most 1
   rt::Output<bool> lin_start{pins_, "lin_start"};
   rt::Output<bool> lin_hold{pins_, "lin_hold"};
   rt::Output<bool> lin_load{pins_, "lin_load"};

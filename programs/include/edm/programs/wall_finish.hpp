@@ -103,8 +103,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Input<bool> start{pins_, "start"};
   rt::Input<double> start_offset_mm{pins_, "start_offset_mm", "mm"};
   rt::Input<double> final_offset_mm{pins_, "final_offset_mm", "mm"};
-  rt::Input<bool> hold{pins_, "hold"};                            // feed hold in the orbit
-  rt::Input<double> feed_mm_min{pins_, "feed_mm_min", "mm/min"};  // > 0: the orbit feed fr
+  rt::Input<bool> hold{pins_, "hold"};                               // feed hold in the orbit
+  rt::Input<double> feed_mm_min{pins_, "feed_mm_min", "mm/min"};     // > 0: the orbit feed fr
+  rt::Input<double> feed_override{pins_, "feed_override", "", 1.0};  // scales fr, 0 … 1.5
   rt::Output<bool> no_spark{pins_, "no_spark"};  // the no-spark timeout tripped (a fault)
   rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
   rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};

@@ -152,6 +152,17 @@ class Machine {
   [[nodiscard]] AlarmCode last_cause() const noexcept {
     return last_cause_.load(std::memory_order_acquire);
   }
+  /// The operator's feed override (issue 21): 0 … kMaxFeedOverride, 1 = as programmed. A job
+  /// sequencer scales its rapids, feeds, orbit feed and the gap-controlled downward feed cap by
+  /// it (never a retract). Any thread; a value outside [0, kMaxFeedOverride] or not finite is
+  /// refused (false) and changes nothing.
+  static constexpr double kMaxFeedOverride = 1.5;
+  bool set_feed_override(double ratio) noexcept;
+  /// RT-safe.
+  [[nodiscard]] double feed_override() const noexcept {
+    return feed_override_.load(std::memory_order_relaxed);
+  }
+
   /// Non-RT consumers (logger, bridge) pop alarms here.
   bool pop_alarm(Alarm& out) noexcept { return alarms_.pop(out); }
   [[nodiscard]] std::uint64_t dropped_alarms() const noexcept {
@@ -180,6 +191,7 @@ class Machine {
   std::array<Latch, kLatchCapacity> latches_{};
   std::atomic<std::uint64_t> repeated_alarms_{0};
   std::atomic<Duration::rep> last_release_ns_{0};
+  std::atomic<double> feed_override_{1.0};
 };
 
 }  // namespace edm::rt
