@@ -37,7 +37,7 @@ inline constexpr std::array<OperatorFunction, 7> kOperatorFunctions{{
     {"offsets", "offset.set"},
     {"mdi", "mdi"},
     {"run_from", "cycle.start_from"},
-    {"override", "override.feed"},
+    {"override", "feed.override"},
 }};
 
 /// The ops of `ops` that the bridge at host:port knows (probe 2 above). Throws std::runtime_error
