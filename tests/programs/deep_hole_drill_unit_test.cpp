@@ -41,6 +41,35 @@ TEST(DeepHoleDrill, IdleUntilARisingStartThenApproachesWithTheGeneratorOn) {
   EXPECT_DOUBLE_EQ(r.vz(), -0.5);
 }
 
+// The operator's feed override (EdmJob wires it): it scales the approach and caps the downward
+// feed of DRILL at override·v_feed_max; backing off is never scaled; not finite: no feed.
+TEST(DeepHoleDrill, FeedOverrideScalesTheApproachAndTheDownwardCapNeverTheBackOff) {
+  Rig r(params());
+  rt::Output<double> ov;
+  ov.set(0.5);
+  r.in<double>("feed_override").connect(ov);
+  r.comp.set(false);
+  r.start.set(true);
+  r.z_mm.set(0.0);
+  r.step();
+  EXPECT_DOUBLE_EQ(r.vz(), -0.5 * 0.5) << "the approach at half speed";
+  r.sparks(20, 100.0);  // a wide gap: the P law asks for its full 1 mm/s down
+  for (int k = 0; k < 4; ++k) r.step();
+  ASSERT_EQ(r.state(), 2);
+  r.step();
+  EXPECT_DOUBLE_EQ(r.vz(), -1.0 * 0.5) << "capped at override x v_feed_max";
+  ov.set(0.0);
+  r.step();
+  EXPECT_DOUBLE_EQ(r.vz(), 0.0) << "0 %: no feed";
+  r.sparks(20, 4.0);  // too small a gap: back off, whatever the override
+  for (int k = 0; k < 10; ++k) r.step();
+  EXPECT_NEAR(r.vz(), +0.05 * 4.0, 1e-9);
+  ov.set(std::numeric_limits<double>::quiet_NaN());
+  r.sparks(20, 100.0);
+  for (int k = 0; k < 10; ++k) r.step();
+  EXPECT_DOUBLE_EQ(r.vz(), 0.0) << "a broken override feeds nothing";
+}
+
 TEST(DeepHoleDrill, TouchNeedsTouchCyclesConsecutiveCyclesWithSparks) {
   Rig r(params());
   r.start.set(true);
