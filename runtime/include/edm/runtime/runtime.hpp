@@ -119,6 +119,7 @@ class Runtime {
 
  private:
   friend class RuntimeBuilder;
+  friend class RetainBuilder;
   Runtime() = default;
   void drain_alarms();
 
