@@ -160,8 +160,9 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
     }
     if (in_flight_ >= kMaxInFlight) return refuse("busy", "too many commands in progress");
     ++in_flight_;
-    const WebHub::Lane lane =
-        kMachineOps.contains(op) || op == "start" ? WebHub::Lane::kMachine : WebHub::Lane::kProgram;
+    const WebHub::Lane lane = kMachineOps.contains(op) || op == "start" || op == "feed.override"
+                                  ? WebHub::Lane::kMachine
+                                  : WebHub::Lane::kProgram;
     const bool queued = hub_.post_work(lane, [weak = weak_from_this(), msg, id, op, &hub = hub_] {
       Json out = run_command(hub, op, msg);
       out["t"] = "reply";
@@ -195,6 +196,11 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
     if (op == "start") return reply_json(hub.job().start());
     if (op == "job") return {{"ok", true}, {"body", hub.job().snapshot()}};
     if (kMachineOps.contains(op)) return reply_json(hub.client().request(op));
+    if (op == "feed.override") {  // edmplc checks the value (0..150) and the role
+      Json params = Json::object();
+      if (msg.contains("percent")) params["percent"] = msg["percent"];
+      return reply_json(hub.client().request(op, params));
+    }
     if (op == "stats") {
       Json r = reply_json(hub.client().request("tasks.stats"));
       const WebHub::Counters c = hub.counters();

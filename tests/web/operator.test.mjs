@@ -47,6 +47,18 @@ test('the operator logs in and sees the machine', async () => {
   await page.locator('#opfun [data-fn="jog"] .na').waitFor({ timeout: T });
 });
 
+test('the operator sets the feed override; edmplc refuses a value above 150 %', async () => {
+  await page.locator('#override-pct').fill('75');
+  await page.locator('#override-set').click();
+  await page.locator('#override-result').filter({ hasText: '75 %' }).waitFor({ timeout: T });
+  await page.locator('#override-pct').fill('200');
+  await page.locator('#override-set').click();
+  await page.locator('#override-result').filter({ hasText: 'refused' }).waitFor({ timeout: T });
+  await page.locator('#override-pct').fill('100');
+  await page.locator('#override-set').click();
+  await page.locator('#override-result').filter({ hasText: '100 %' }).waitFor({ timeout: T });
+});
+
 test('first render on loopback is under 1 s', async () => {
   await page.reload();
   await page.waitForFunction(() => window.edm && window.edm.firstRender !== null, null, { timeout: T });

@@ -51,7 +51,7 @@ const conn = new Connection({
     editor.readOnly = m.role !== 'operator';
     charts.setup(m.series || []);
     if (m.history) charts.push(m.history, true);
-    renderOperatorFunctions(m.caps);
+    renderOperatorFunctions(m.caps, conn, m.role === 'operator');
     ui.alarms = m.alarms || [];
     renderAlarms(ui.alarms, m.role === 'operator');
     vars.isOperator = m.role === 'operator';
