@@ -40,8 +40,8 @@ TEST(FeedOverride, AFeedMoveAtHalfOverrideTakesTwiceAsLong) {
   const double full = job_time_s(MotionKind::kLinear, 1.0);
   const double half = job_time_s(MotionKind::kLinear, 0.5);
   const double fast = job_time_s(MotionKind::kLinear, 1.5);
-  std::printf("[feed_override] a feed move at F120: 100 %% %.3f s, 50 %% %.3f s, 150 %% %.3f s\n", full,
-              half, fast);
+  std::printf("[feed_override] a feed move at F120: 100 %% %.3f s, 50 %% %.3f s, 150 %% %.3f s\n",
+              full, half, fast);
   // The move's time scales as 1/override (the settling into position is a few ms of it).
   EXPECT_NEAR(half / full, 2.0, 0.01);
   EXPECT_NEAR(fast / full, 1.0 / 1.5, 0.01);

@@ -118,6 +118,22 @@ RunSpec sink_with_jumps(bool quick) {
   return v;
 }
 
+// The columns of B5 and B5p: removal, the pulse classes, z-jitter and the STR's loop.
+std::vector<Column> sink_columns(int stable_arc_precision) {
+  return {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
+          col("spark %", &Outcome::ratio_normal_pct, 1),
+          col("transient arc %", &Outcome::ratio_tarc_pct),
+          col("stable arc %", &Outcome::ratio_sarc_pct, stable_arc_precision),
+          col("short %", &Outcome::ratio_short_pct),
+          col("open %", &Outcome::ratio_open_pct, 1),
+          col("z-jitter µm (mean/cycle)", &Outcome::jitter_um),
+          col("first 3 cycles µm", &Outcome::jitter_first_um),
+          col("last 3 cycles µm", &Outcome::jitter_last_um),
+          col("y_v (STR)", &Outcome::loop_y_mean, 3),
+          col("y_rv (STR)", &Outcome::loop_ref_mean, 3),
+          col("y_v − y_rv RMS", &Outcome::loop_err_rms, 3)};
+}
+
 // The self-tuning regulator (seed 001) on `v`'s run, its loop watched, paused over each jump.
 RunSpec str_of(const RunSpec& v) {
   RunSpec str = v;
@@ -285,18 +301,7 @@ std::vector<Scenario> make_scenarios(bool quick) {
                   {"self-tuning regulator (seed 001)", str},
                   {"iterative learning control (seed 002)", ilc},
                   {"ILC learning from the voltage servo's first 2 cycles", warm}};
-    s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
-                 col("spark %", &Outcome::ratio_normal_pct, 1),
-                 col("transient arc %", &Outcome::ratio_tarc_pct),
-                 col("stable arc %", &Outcome::ratio_sarc_pct),
-                 col("short %", &Outcome::ratio_short_pct),
-                 col("open %", &Outcome::ratio_open_pct, 1),
-                 col("z-jitter µm (mean/cycle)", &Outcome::jitter_um),
-                 col("first 3 cycles µm", &Outcome::jitter_first_um),
-                 col("last 3 cycles µm", &Outcome::jitter_last_um),
-                 col("y_v (STR)", &Outcome::loop_y_mean, 3),
-                 col("y_rv (STR)", &Outcome::loop_ref_mean, 3),
-                 col("y_v − y_rv RMS", &Outcome::loop_err_rms, 3)};
+    s.columns = sink_columns(2);
     s.plot_column = 0;
     s.plot_jitter = true;
     out.push_back(std::move(s));
@@ -359,18 +364,7 @@ std::vector<Scenario> make_scenarios(bool quick) {
         {"ILC before issue 20 (p0 0.05, kδ 3000 by trial)", ilc_before},
         {"ILC learning from the voltage servo, as shipped (λ3 0.0997)", warm},
         {"ILC learning from the voltage servo, before issue 20", warm_before}};
-    s.columns = {col("MRR mm³/min", &Outcome::mrr_mm3_min, 1),
-                 col("spark %", &Outcome::ratio_normal_pct, 1),
-                 col("transient arc %", &Outcome::ratio_tarc_pct),
-                 col("stable arc %", &Outcome::ratio_sarc_pct, 3),
-                 col("short %", &Outcome::ratio_short_pct),
-                 col("open %", &Outcome::ratio_open_pct, 1),
-                 col("z-jitter µm (mean/cycle)", &Outcome::jitter_um),
-                 col("first 3 cycles µm", &Outcome::jitter_first_um),
-                 col("last 3 cycles µm", &Outcome::jitter_last_um),
-                 col("y_v (STR)", &Outcome::loop_y_mean, 3),
-                 col("y_rv (STR)", &Outcome::loop_ref_mean, 3),
-                 col("y_v − y_rv RMS", &Outcome::loop_err_rms, 3)};
+    s.columns = sink_columns(3);
     s.plot_column = 0;
     s.plot_jitter = true;
     out.push_back(std::move(s));
