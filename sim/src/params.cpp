@@ -232,6 +232,75 @@ void SimParams::visit(rt::ParamVisitor& outer) {
            .description = "tube/block: a hole this deep is already there under the electrode; the "
                           "tip starts start_gap_um above its bottom",
            .range = rt::kNonNegative});
+  v.param("work_surface_z_mm", work_surface_z_mm,
+          {.unit = "mm", .description = "machine Z of the work's top surface"});
+  v.param("work_origin_x_mm", work_origin_x_mm,
+          {.unit = "mm", .description = "machine X of the work's datum"});
+  v.param("work_origin_y_mm", work_origin_y_mm,
+          {.unit = "mm", .description = "machine Y of the work's datum"});
+  v.param("work_x_min_mm", work_x_min_mm,
+          {.unit = "mm", .description = "work block: lowest X, relative to the datum"});
+  v.param("work_x_max_mm", work_x_max_mm,
+          {.unit = "mm", .description = "work block: highest X, relative to the datum (> min)"});
+  v.param("work_y_min_mm", work_y_min_mm,
+          {.unit = "mm", .description = "work block: lowest Y, relative to the datum"});
+  v.param("work_y_max_mm", work_y_max_mm,
+          {.unit = "mm", .description = "work block: highest Y, relative to the datum (> min)"});
+  v.param("work_bore_x_mm", work_bore_x_mm,
+          {.unit = "mm", .description = "through bore: centre X relative to the datum"});
+  v.param("work_bore_y_mm", work_bore_y_mm,
+          {.unit = "mm", .description = "through bore: centre Y relative to the datum"});
+  v.param("work_bore_d_mm", work_bore_d_mm,
+          {.unit = "mm",
+           .description = "through bore diameter, inside the block (0: none)",
+           .range = rt::kNonNegative});
+  v.param("start_x_mm", start_x_mm,
+          {.unit = "mm", .description = "machine X of the electrode at power-on"});
+  v.param("start_y_mm", start_y_mm,
+          {.unit = "mm", .description = "machine Y of the electrode at power-on"});
+  v.param("ref_x_mm", ref_x_mm,
+          {.unit = "mm", .description = "X reference switch: on at or beyond this machine X"});
+  v.param("ref_y_mm", ref_y_mm,
+          {.unit = "mm", .description = "Y reference switch: on at or beyond this machine Y"});
+  v.param("ref_z_mm", ref_z_mm,
+          {.unit = "mm", .description = "Z reference switch: on at or beyond this machine Z"});
+  v.param("ref_repeat_um", ref_repeat_um,
+          {.unit = "um",
+           .description = "reference switches: SD of the trip point, drawn anew per trip",
+           .range = rt::kNonNegative});
+  v.param("ref_hysteresis_um", ref_hysteresis_um,
+          {.unit = "um",
+           .description = "reference switches: release this far below the trip point",
+           .range = rt::kNonNegative});
+  v.param("encoder_offset_x_mm", encoder_offset_x_mm,
+          {.unit = "mm", .description = "X encoder reads machine X - this at power-on"});
+  v.param("encoder_offset_y_mm", encoder_offset_y_mm,
+          {.unit = "mm", .description = "Y encoder reads machine Y - this at power-on"});
+  v.param("encoder_offset_z_mm", encoder_offset_z_mm,
+          {.unit = "mm", .description = "Z encoder reads machine Z - this at power-on"});
+  v.param("touch_gap_um", touch_gap_um,
+          {.unit = "um",
+           .description = "touch mode: contact within this distance of the work's material",
+           .range = rt::kNonNegative});
+  v.param("touch_noise_um", touch_noise_um,
+          {.unit = "um",
+           .description = "touch mode: SD of that distance, drawn anew per contact",
+           .range = rt::kNonNegative});
+  v.param("touch_voltage_v", touch_voltage_v,
+          {.unit = "V",
+           .description = "touch mode: gap voltage while open (0 V in contact)",
+           .range = rt::kNonNegative});
+  // Outside LoadTimeOnly: a retain store restores the hole through these (docs/simulator.md §5a).
+  outer.param("hole_depth_mm", hole_depth_mm,
+              {.unit = "mm",
+               .description = "the hole in the work: reads its live depth, a write sets it",
+               .range = rt::kNonNegative});
+  outer.param("hole_x_mm", hole_x_mm,
+              {.unit = "mm",
+               .description = "the hole's axis, machine X: reads the live one, a write sets it"});
+  outer.param("hole_y_mm", hole_y_mm,
+              {.unit = "mm",
+               .description = "the hole's axis, machine Y: reads the live one, a write sets it"});
   v.param("debris_kappa", debris_kappa,
           {.unit = "1", .description = "kappa: c += kappa V / V_gap", .range = rt::kNonNegative});
   v.param(
@@ -397,6 +466,24 @@ std::vector<rt::ParamError> SimParams::cross_field_errors() const {
   if (wire_break_rab_shape != std::floor(wire_break_rab_shape)) {
     e.push_back({"wire_break_rab_shape",
                  "must be a whole number (got " + std::to_string(wire_break_rab_shape) + ")"});
+  }
+  if (!(work_x_min_mm < work_x_max_mm)) {
+    e.push_back({"work_x_max_mm", "must be > work_x_min_mm (got " + std::to_string(work_x_max_mm) +
+                                      " <= " + std::to_string(work_x_min_mm) + ")"});
+  }
+  if (!(work_y_min_mm < work_y_max_mm)) {
+    e.push_back({"work_y_max_mm", "must be > work_y_min_mm (got " + std::to_string(work_y_max_mm) +
+                                      " <= " + std::to_string(work_y_min_mm) + ")"});
+  }
+  if (work_bore_d_mm > 0.0) {  // the bore must leave a wall on every side
+    const double r = work_bore_d_mm / 2.0;
+    if (!(work_bore_x_mm - r > work_x_min_mm && work_bore_x_mm + r < work_x_max_mm &&
+          work_bore_y_mm - r > work_y_min_mm && work_bore_y_mm + r < work_y_max_mm)) {
+      e.push_back({"work_bore_d_mm", "the bore (centre " + std::to_string(work_bore_x_mm) + ", " +
+                                         std::to_string(work_bore_y_mm) + ", diameter " +
+                                         std::to_string(work_bore_d_mm) +
+                                         ") must lie inside the work block"});
+    }
   }
   if (removal_mm3_per_j == 0.0 && crater_ref_um3 == 0.0) {
     e.push_back({"removal_mm3_per_j", "removal_mm3_per_j or crater_ref_um3 must be > 0"});

@@ -69,6 +69,10 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
   AxisLimits z = xy;
   z.v_pos_max_mm_s = p.v_jump_mm_s;
   axes_ = {Axis(xy), Axis(xy), Axis(z)};
+  axes_[0].reset(p.start_x_mm);
+  axes_[1].reset(p.start_y_mm);
+  hole_cx_mm_ = p.start_x_mm;
+  hole_cy_mm_ = p.start_y_mm;
   if (tool_ != Tool::kWire && p.initial_depth_mm > 0.0) {
     hole_bottom_mm_ = -p.initial_depth_mm;
     hole_started_ = true;
@@ -83,17 +87,23 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
       to_ns(p.wire_break_current_ms * 1e3), p.wire_break_rab, to_ns(p.wire_break_rab_ms * 1e3),
       p.wire_break_rab_width, to_ns(p.wire_break_rab_tau_ms * 1e3),
       wire_break_threshold(seed_, static_cast<int>(p.wire_break_rab_shape)));
+  init_work();
   publish();
 }
 
 bool Plant::generator_enabled() const noexcept {
-  return cmd_.generator_armed && cmd_.generator_on && !state_.wire_broken;
+  return cmd_.generator_armed && cmd_.generator_on && !cmd_.touch_mode && !state_.wire_broken;
 }
 
 void Plant::set_commands(const PlantCommands& c) noexcept {
   const bool was = generator_enabled();
+  const bool was_touch = cmd_.touch_mode;
   cmd_ = c;
   const std::int64_t now = state_.now.count();
+  if (c.touch_mode != was_touch) {
+    account(now);
+    set_touch_mode(c.touch_mode);
+  }
   if (!was && generator_enabled() && phase_ == Phase::kIdle && !paused_) start_pulse(now);
   if (was && !generator_enabled()) set_idle(now);
 }
@@ -116,7 +126,7 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
   axes_[1].step(cmd_.vy_mm_s, dt);
   track_hole();
   if (hold_) {
-    axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
+    axes_[2].reset(hold_gap_um_ * 1e-3 + bottom_mm() - wear_length_mm_);
   } else {
     double vz = cmd_.vz_mm_s;
     if (cmd_.servo_ref_v > 0.0) {  // the machine's own servo: advance while U_av > reference
@@ -125,6 +135,8 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
     axes_[2].step(vz, dt);
   }
   track_short_events();
+  update_ref_switches();
+  if (cmd_.touch_mode) update_touch();
   const double z = axes_[2].position_mm();
   const double gap = front_gap_um(z);
   const double h_flush = tool_ == Tool::kWire ? 0.0 : depth_mm();
@@ -152,7 +164,7 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
 void Plant::set_idle(std::int64_t t_ns) noexcept {
   account(t_ns);
   phase_ = Phase::kIdle;
-  phase_voltage_v_ = 0.0;
+  phase_voltage_v_ = idle_voltage_v();
   phase_end_ns_ = kNever;
 }
 
@@ -220,7 +232,7 @@ void Plant::start_pulse(std::int64_t t_ns) noexcept {
   double median = model_.td_median_us(gap_front, c);
   int site = -1;
   // The wall competes only where there is one: with the tip below the work surface.
-  if (tool_ == Tool::kTube && p.wall_sparks && tool_z_mm(t_ns) + wear_length_mm_ < 0.0) {
+  if (tool_ == Tool::kTube && p.wall_sparks && !away_ && tool_z_mm(t_ns) + wear_length_mm_ < 0.0) {
     const double kw = p.weibull_k;
     std::array<double, kWallBins> w{};
     const double w_front = std::isfinite(median) ? area_front_mm2_ * std::pow(median, -kw) : 0.0;
@@ -361,7 +373,7 @@ void Plant::enter_safe_state() noexcept {
 void Plant::hold_gap(double gap_um) noexcept {
   hold_ = true;
   hold_gap_um_ = gap_um;
-  axes_[2].reset(gap_um * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
+  axes_[2].reset(gap_um * 1e-3 + bottom_mm() - wear_length_mm_);
   publish();
 }
 
@@ -370,7 +382,8 @@ void Plant::release_gap() noexcept { hold_ = false; }
 void Plant::set_depth_mm(double h) noexcept {
   hole_bottom_mm_ = -h;
   hole_started_ = hole_started_ || h > 0.0;
-  if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
+  away_ = false;  // the hole under the electrode
+  if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + bottom_mm() - wear_length_mm_);
   publish();
 }
 
@@ -381,20 +394,25 @@ void Plant::set_debris(double c) noexcept {
 
 void Plant::set_electrode_length_mm(double mm) noexcept {
   wear_length_mm_ = params_.electrode_length_mm - mm;
-  if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + hole_bottom_mm_ - wear_length_mm_);
+  if (hold_) axes_[2].reset(hold_gap_um_ * 1e-3 + bottom_mm() - wear_length_mm_);
   publish();
 }
 
 void Plant::publish() noexcept {
   const double q = params_.encoder_um * 1e-3;
   auto quantise = [q](double x) { return q > 0.0 ? std::round(x / q) * q : x; };
-  state_.x_mm = quantise(axes_[0].position_mm());
-  state_.y_mm = quantise(axes_[1].position_mm());
-  state_.z_mm = quantise(axes_[2].position_mm());
+  // bias 0 (the defaults) leaves a position's bits as they are, −0 included
+  state_.x_mm = quantise(axes_[0].position_mm() - enc_bias_mm_[0]);
+  state_.y_mm = quantise(axes_[1].position_mm() - enc_bias_mm_[1]);
+  state_.z_mm = quantise(axes_[2].position_mm() - enc_bias_mm_[2]);
+  state_.machine_x_mm = axes_[0].position_mm();
+  state_.machine_y_mm = axes_[1].position_mm();
+  state_.machine_z_mm = axes_[2].position_mm() + params_.work_surface_z_mm;
   state_.vz_mm_s = axes_[2].velocity_mm_s();
   state_.depth_mm = depth_mm();
+  // Away from its hole the electrode is over a fresh one (the bins as a new hole would have them).
   double r = 0.0;
-  for (double w : wall_r_mm_) r += w;
+  for (double w : wall_r_mm_) r += away_ ? params_.hole_d_mm / 2.0 : w;
   state_.wall_radius_mm = r / static_cast<double>(kWallBins);
   state_.gap_um = front_gap_um(axes_[2].position_mm());
   state_.electrode_length_mm = params_.electrode_length_mm - wear_length_mm_;
@@ -403,6 +421,15 @@ void Plant::publish() noexcept {
   state_.rab = rab_.rab(state_.now.count());
   state_.contact =
       contact_ == Contact::kMet && (tip_z_mm() - contact_tip_mm_) * 1e3 < params_.contact_clear_um;
+  state_.ref_x = ref_on_[0];
+  state_.ref_y = ref_on_[1];
+  state_.ref_z = ref_on_[2];
+  state_.touch_contact = cmd_.touch_mode && touch_contact_;
+  state_.hole_depth_mm = -hole_bottom_mm_;
+  state_.hole_x_mm = hole_cx_mm_;
+  state_.hole_y_mm = hole_cy_mm_;
+  state_.hole_work_x_mm = hole_cx_mm_ - params_.work_origin_x_mm;
+  state_.hole_work_y_mm = hole_cy_mm_ - params_.work_origin_y_mm;
 }
 
 }  // namespace edm::sim

@@ -20,7 +20,9 @@ double Plant::tool_z_mm(std::int64_t t_ns) const noexcept {
          axes_[2].velocity_mm_s() * static_cast<double>(t_ns - axis_time_ns_) * 1e-9;
 }
 
-double Plant::depth_mm() const noexcept { return -hole_bottom_mm_; }
+double Plant::depth_mm() const noexcept { return away_ ? 0.0 : -hole_bottom_mm_; }
+
+double Plant::bottom_mm() const noexcept { return away_ ? 0.0 : hole_bottom_mm_; }
 
 double Plant::front_gap_um(double z_mm) const noexcept {
   if (tool_ != Tool::kWire) {
@@ -30,7 +32,7 @@ double Plant::front_gap_um(double z_mm) const noexcept {
     }
   }
   if (hold_) return hold_gap_um_;
-  return (z_mm + wear_length_mm_ - hole_bottom_mm_) * 1e3;
+  return (z_mm + wear_length_mm_ - bottom_mm()) * 1e3;
 }
 
 double Plant::wall_gap_um(std::size_t j) const noexcept {
@@ -103,6 +105,7 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
     }
     hole_bottom_mm_ = -s;
   } else {
+    if (away_) start_fresh_hole();  // the first crater away from the kept hole: a new one
     hole_started_ = true;
     if (site < 0) {
       hole_bottom_mm_ -= volume_mm3 / area_front_mm2_;
@@ -118,21 +121,26 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
 }
 
 void Plant::track_hole() noexcept {
-  if (tool_ != Tool::kTube) return;
+  if (tool_ == Tool::kWire) return;
   const double x = axes_[0].position_mm(), y = axes_[1].position_mm();
   if (!hole_started_) {  // nothing eroded yet
     hole_cx_mm_ = x;
     hole_cy_mm_ = y;
     return;
   }
+  if (tool_ != Tool::kTube) return;  // a sinking electrode stays over its cavity
+  // Above the surface the electrode may leave the hole, and come back to it, sideways.
   const double tip_z = axes_[2].position_mm() + wear_length_mm_;
-  if (tip_z > 0.0 && std::hypot(x - hole_cx_mm_, y - hole_cy_mm_) > params_.hole_d_mm) {
-    hole_bottom_mm_ = 0.0;
-    wall_r_mm_.fill(params_.hole_d_mm / 2.0);
-    hole_started_ = false;
-    hole_cx_mm_ = x;
-    hole_cy_mm_ = y;
-  }
+  if (tip_z > 0.0) away_ = std::hypot(x - hole_cx_mm_, y - hole_cy_mm_) > params_.hole_d_mm;
+}
+
+void Plant::start_fresh_hole() noexcept {
+  hole_bottom_mm_ = 0.0;
+  wall_r_mm_.fill(params_.hole_d_mm / 2.0);
+  hole_started_ = false;
+  away_ = false;
+  hole_cx_mm_ = axes_[0].position_mm();
+  hole_cy_mm_ = axes_[1].position_mm();
 }
 
 }  // namespace edm::sim

@@ -6,6 +6,12 @@ namespace edm::sim {
 
 namespace rt = edm::rt;
 
+namespace {
+// The runtime-writable parameters, in the order of SimDriver::Live.
+constexpr std::string_view kLiveNames[] = {"electrode_length_mm", "hole_depth_mm", "hole_x_mm",
+                                           "hole_y_mm"};
+}  // namespace
+
 void SimDriverParams::visit(rt::ParamVisitor& v) {
   v.param("preset", preset,
           {.unit = "",
@@ -42,30 +48,64 @@ std::vector<rt::ParamError> SimDriver::configure(const rt::BlockSetup& setup) {
   }
   plant_ = std::make_unique<Plant>(params_.plant, static_cast<std::uint64_t>(params_.seed));
   started_ = false;
-  electrode_left_mm_.store(plant_->state().electrode_length_mm, std::memory_order_relaxed);
-  // The index the registry uses for io.electrode_length_mm (visit order of SimDriverParams).
+  for (bool& b : pos_set_before_) b = false;
+  // The indices the registry uses for the live parameters (visit order of SimDriverParams).
   struct Find final : rt::ParamVisitor {
-    std::size_t n = 0, at = 0;
+    std::size_t n = 0;
+    std::size_t at[kLiveCount]{};
     void on_param(std::string_view name, rt::ParamRef, rt::ParamSpec) override {
-      if (name == "electrode_length_mm") at = n;
+      for (std::size_t k = 0; k < kLiveCount; ++k) {
+        if (name == kLiveNames[k]) at[k] = n;
+      }
       ++n;
     }
   } find;
   SimDriverParams copy = params_;
   copy.visit(find);
-  electrode_param_index_ = find.at;
+  for (std::size_t k = 0; k < kLiveCount; ++k) {
+    live_index_[k] = find.at[k];
+  }
+  publish_live();
   return {};
+}
+
+void SimDriver::publish_live() noexcept {
+  const PlantState& st = plant_->state();
+  const double v[kLiveCount] = {st.electrode_length_mm, st.hole_depth_mm, st.hole_x_mm,
+                                st.hole_y_mm};
+  for (std::size_t k = 0; k < kLiveCount; ++k) {
+    live_[k].store(v[k], std::memory_order_relaxed);
+  }
+}
+
+void SimDriver::apply_param(std::size_t index, const rt::ParamValue& v) noexcept {
+  changed_param_ = index;
+  BlockWithParams::apply_param(index, v);
 }
 
 void SimDriver::params_changed() noexcept {
   if (!plant_) return;
-  plant_->set_electrode_length_mm(params_.plant.electrode_length_mm);
-  electrode_left_mm_.store(plant_->state().electrode_length_mm, std::memory_order_relaxed);
+  const SimParams& p = params_.plant;
+  const PlantState& st = plant_->state();
+  // One figure at a time, the others as the plant has them now: a retain store restores the
+  // three one after the other, and the live hole may have moved since the config was read.
+  if (changed_param_ == live_index_[kElectrode]) {
+    plant_->set_electrode_length_mm(p.electrode_length_mm);
+  } else if (changed_param_ == live_index_[kHoleDepth]) {
+    plant_->set_hole_mm(st.hole_x_mm, st.hole_y_mm, p.hole_depth_mm);
+  } else if (changed_param_ == live_index_[kHoleX]) {
+    plant_->set_hole_mm(p.hole_x_mm, st.hole_y_mm, st.hole_depth_mm);
+  } else if (changed_param_ == live_index_[kHoleY]) {
+    plant_->set_hole_mm(st.hole_x_mm, p.hole_y_mm, st.hole_depth_mm);
+  }
+  publish_live();
 }
 
 rt::ParamValue SimDriver::read_param(std::size_t index) const {
-  if (plant_ && index == electrode_param_index_) {
-    return rt::ParamValue::of_real(electrode_left_mm_.load(std::memory_order_relaxed));
+  for (std::size_t k = 0; plant_ && k < kLiveCount; ++k) {
+    if (index == live_index_[k]) {
+      return rt::ParamValue::of_real(live_[k].load(std::memory_order_relaxed));
+    }
   }
   return BlockWithParams::read_param(index);
 }
@@ -124,6 +164,12 @@ void SimDriver::visit_pins(rt::PinVisitor& v) {
   for (const StateOutput& o : kTruthOutputs) {
     v.output(o.name, this->*o.pin, o.unit);
   }
+  v.output("ref_x", ref_[0]);
+  v.output("ref_y", ref_[1]);
+  v.output("ref_z", ref_[2]);
+  v.output("contact", contact_);
+  v.output("hole_work_x_mm", hole_work_x_mm_, "mm");
+  v.output("hole_work_y_mm", hole_work_y_mm_, "mm");
 
   v.input("vx_cmd", vx_cmd_, "mm/s");
   v.input("vy_cmd", vy_cmd_, "mm/s");
@@ -138,6 +184,13 @@ void SimDriver::visit_pins(rt::PinVisitor& v) {
   v.input("flushing_on", flushing_on_);
   v.input("flushing_strength", flushing_strength_, "1");
   v.input("rotation_on", rotation_on_);
+  v.input("touch_mode", touch_mode_);
+  v.input("pos_set_x", pos_set_[0]);
+  v.input("pos_set_y", pos_set_[1]);
+  v.input("pos_set_z", pos_set_[2]);
+  v.input("pos_value_x_mm", pos_value_mm_[0], "mm");
+  v.input("pos_value_y_mm", pos_value_mm_[1], "mm");
+  v.input("pos_value_z_mm", pos_value_mm_[2], "mm");
 }
 
 void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
@@ -170,12 +223,18 @@ void SimDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
   for (const StateOutput& o : kAxisOutputs) {
     (this->*o.pin).set(st.*o.field);
   }
-  electrode_left_mm_.store(st.electrode_length_mm, std::memory_order_relaxed);
+  publish_live();
   wire_broken_.set(st.wire_broken);
   driver_fault_.set(st.wire_broken);
   for (const StateOutput& o : kTruthOutputs) {
     (this->*o.pin).set(st.*o.field);
   }
+  ref_[0].set(st.ref_x);
+  ref_[1].set(st.ref_y);
+  ref_[2].set(st.ref_z);
+  contact_.set(st.touch_contact);
+  hole_work_x_mm_.set(st.hole_work_x_mm);
+  hole_work_y_mm_.set(st.hole_work_y_mm);
 }
 
 void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {
@@ -195,7 +254,13 @@ void SimDriver::write_outputs(const rt::CycleContext& ctx) noexcept {
   c.flushing_on = flushing_on_.get();
   c.flushing_strength = flushing_strength_.get();
   c.rotation_on = rotation_on_.get();
+  c.touch_mode = touch_mode_.get();
   plant_->set_commands(c);
+  for (int a = 0; a < 3; ++a) {  // a drive's "set actual position", on the rising edge
+    const bool set = pos_set_[a].get();
+    if (set && !pos_set_before_[a]) plant_->set_encoder_mm(a, pos_value_mm_[a].get());
+    pos_set_before_[a] = set;
+  }
 }
 
 void SimDriver::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {

@@ -72,6 +72,8 @@ TEST(SimDriver, BadParametersAreLocatedErrors) {
       {"{preset: drill, peak_curent_a: 10}", "unknown parameter 'peak_curent_a'"},
       {"{preset: drill, peak_current_a: -5}", "peak_current_a"},
       {"{preset: drill, seed: -1}", "seed must be >= 0"},
+      {"{preset: drill, work_x_min_mm: 10, work_x_max_mm: 5}", "work_x_max_mm"},
+      {"{preset: drill, work_bore_d_mm: 30, work_bore_x_mm: 40}", "must lie inside the work"},
   };
   for (const BadSim& b : cases) {
     const std::string path = dir.file("bad.yaml");

@@ -89,7 +89,7 @@ TEST(SimElectrodeRetain, the_length_left_is_read_back_and_a_write_restores_it_in
   EXPECT_LT(r->variables().read("io.electrode_length_mm").value(), worn_mm);
 }
 
-TEST(SimElectrodeRetain, only_the_electrode_length_is_writable_at_run_time) {
+TEST(SimElectrodeRetain, the_electrode_length_is_writable_at_run_time_and_load_time_ones_are_not) {
   edm::test::TempDir dir("edm-sim-retain");
   auto r = build(dir.file("retain.dat"));
   EXPECT_TRUE(r->variables().write("io.electrode_length_mm", 42.0, /*apply_now=*/true));

@@ -84,8 +84,8 @@ TEST(SimParams, validate_names_the_bad_fields) {
 }
 
 // The plant resolves its parameters once: every one is load time only, but the electrode length
-// a retain store restores at start (docs/simulator.md §5a).
-TEST(SimParams, every_field_but_the_electrode_length_is_load_time_only) {
+// and the hole a retain store restores at start (docs/simulator.md §5a).
+TEST(SimParams, every_field_but_the_electrode_length_and_the_hole_is_load_time_only) {
   struct Check final : edm::rt::ParamVisitor {
     std::vector<std::string> runtime_writable;
     void on_param(std::string_view name, edm::rt::ParamRef, edm::rt::ParamSpec spec) override {
@@ -94,7 +94,9 @@ TEST(SimParams, every_field_but_the_electrode_length_is_load_time_only) {
   } check;
   SimParams p;
   p.visit(check);
-  EXPECT_EQ(check.runtime_writable, std::vector<std::string>{"electrode_length_mm"});
+  EXPECT_EQ(check.runtime_writable,
+            (std::vector<std::string>{"electrode_length_mm", "hole_depth_mm", "hole_x_mm",
+                                      "hole_y_mm"}));
 }
 
 TEST(SimParams, wire_break_shape_must_be_a_whole_number_in_range) {

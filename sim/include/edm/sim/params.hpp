@@ -18,7 +18,7 @@ namespace edm::sim {
 
 /// Version of the parameter set (names, meanings, defaults). Logged with every run (§6.6);
 /// bump it when a name, a unit, a default or the meaning of a parameter changes.
-inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/7";
+inline constexpr std::string_view kSimParamsVersion = "edm-sim-params/8";
 
 struct SimParams {
   // --- Generator (§1, §6.5) ---
@@ -120,6 +120,46 @@ struct SimParams {
   double work_thickness_mm{0.0};  // tube/block: through at this depth; 0 = blind (no limit)
   double start_gap_um{100.0};     // tip above the work surface at start
   double initial_depth_mm{0.0};   // a hole already there (tip start_gap_um above its bottom)
+
+  // --- The work on the machine, the machine's axes and its operator functions
+  //     (docs/simulator.md §3a; edm-sim-params/8). The defaults are the plant before them. ---
+  // Where the work is, in machine coordinates; the part program does not know it.
+  double work_surface_z_mm{0.0};  // machine Z of the work's top surface
+  double work_origin_x_mm{0.0};   // machine XY of the work's datum
+  double work_origin_y_mm{0.0};
+  double work_x_min_mm{-50.0};  // the work block's extent relative to its datum (min < max)
+  double work_x_max_mm{50.0};
+  double work_y_min_mm{-50.0};
+  double work_y_max_mm{50.0};
+  double work_bore_x_mm{0.0};  // a through bore, centre relative to the datum ...
+  double work_bore_y_mm{0.0};
+  double work_bore_d_mm{0.0};  // ... of this diameter (0: none); inside the block
+  double start_x_mm{0.0};      // machine XY of the electrode at power-on
+  double start_y_mm{0.0};
+  // Reference (home) cam switches, machine coordinates: on while the axis is at or beyond the
+  // trip point in +. Each trip point is drawn anew ~ N(ref, ref_repeat_um) for every trip; a
+  // switch releases ref_hysteresis_um below the point it tripped at.
+  double ref_x_mm{90.0};
+  double ref_y_mm{90.0};
+  double ref_z_mm{15.0};
+  double ref_repeat_um{0.5};
+  double ref_hysteresis_um{20.0};
+  // Incremental encoders: at power-on an axis reads machine − offset (0: absolute encoders).
+  double encoder_offset_x_mm{0.0};
+  double encoder_offset_y_mm{0.0};
+  double encoder_offset_z_mm{0.0};
+  // Touch mode: contact when the electrode is within a threshold of the work's material, the
+  // threshold ~ N(touch_gap_um, touch_noise_um) drawn anew for every contact event; the gap
+  // reads touch_voltage_v while open, 0 V in contact.
+  double touch_gap_um{1.0};
+  double touch_noise_um{0.3};
+  double touch_voltage_v{10.0};
+  // The hole in the work (runtime-writable, for a retain store, like electrode_length_mm): read,
+  // the live depth of the current hole below the surface and its axis in machine XY; a write sets
+  // the hole already in the work (depth > 0: drilling at that XY continues it).
+  double hole_depth_mm{0.0};
+  double hole_x_mm{0.0};
+  double hole_y_mm{0.0};
 
   // --- Debris and flushing (§6.2 step 7) ---
   double debris_kappa{0.75};        // κ: c += κ V / V_gap; calibrated [bk], see simulator.md

@@ -15,6 +15,7 @@
 #include "edm/sim/gap_model.hpp"
 #include "edm/sim/monitors.hpp"
 #include "edm/sim/params.hpp"
+#include "edm/sim/work_geometry.hpp"
 
 namespace edm::sim {
 
@@ -38,6 +39,9 @@ struct PlantCommands {
   bool flushing_on{true};
   double flushing_strength{1.0};  // 0..1, multiplies the scenario's flushing factor F
   bool rotation_on{false};
+  // The generator's touch mode: no discharges whatever generator_on says, a low sensing voltage
+  // across the gap, and contact sensing (PlantState::touch_contact).
+  bool touch_mode{false};
 };
 
 /// Sensor values accumulated since the last take_sensors() (one PLC cycle), FPGA-style.
@@ -52,7 +56,11 @@ struct CycleSensors {
 /// The plant's state as the sensors and the trace see it.
 struct PlantState {
   edm::rt::TimePoint now{};
-  double x_mm{0.0}, y_mm{0.0}, z_mm{0.0};  // axis positions (encoder, quantised)
+  // Encoder readings (quantised): machine position − encoder offset, or what a set_encoder_mm()
+  // made them read. With the default parameters they are the machine coordinates.
+  double x_mm{0.0}, y_mm{0.0}, z_mm{0.0};
+  // True machine coordinates (not quantised; the work's surface is at work_surface_z_mm).
+  double machine_x_mm{0.0}, machine_y_mm{0.0}, machine_z_mm{0.0};
   double vz_mm_s{0.0};
   double gap_um{0.0};               // front gap
   double debris{0.0};               // c in [0, 1]
@@ -78,6 +86,12 @@ struct PlantState {
   bool contact{false};                  // the injected contact holds the gap short now
   std::uint64_t bridges{0};             // debris bridges formed so far
   std::uint64_t vibration_contacts{0};  // lateral tube contacts so far
+  // The work and the operator functions (docs/simulator.md §3a):
+  bool ref_x{false}, ref_y{false}, ref_z{false};  // reference switches
+  bool touch_contact{false};  // touch mode and the electrode within the touch gap of material
+  double hole_depth_mm{0.0};  // the hole in the work (kept while the electrode is elsewhere)
+  double hole_x_mm{0.0}, hole_y_mm{0.0};            // its axis, machine XY
+  double hole_work_x_mm{0.0}, hole_work_y_mm{0.0};  // its axis, relative to the work's datum
 };
 
 class Plant {
@@ -108,6 +122,14 @@ class Plant {
   /// change): the wear becomes electrode_length_mm − mm, so the tip sits that much above where a
   /// new electrode's would. RT-safe.
   void set_electrode_length_mm(double mm) noexcept;
+  /// A drive's "set actual position": axis 0, 1, 2 (x, y, z) reads `reading_mm` from now on;
+  /// the machine does not move. RT-safe.
+  void set_encoder_mm(int axis, double reading_mm) noexcept;
+  /// The hole already in the work (a retained hole restored at start): its axis at machine XY
+  /// (x_mm, y_mm), depth_mm below the surface; depth 0 = none yet (the next hole begins wherever
+  /// the electrode erodes first). Tube and block; for the wire, depth_mm is the cut length.
+  /// RT-safe.
+  void set_hole_mm(double x_mm, double y_mm, double depth_mm) noexcept;
 
   /// Tube hole wall: radius of bin j (angle 2πj/kWallBins from +x) at the tip, mm.
   static constexpr std::size_t kWallBins = 64;
@@ -120,7 +142,8 @@ class Plant {
   [[nodiscard]] bool generator_enabled() const noexcept;
   [[nodiscard]] double tool_z_mm(std::int64_t t_ns) const noexcept;  // axis z extrapolated
   [[nodiscard]] double front_gap_um(double z_mm) const noexcept;
-  [[nodiscard]] double depth_mm() const noexcept;
+  [[nodiscard]] double depth_mm() const noexcept;  // of the hole under the electrode
+  [[nodiscard]] double bottom_mm() const noexcept;  // z of what is under the electrode
   [[nodiscard]] double wall_gap_um(std::size_t j) const noexcept;
   [[nodiscard]] double gap_volume_mm3(double gap_um) const noexcept;
   [[nodiscard]] double flush_effective() const noexcept;
@@ -150,6 +173,17 @@ class Plant {
   void update_wire(std::int64_t t_ns) noexcept;
   void set_idle(std::int64_t t_ns) noexcept;
   void publish() noexcept;
+  // The work and the operator functions (plant_work.cpp).
+  void init_work() noexcept;
+  void update_ref_switches() noexcept;
+  void update_touch() noexcept;
+  void set_touch_mode(bool on) noexcept;
+  [[nodiscard]] double touch_distance_um() const noexcept;
+  [[nodiscard]] double touch_threshold_um(std::uint64_t event) const noexcept;
+  [[nodiscard]] double touch_release_um() const noexcept;
+  [[nodiscard]] double idle_voltage_v() const noexcept;  // the gap's voltage with no pulse
+  [[nodiscard]] double mean_wall_radius_mm() const noexcept;
+  void start_fresh_hole() noexcept;
 
   SimParams params_;
   PlantState state_;
@@ -171,6 +205,9 @@ class Plant {
   // front, so a hole is drilled where the program puts the electrode; see track_hole().
   double hole_cx_mm_{0.0}, hole_cy_mm_{0.0};
   bool hole_started_{false};  // material removed since the hole began
+  // Tube: the electrode has left the hole (tip above the surface, more than a hole diameter
+  // away): the surface is under it, the hole is kept until material is removed elsewhere.
+  bool away_{false};
   ThicknessProfile profile_{};
 
   // Axes.
@@ -201,6 +238,19 @@ class Plant {
   enum class Contact : std::uint8_t { kArmed, kMet, kCleared, kOff };
   Contact contact_{Contact::kOff};
   double contact_tip_mm_{0.0};  // tip z where the injected contact was met
+
+  // The work on the machine (plant_work.cpp). Axis positions are machine X, Y and the plant's z
+  // (surface at 0); machine Z = z + work_surface_z_mm. An encoder reads position − bias.
+  std::array<double, 3> enc_bias_mm_{};
+  std::array<double, 3> ref_pos_mm_{};   // nominal switch positions, axis frame
+  std::array<double, 3> ref_trip_mm_{};  // where each switch trips next (or tripped)
+  std::array<bool, 3> ref_on_{};
+  std::array<std::uint64_t, 3> ref_trips_{};
+  Section tool_section_{};  // the electrode's cross-section (centre set when used)
+  WorkSolid work_{};        // block and bore (the hole is filled in when used)
+  bool touch_contact_{false};
+  std::uint64_t touch_events_{0};  // contacts ended so far: keys the next threshold
+  double touch_threshold_now_um_{0.0};
 
   // Sensors and WEDM.
   RabWindow rab_{};

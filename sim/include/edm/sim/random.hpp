@@ -25,6 +25,8 @@ enum class Stream : std::uint64_t {
   kShortEvent = 8,       // a short event (debris bridge, tube contact) starts at this pulse
   kShortEventKind = 9,   // which of the competing events it is
   kShortEventLife = 10,  // how long it lasts
+  kRefSwitch = 11,       // reference switch trip points (normal, index 3 trip + axis)
+  kTouch = 12,           // touch-sensing threshold (normal, index: contact event)
 };
 
 inline constexpr std::uint64_t kGolden = 0x9E3779B97F4A7C15ULL;
