@@ -145,6 +145,8 @@ void DeepHoleDrill::set_state(State s) noexcept {
 void DeepHoleDrill::begin_cycle() noexcept {
   const double d = depth_mm.get();
   target_depth_mm_ = d > 0.0 ? d : params_.depth_default_mm;
+  const double done_mm = depth_done_mm.get();
+  depth_done_mm_ = std::isfinite(done_mm) && done_mm > 0.0 ? done_mm : 0.0;
   spark_cycles_ = 0;
   dark_cycles_ = 0;
   safe_retract_ = false;
@@ -296,7 +298,8 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     // the front's travel by the working gap and shallower by the first-spark gap,
     //   depth = (touch_z − z) − wear_mm − spark_gap_offset_um·1e-3   (first-spark − working gap).
     const double wear_now = comp ? wear_.wear_mm.get() : 0.0;
-    const double depth = (touch_z_mm.get() - z) - wear_now - params_.spark_gap_offset_um * 1e-3;
+    const double depth = depth_done_mm_ + (touch_z_mm.get() - z) - wear_now -
+                         params_.spark_gap_offset_um * 1e-3;
     depth_reached_mm.set(depth);
     wear_mm.set(wear_now);
     dark_cycles_ = pulses.td_count.get() > 0 ? 0 : dark_cycles_ + 1;

@@ -41,11 +41,13 @@ EdmJob::EdmJob()
       arc_(add_child<blocks::CircularInterpolator>("arc")),
       px_(add_child<blocks::PositionLoop>("px")),
       py_(add_child<blocks::PositionLoop>("py")),
-      pz_(add_child<blocks::PositionLoop>("pz")) {}
+      pz_(add_child<blocks::PositionLoop>("pz")),
+      manual_(add_child<ManualMotion>("manual")) {}
 
 std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) {
   std::vector<rt::ParamError> errs;
   machine_ = setup.machine;
+  manual_control_ = setup.manual;
   job_ = setup.job;
   if (job_ != nullptr) job_->attach_runner();
   tables_ = setup.tables;
@@ -71,6 +73,11 @@ void EdmJob::bind_self() {
   drill_.z_mm.follow(z_mm);
   drill_.start.connect(drill_start);
   drill_.depth_mm.connect(drill_depth_mm);
+  drill_.depth_done_mm.connect(drill_depth_done_mm);
+  manual_.enable.connect(manual_enable);
+  manual_.x_mm.follow(x_mm);
+  manual_.y_mm.follow(y_mm);
+  manual_.z_mm.follow(z_mm);
   drill_.wear_ratio.connect(wear_ratio);
   drill_.area_ratio.connect(area_ratio);
   drill_.tdr_us.connect(tdr_us);
@@ -173,7 +180,7 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
 
 void EdmJob::select_condition(int e) noexcept {
   condition_ = e > 0 ? tables_->condition(e) : nullptr;
-  gen_arm.set(condition_ != nullptr);
+  gen_arm.set(condition_ != nullptr && !dry_run.get());  // a dry run never arms the generator
   if (condition_ == nullptr) return;
   on_time_us.set(condition_->on_time_us);
   off_time_us.set(condition_->off_time_us);
@@ -280,7 +287,8 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     drill_return_.col = b.col;
     drill_return_.target = {x_mm.get(), y_mm.get(), z_mm.get()};
     figures_.begin_drill_block();
-    drill_depth_mm.set(-b.target.z);
+    drill_depth_mm.set(b.depth_mm > 0.0 ? b.depth_mm : -b.target.z);
+    drill_depth_done_mm.set(b.depth_done_mm);
     drill_start.set(true);
     step_ = Step::kBusy;
     return false;
@@ -356,9 +364,9 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     case MotionKind::kArcCcw:
       return run_arc(b, ctx, hold, status);
     case MotionKind::kDrill:
-      return run_drill(b, ctx, hold, status);
+      return dry_run.get() || run_drill(b, ctx, hold, status);  // a dry run skips it
     case MotionKind::kOrbitFinish:
-      return run_finish(b, hold);
+      return dry_run.get() || run_finish(b, hold);
     case MotionKind::kEnd:
       return true;
   }
@@ -382,7 +390,13 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
       hold_z_ = z;
       hold_valid_ = !rt::is_safe_state(ms);
     }
-    if (ms == rt::MachineState::kRunning && job_->rt_begin()) {
+    const bool may_run = manual_control_ == nullptr || manual_control_->may_run_programs();
+    if (ms == rt::MachineState::kRunning && (!may_run || manual_.active.get())) {
+      // Not referenced (or still moving by hand): no job; back to READY (the bridge refuses
+      // such a start first, this is the runtime's own guard).
+      machine_->command(rt::MachineCommand::kStop, ctx.release);
+    } else if (ms == rt::MachineState::kRunning && job_->rt_begin()) {
+      dry_run.set(job_->current_options().dry_run);
       state_value_ = State::kRun;
       state.set(1);
       figures_.begin(ctx.release);
@@ -424,6 +438,10 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   }
 
   // The children that run every cycle (they idle when not started).
+  manual_enable.set(ms == rt::MachineState::kReady && state_value_ == State::kIdle);
+  status = rt::worst(status, step(manual_, ctx));
+  const bool manual = manual_.active.get();
+  if (manual) hold_valid_ = false;  // after it the loops hold where the axes are
   status = rt::worst(status, step(drill_, ctx));
   status = rt::worst(status, step(finish_, ctx));
   status = rt::worst(status, step(px_, ctx));
@@ -437,9 +455,15 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   const std::int64_t fs = finish_.state.get();
   const bool finishing = fs != static_cast<std::int64_t>(WallFinish::State::kIdle) &&
                          fs != static_cast<std::int64_t>(WallFinish::State::kDone);
-  vx_cmd_mm_s.set(finishing ? finish_.vx_cmd_mm_s.get() : px_.v_cmd_mm_s.get());
-  vy_cmd_mm_s.set(finishing ? finish_.vy_cmd_mm_s.get() : py_.v_cmd_mm_s.get());
-  vz_cmd_mm_s.set(drilling ? drill_.vz_cmd_mm_s.get() : pz_.v_cmd_mm_s.get());
+  vx_cmd_mm_s.set(manual      ? manual_.vx_cmd_mm_s.get()
+                  : finishing ? finish_.vx_cmd_mm_s.get()
+                              : px_.v_cmd_mm_s.get());
+  vy_cmd_mm_s.set(manual      ? manual_.vy_cmd_mm_s.get()
+                  : finishing ? finish_.vy_cmd_mm_s.get()
+                              : py_.v_cmd_mm_s.get());
+  vz_cmd_mm_s.set(manual     ? manual_.vz_cmd_mm_s.get()
+                  : drilling ? drill_.vz_cmd_mm_s.get()
+                             : pz_.v_cmd_mm_s.get());
   if (drilling) hold_z_ = z;
   gen_on.set(gen_arm.get() && (drill_.gen_on.get() || finish_.gen_on.get()));
   polarity_positive.set(finishing ? finish_.polarity_positive.get() : polarity_positive_value_);

@@ -178,7 +178,7 @@ class RuntimeBuilder {
       const PinEntry* e = resolve("", n.name, n.loc, false);
       return e != nullptr ? e->ref : PinRef{};
     };
-    rt_->supervisor_ = build_supervisor(spec, rt_->tables_, rt_->machine_,
+    rt_->supervisor_ = build_supervisor(spec, rt_->tables_, rt_->machine_, &rt_->manual_,
                                         io_task_->spec().interval, pin_of, diag_);
     if (rt_->supervisor_) {
       io_task_->attach_supervisor(*rt_->supervisor_);
@@ -186,7 +186,7 @@ class RuntimeBuilder {
   }
 
   BlockSetup setup(std::string_view instance, Duration period) {
-    return BlockSetup{instance, period, &rt_->machine_, &rt_->job_, &rt_->tables_};
+    return BlockSetup{instance, period, &rt_->machine_, &rt_->job_, &rt_->tables_, &rt_->manual_};
   }
 
   void make_programs() {

@@ -34,9 +34,12 @@ Supervisor::Supervisor(Machine& machine, SupervisorSetup setup, Duration period)
       electrode_margin_mm_(setup.electrode_margin_mm),
       wire_broken_(setup.wire_broken),
       generator_(std::move(setup.generator)),
+      manual_(setup.manual),
       dt_s_(to_seconds(period)) {
   for (std::size_t k = 0; k < axes_.size(); ++k) {
     axes_[k].cfg = setup.axes[k];
+    const char n = setup.axes[k].limits.name;
+    axes_[k].ref_bit = n == 'X' ? 0 : n == 'Y' ? 1 : n == 'Z' ? 2 : -1;
     axes_[k].source = std::string("safety.") + setup.axes[k].limits.name;
     axes_[k].speed_source = axes_[k].source + ".v_max";
   }
@@ -67,7 +70,12 @@ void Supervisor::check_machine(TimePoint now) noexcept {
   }
 }
 
-bool Supervisor::is_outside(const Axis& a, double x) noexcept {
+bool Supervisor::referenced(const Axis& a) const noexcept {
+  return manual_ == nullptr || a.ref_bit < 0 || (manual_->referenced() >> a.ref_bit & 1U) != 0;
+}
+
+bool Supervisor::is_outside(const Axis& a, double x) const noexcept {
+  if (!referenced(a)) return false;  // its coordinates are the power-on ones: no range yet
   // The command stops at the limit; the mechanics may overshoot it by their dynamic error,
   // which the following-error band at standstill (min_ferror_mm) allows for.
   const double tol = std::max(kEpsilon, a.cfg.min_ferror_mm);
@@ -122,7 +130,9 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
 
   // A command the axis could not stop from inside the range is cut to one it can.
   const double d = v > 0.0 ? lim.max_mm - x : x - lim.min_mm;
-  const double allowed = std::isfinite(x) ? stop_speed(d, lim.a_max_mm_s2, dt_s_) : 0.0;
+  const double allowed = !std::isfinite(x)   ? 0.0
+                         : !referenced(a)   ? lim.v_max_mm_s
+                                            : stop_speed(d, lim.a_max_mm_s2, dt_s_);
   const bool refused = std::abs(v) > allowed + kEpsilon;
   if (refused) {
     v = v > 0.0 ? allowed : -allowed;
@@ -145,7 +155,14 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
 
 void Supervisor::supervise(const CycleContext& ctx) noexcept {
   const MachineState before = machine_.state();
-  const bool track = before != MachineState::kOff && !is_safe_state(before);
+  bool track = before != MachineState::kOff && !is_safe_state(before);
+  if (manual_ != nullptr) {
+    const std::uint64_t epoch = manual_->position_epoch();
+    if (epoch != epoch_seen_) {  // an encoder was set: the readings jumped, restart the models
+      epoch_seen_ = epoch;
+      for (Axis& a : axes_) a.tracking = false;
+    }
+  }
   check_machine(ctx.release);
   for (Axis& a : axes_) {
     check_axis(a, ctx.release, track);

@@ -32,7 +32,8 @@ void* typed_pin(const PinRef& p, PinDir dir, const NameRef& n, const char* role,
 
 std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
                                              const machining::MachineTables& tables,
-                                             Machine& machine, Duration io_period,
+                                             Machine& machine, const ManualControl* manual,
+                                             Duration io_period,
                                              const IoPinResolver& resolve, DiagnosticSink& diag) {
   if (!spec.present) {
     return nullptr;
@@ -73,6 +74,7 @@ std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
   if (diag.diagnostics().size() != errors_before) {
     return nullptr;
   }
+  setup.manual = manual;
   return std::make_unique<Supervisor>(machine, std::move(setup), io_period);
 }
 

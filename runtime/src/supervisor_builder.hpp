@@ -21,7 +21,8 @@ using IoPinResolver = std::function<PinRef(const NameRef&)>;
 /// nullptr when the config has no `machine.safety` or a problem was reported to `diag`.
 std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
                                              const machining::MachineTables& tables,
-                                             Machine& machine, Duration io_period,
+                                             Machine& machine, const ManualControl* manual,
+                                             Duration io_period,
                                              const IoPinResolver& resolve, DiagnosticSink& diag);
 
 }  // namespace edm::rt

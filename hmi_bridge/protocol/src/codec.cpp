@@ -88,6 +88,8 @@ Json to_json(const MotionBlock& b) {
   put_unless_default(j, "feed_mm_s", b.feed_mm_s, d.feed_mm_s);
   put_unless_default(j, "condition", b.condition, d.condition);
   put_unless_default(j, "z_travel_mm", b.z_travel_mm, d.z_travel_mm);
+  put_unless_default(j, "depth_mm", b.depth_mm, d.depth_mm);
+  put_unless_default(j, "depth_done_mm", b.depth_done_mm, d.depth_done_mm);
   put_unless_default(j, "final_radius_mm", b.final_radius_mm, d.final_radius_mm);
   put_unless_default(j, "dwell_s", b.dwell_s, d.dwell_s);
   put_unless_default(j, "on", b.on, d.on);
@@ -123,6 +125,10 @@ bool from_json(const Json& j, MotionBlock& out, std::string& error) {
       ok = int32_value(v, b.condition);
     } else if (key == "z_travel_mm") {
       ok = finite_number(v, b.z_travel_mm);
+    } else if (key == "depth_mm") {
+      ok = finite_number(v, b.depth_mm) && b.depth_mm >= 0.0;
+    } else if (key == "depth_done_mm") {
+      ok = finite_number(v, b.depth_done_mm) && b.depth_done_mm >= 0.0;
     } else if (key == "final_radius_mm") {
       ok = finite_number(v, b.final_radius_mm);
     } else if (key == "dwell_s") {
@@ -168,6 +174,8 @@ void Crc32::update(const MotionBlock& b) noexcept {
   put_le(p, b.feed_mm_s);
   put_le(p, b.condition);
   put_le(p, b.z_travel_mm);
+  put_le(p, b.depth_mm);
+  put_le(p, b.depth_done_mm);
   put_le(p, b.final_radius_mm);
   put_le(p, b.dwell_s);
   *p++ = b.on ? 1 : 0;
@@ -364,17 +372,22 @@ Json to_json(const StatusMessage& s) {
   for (const auto& [name, value] : s.vars) {
     vars[name] = std::isfinite(value) ? Json(value) : Json(nullptr);
   }
-  return {{"state", s.state},
-          {"cause", s.cause},
-          {"t_s", s.t_s},
-          {"cycle", s.cycle},
-          {"job",
-           {{"outcome", s.job_outcome},
-            {"generation", s.job_generation},
-            {"block", s.job_block},
-            {"blocks", s.job_blocks},
-            {"line", s.job_line}}},
-          {"vars", std::move(vars)},
+  Json job = {{"outcome", s.job_outcome},
+              {"generation", s.job_generation},
+              {"block", s.job_block},
+              {"blocks", s.job_blocks},
+              {"line", s.job_line}};
+  if (s.job_last) {
+    Json last = {{"outcome", s.job_last->outcome},
+                 {"block", s.job_last->block},
+                 {"line", s.job_last->line}};
+    if (s.job_last->depth_mm && std::isfinite(*s.job_last->depth_mm)) {
+      last["depth_mm"] = *s.job_last->depth_mm;
+    }
+    job["last"] = std::move(last);
+  }
+  return {{"state", s.state}, {"cause", s.cause},          {"t_s", s.t_s},
+          {"cycle", s.cycle}, {"job", std::move(job)},     {"vars", std::move(vars)},
           {"dropped", s.dropped}};
 }
 
@@ -391,6 +404,16 @@ bool from_json(const Json& j, StatusMessage& out, std::string& error) {
     s.job_block = job.at("block").get<std::uint64_t>();
     s.job_blocks = job.at("blocks").get<std::uint64_t>();
     s.job_line = job.at("line").get<std::int32_t>();
+    if (auto it = job.find("last"); it != job.end() && it->is_object()) {
+      LastJob l;
+      l.outcome = it->at("outcome").get<std::string>();
+      l.block = it->at("block").get<std::uint64_t>();
+      l.line = it->at("line").get<std::int32_t>();
+      if (auto d = it->find("depth_mm"); d != it->end() && d->is_number()) {
+        l.depth_mm = d->get<double>();
+      }
+      s.job_last = std::move(l);
+    }
     for (const auto& [name, v] : j.at("vars").items()) {
       s.vars.emplace_back(
           name, v.is_number() ? v.get<double>() : std::numeric_limits<double>::quiet_NaN());

@@ -12,7 +12,7 @@ constexpr std::array<std::string_view, kErrorCodeCount> kErrorNames = {
     "bad_json",      "bad_request", "unknown_op", "unauthorized", "forbidden",
     "invalid_state", "not_found",   "too_large",  "busy"};
 
-constexpr std::array<OpInfo, 25> kOps = {{
+constexpr std::array<OpInfo, 32> kOps = {{
     {"hello", false},        {"ping", false},          {"status", false},
     {"subscribe", false},    {"unsubscribe", false},   {"program.begin", true},
     {"program.chunk", true}, {"program.commit", true}, {"program.abort", true},
@@ -21,7 +21,9 @@ constexpr std::array<OpInfo, 25> kOps = {{
     {"var.list", false},     {"var.read", false},      {"var.write", true},
     {"var.force", true},     {"var.unforce", true},    {"tasks.stats", false},
     {"trace.start", false},  {"trace.stop", false},    {"machine.info", false},
-    {"feed.override", true},
+    {"feed.override", true}, {"home", true},           {"jog", true},
+    {"jog.stop", true},      {"touch", true},          {"manual.status", false},
+    {"offset.get", false},   {"offset.set", true},
 }};
 
 }  // namespace

@@ -11,6 +11,8 @@
 #include "edm/bridge/machine_info.hpp"
 #include "edm/machining/program_check.hpp"
 #include "edm/runtime/stats_json.hpp"
+#include "ops_body.hpp"
+#include "ops_operator.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge {
@@ -19,36 +21,11 @@ namespace {
 
 constexpr std::size_t kMaxIssuesReported = 100;
 
-struct Error {
-  ErrorCode code;
-  std::string message;
-  Json details{nullptr};
-};
-
-using Body = std::variant<Json, Error>;
-
-Body error(ErrorCode code, std::string message, Json details = nullptr) {
-  return Error{code, std::move(message), std::move(details)};
-}
-
-/// A client-supplied name quoted in a message: at most 64 characters, never the client's JSON.
-std::string brief_name(std::string_view name) {
-  constexpr std::size_t kMax = 64;
-  std::string q = "'";
-  q.append(name.substr(0, kMax));
-  q += name.size() > kMax ? "…'" : "'";
-  return q;
-}
-
-/// A required field of type T, or an error naming it.
-template <class Pred>
-const Json* field(const Json& msg, const char* key, Pred ok) {
-  auto it = msg.find(key);
-  if (it == msg.end() || !ok(*it)) {
-    return nullptr;
-  }
-  return &*it;
-}
+using ops::Body;
+using ops::brief_name;
+using ops::error;
+using ops::Error;
+using ops::field;
 
 ErrorCode var_error(rt::VarResult r) {
   switch (r) {
@@ -188,6 +165,7 @@ Body op_program_begin(Session& s, const Json& msg) {
   }
   static std::uint64_t next_upload = 1;
   Upload u;
+  if (auto e = ops::read_upload_options(msg, u.slot, u.offsets_generation)) return *e;
   u.id = next_upload++;
   u.expected = n->get<std::size_t>();
   u.blocks.reserve(u.expected);
@@ -283,15 +261,23 @@ Body op_program_commit(Session& s, const Json& msg) {
                  Json{{"issues", std::move(list)}, {"count", issues.size()}});
   }
   const std::size_t n = u.blocks.size();
-  if (rt.job().load(std::move(u.blocks), got) != rt::LoadResult::kOk) {
+  const rt::JobSlot slot = u.slot;
+  const std::optional<std::uint64_t> offsets = u.offsets_generation;
+  const rt::LoadResult loaded = slot == rt::JobSlot::kMdi
+                                    ? rt.job().load_mdi(std::move(u.blocks))
+                                    : rt.job().load(std::move(u.blocks), got);
+  if (loaded != rt::LoadResult::kOk) {
     s.upload_.reset();
     return error(ErrorCode::kBusy, "a job became active; program not swapped");
   }
   s.upload_.reset();
+  srv.committed_offsets[static_cast<std::size_t>(slot)] = offsets;
   srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
-  spdlog::info("bridge: session {} committed a program of {} blocks (crc32 {})", s.id(), n,
+  spdlog::info("bridge: session {} committed {} of {} blocks (crc32 {})", s.id(),
+               slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n,
                format_checksum(got));
   return Json{{"blocks", n},
+              {"slot", slot == rt::JobSlot::kMdi ? "mdi" : "main"},
               {"checksum", format_checksum(got)},
               {"generation", rt.job().progress().generation}};
 }
@@ -299,11 +285,7 @@ Body op_program_commit(Session& s, const Json& msg) {
 Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
   auto& m = s.server().rt.machine();
   const rt::MachineState before = m.state();
-  const rt::JobStore& job = s.server().rt.job();
-  if (c == rt::MachineCommand::kStart && job.has_runner() && job.loaded_blocks() == 0) {
-    // A machine that runs part programs would only stand in RUNNING doing nothing.
-    return error(ErrorCode::kInvalidState, "cycle.start: no part program loaded (program.commit)");
-  }
+  // cycle.start's own checks (program loaded, referenced, offsets): ops::prepare_start().
   if (m.command(c) != rt::CommandResult::kOk) {
     return error(ErrorCode::kInvalidState,
                  std::string(op) + " is not allowed in " + std::string(to_string(before)));
@@ -524,8 +506,14 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
       {"cycle.stop", C::kStop},   {"estop", C::kEstop},     {"reset", C::kReset}};
   for (const auto& [name, c] : kCommands) {
     if (op == name) {
+      if (c == C::kStart) {
+        if (auto e = ops::prepare_start(s, msg)) return *e;
+      }
       return op_machine(s, c, op);
     }
+  }
+  if (auto body = ops::dispatch_operator(s, op, msg)) {
+    return *body;
   }
   if (op == "var.list") {
     return op_var_list(s, msg);
@@ -555,8 +543,13 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
     return op_feed_override(s, msg);
   }
   if (op == "machine.info") {
-    const rt::Runtime& rt = s.server().rt;
-    return to_json(rt.tables(), rt.config().machine.name);
+    rt::Runtime& rt = s.server().rt;
+    Json info = to_json(rt.tables(), rt.config().machine.name);
+    Json ops_list = Json::array();
+    for (const OpInfo& o : all_ops()) ops_list.push_back(std::string(o.name));
+    info["ops"] = std::move(ops_list);
+    info["manual"] = ops::manual_info_json(rt.manual().info());
+    return info;
   }
   return error(ErrorCode::kUnknownOp, "unknown op " + brief_name(op));
 }

@@ -490,7 +490,23 @@ StatusMessage Server::Impl::status_message() {
   m.job_block = p.block_index;
   m.job_blocks = p.block_count;
   m.job_line = p.line;
+  m.job_last = last_job();
   return m;
+}
+
+std::optional<LastJob> Server::Impl::last_job() {
+  const rt::JobProgress p = rt.job().progress();
+  const auto& interrupted = rt.interrupted_job();
+  if (interrupted && p.jobs_started == 0) {
+    return LastJob{"interrupted", static_cast<std::uint64_t>(interrupted->block_index),
+                   static_cast<std::int32_t>(interrupted->line), interrupted->depth_mm};
+  }
+  if (p.outcome != rt::JobOutcome::kAborted || p.slot != rt::JobSlot::kMain) return std::nullopt;
+  LastJob l{"aborted", p.block_index, p.line, std::nullopt};
+  if (const auto& d = rt.config().retain.job_depth) {
+    l.depth_mm = rt.variables().read(d->name);
+  }
+  return l;
 }
 
 Server::Server(rt::Runtime& runtime, ServerOptions options)

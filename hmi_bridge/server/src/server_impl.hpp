@@ -97,9 +97,14 @@ struct Server::Impl {
   void retrace();
   /// Fills a status message (from the board when it has published, else directly).
   StatusMessage status_message();
+  /// status's job.last: the interrupted job (until one begins) or the last, aborted one.
+  std::optional<LastJob> last_job();
   [[nodiscard]] ServerStats stats_snapshot() const noexcept;
 
   rt::Runtime& rt;
+  /// Per job slot (main, MDI): the work-offset generation the committed program was interpreted
+  /// with (program.begin's offsets_generation), checked again at cycle.start.
+  std::array<std::optional<std::uint64_t>, 2> committed_offsets;
   ServerOptions opt;
   TokenSet tokens;
   std::shared_ptr<asio::ssl::context> tls;  // null: plain TCP
@@ -141,6 +146,8 @@ struct Server::Impl {
 struct Upload {
   std::uint64_t id{0};
   std::size_t expected{0};
+  rt::JobSlot slot{rt::JobSlot::kMain};  // program.begin's "slot": the part program or MDI
+  std::optional<std::uint64_t> offsets_generation;  // the work offsets it was interpreted with
   std::vector<machining::MotionBlock> blocks;
   Crc32 crc;
 };

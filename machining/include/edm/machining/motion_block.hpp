@@ -54,6 +54,11 @@ struct MotionBlock {
   double feed_mm_s{0.0};        // linear / arc / drill speed cap; 0 = machine default
   std::int32_t condition{0};    // kCondition: E number (0 = disarm); other kinds: active E
   double z_travel_mm{0.0};      // kDrill: Z travel to send after wear pre-compensation (> 0)
+  double depth_mm{0.0};         // kDrill: programmed depth below the work's Z0 (the active work
+                                // offset's surface); 0 = a machine-coordinate program whose Z0 is
+                                // machine Z 0 (depth = −target.z)
+  double depth_done_mm{0.0};    // kDrill: depth the hole already has when the block starts (run
+                                // from a block after an interruption); 0 = a new hole
   double final_radius_mm{0.0};  // kOrbitFinish: final hole radius (mm, absolute, > 0)
   double dwell_s{0.0};          // kDwell
   bool on{false};               // kRotation / kFlushing

@@ -19,8 +19,10 @@
 //               still run (their outputs stay observable). A non-finite vz_servo_mm_s is a
 //               broken signal: the feed stops (vz 0 into wear) and update() returns kFault.
 //               Hole depth estimate (the electrode front is z − accumulated wear):
-//                 depth_reached_mm = (touch_z_mm − z_mm) − (enable_wear_comp ? wear.wear_mm : 0)
+//                 depth_reached_mm = depth_done_mm + (touch_z_mm − z_mm)
+//                                    − (enable_wear_comp ? wear.wear_mm : 0)
 //                                    − spark_gap_offset_um·1e-3
+//                 (depth_done_mm: the depth a resumed hole already had, 0 for a new one)
 //                 (the front touches at the first-spark gap and drills one working gap above
 //                 the bottom; spark_gap_offset_um is their difference, docs/blocks.md)
 //                 (output wear_mm: that estimated electrode wear of this cycle)
@@ -135,6 +137,10 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Input<double> z_mm{pins_, "z_mm", "mm"};
   rt::Input<bool> start{pins_, "start"};
   rt::Input<double> depth_mm{pins_, "depth_mm", "mm"};  // 0: use depth_default_mm
+  // The depth the hole already has (run from a block after an interruption): the first sparks
+  // strike at its bottom, so the depth counts from there. Read at the start of a cycle; ≤ 0 or
+  // not finite: a new hole.
+  rt::Input<double> depth_done_mm{pins_, "depth_done_mm", "mm"};
   rt::Input<double> wear_ratio{pins_,
                                "wear_ratio"};  // ≤ 0 (unwired): the wear child's wear_ratio_default
   rt::Input<double> area_ratio{pins_, "area_ratio"};  // ≤ 0 (unwired): the wear child's areas
@@ -199,6 +205,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   std::int64_t dark_cycles_{0};    // consecutive DRILL cycles without an ignited pulse
   double breakthrough_z_mm_{0.0};  // z where the breakthrough was detected
   double target_depth_mm_{0.0};
+  double depth_done_mm_{0.0};  // depth_done_mm at the start of the cycle
   double retract_to_z_mm_{0.0};
   bool safe_retract_{false};  // the running retract was started by the safe state
   double last_z_sp_mm_{0.0};

@@ -10,11 +10,19 @@
 //   lin     LinearInterpolator  rapids and linear moves (eq. 12-13 in XYZ)
 //   arc     CircularInterpolator  G02/G03 in XY (eq. 14-19)
 //   px/py/pz PositionLoop   the three axis loops following lin/arc (and holding still otherwise)
+//   manual  ManualMotion    the operator's reference, jog and touch-off (manual_motion.hpp):
+//                           enabled while the machine is READY and no job runs; while it is
+//                           active it drives the axes. Its inputs ref_x/ref_y/ref_z and contact
+//                           and its outputs touch_mode, pos_set_* and pos_value_*_mm are wired
+//                           in YAML to the driver (`job.manual.contact: io.contact`, …).
 //
 // Sequence (output `state`): 0 IDLE — when the machine is RUNNING and a program is loaded, the
 // job begins (JobStore::rt_begin) → 1 RUN: the current block is executed; when it completes the
 // store advances. At the end block or past the last block the job finishes (kFinished) and the
-// machine is commanded back to READY. An operator stop (machine READY), FAULT or ESTOP while
+// machine is commanded back to READY. A job does not begin while ManualControl says the machine
+// must be referenced first (manual.reference_required): the machine is commanded back to READY.
+// A dry run (StartOptions::dry_run) runs every move with the generator disarmed and skips the
+// drilling and orbit-finishing blocks (the electrode stays above the work). An operator stop (machine READY), FAULT or ESTOP while
 // running aborts the job (kAborted); the children's safe states stop the axes, switch the
 // generator off and back Z off. HOLD pauses interpolated moves and dwells at once, and a drilling
 // block and an orbit-finishing block at once too (the children's `hold`: generator off, axes
@@ -29,8 +37,9 @@
 //              rapid_speed_mm_s, linear at the block's feed or feed_default_mm_s); generator off
 //              during rapids; done when lin is done and every axis is in position.
 //   arc_cw / arc_ccw  arc interpolates in XY (centre, end, turns), Z held; then in position.
-//   drill      drill.depth_mm = −target.z (Z0 is the work surface; the depth is measured from
-//              the touch point), through = false, wear ratio and Tdr of the active condition; XY
+//   drill      drill.depth_mm = the block's depth_mm (below the work frame's Z0), or −target.z
+//              for a block without one (machine Z0 is the work surface); drill.depth_done_mm =
+//              depth_done_mm (a resumed hole); the depth is measured from the first sparks, through = false, wear ratio and Tdr of the active condition; XY
 //              held by px/py; when the drill child is DONE (after its retract) a rapid takes the
 //              electrode back to where the block began, so a drilling block ends at its start
 //              point (the G-code interpreter's current point after it, docs/gcode.md).
@@ -62,6 +71,7 @@
 #include "edm/machining/motion_block.hpp"
 #include "edm/programs/deep_hole_drill.hpp"
 #include "edm/programs/job_figures.hpp"
+#include "edm/programs/manual_motion.hpp"
 #include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/wall_finish.hpp"
 #include "edm/runtime/block.hpp"
@@ -113,6 +123,9 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<bool> finish_start{pins_, "finish_start"};
   rt::Output<bool> feed_hold{pins_, "feed_hold"};
   rt::Output<double> drill_depth_mm{pins_, "drill_depth_mm", "mm"};
+  rt::Output<double> drill_depth_done_mm{pins_, "drill_depth_done_mm", "mm"};
+  rt::Output<bool> manual_enable{pins_, "manual_enable"};
+  rt::Output<bool> dry_run{pins_, "dry_run"};
   rt::Output<double> wear_ratio{pins_, "wear_ratio"};
   rt::Output<double> area_ratio{pins_, "area_ratio"};
   rt::Output<double> tdr_us{pins_, "tdr_us", "us"};
@@ -183,7 +196,9 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   blocks::PositionLoop& px_;
   blocks::PositionLoop& py_;
   blocks::PositionLoop& pz_;
+  ManualMotion& manual_;
   rt::Machine* machine_{nullptr};
+  rt::ManualControl* manual_control_{nullptr};
   rt::JobStore* job_{nullptr};
   const machining::MachineTables* tables_{nullptr};
   JobFigures figures_{pins_};

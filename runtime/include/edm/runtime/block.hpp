@@ -30,6 +30,7 @@ namespace edm::rt {
 
 class Clock;
 class JobStore;
+class ManualControl;
 
 enum class BlockStatus : std::int8_t { kOk = 0, kSaturated = 1, kFault = -1 };
 
@@ -64,6 +65,7 @@ struct BlockSetup {
   Machine* machine{nullptr};  // the state machine (commands from a sequencer; alarms)
   JobStore* job{nullptr};     // the loaded part program (job sequencers)
   const machining::MachineTables* tables{nullptr};  // conditions and soft limits of the config
+  ManualControl* manual{nullptr};  // the operator's manual motion requests (job sequencers)
 };
 
 class Block : public SafeStateHandler {

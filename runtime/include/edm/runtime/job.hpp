@@ -32,6 +32,16 @@ enum class JobOutcome : std::uint8_t {
 
 enum class LoadResult : std::uint8_t { kOk, kBusy };
 
+/// Which program a job runs: the loaded part program, or the one-line program of MDI (issue 21),
+/// which never replaces the part program.
+enum class JobSlot : std::uint8_t { kMain = 0, kMdi = 1 };
+
+/// How the next job starts (set by the bridge's cycle.start before it commands kStart).
+struct StartOptions {
+  JobSlot slot{JobSlot::kMain};
+  bool dry_run{false};  // the motion with the generator off; drill and orbit blocks skipped
+};
+
 struct JobProgress {
   JobOutcome outcome{JobOutcome::kNone};
   std::uint64_t generation{0};  // increments on every successful load()
@@ -41,6 +51,8 @@ struct JobProgress {
   std::int32_t line{0};        // G-code line of the block being executed
   std::uint32_t program_id{
       0};  // the id the program was loaded under (bridge: its CRC-32); 0 = none
+  JobSlot slot{JobSlot::kMain};  // the program the current (or last) job runs
+  bool dry_run{false};           // the current (or last) job is a dry run
 };
 
 class JobStore {
@@ -54,13 +66,29 @@ class JobStore {
   /// names it in progress() and in the retained job record (the bridge passes the CRC-32 it was
   /// committed with; 0 = unnamed).
   LoadResult load(std::vector<machining::MotionBlock> program, std::uint32_t program_id = 0);
+  /// Non-RT. Replaces the MDI program (kBusy as load()); the part program is untouched.
+  LoadResult load_mdi(std::vector<machining::MotionBlock> program);
+  /// Number of blocks in the MDI program (0 = none).
+  [[nodiscard]] std::size_t loaded_mdi_blocks() const noexcept {
+    return mdi_count_.load(std::memory_order_acquire);
+  }
+  /// Any thread: how the next rt_begin() starts (the bridge, just before commanding kStart).
+  void set_start_options(StartOptions o) noexcept {
+    next_slot_.store(o.slot, std::memory_order_relaxed);
+    next_dry_run_.store(o.dry_run, std::memory_order_release);
+  }
+  /// Any thread: the options of the current (or last) job.
+  [[nodiscard]] StartOptions current_options() const noexcept {
+    return {cur_slot_.load(std::memory_order_relaxed), cur_dry_run_.load(std::memory_order_acquire)};
+  }
   /// Non-RT. Number of blocks in the loaded program (0 = none).
   [[nodiscard]] std::size_t loaded_blocks() const noexcept {
     return count_.load(std::memory_order_acquire);
   }
 
-  /// RT-safe. Starts a job at block 0 of the loaded program. False (nothing changed) when there is
-  /// no program, a job is already active, or a load is in progress.
+  /// RT-safe. Starts a job at block 0 of the program set_start_options() chose (the part program
+  /// by default; the options then return to the default). False (nothing changed) when there is
+  /// no such program, a job is already active, or a load is in progress.
   bool rt_begin() noexcept;
   /// RT-safe. The block being executed, or nullptr when no job is active or it is past the end.
   [[nodiscard]] const machining::MotionBlock* rt_current() const noexcept;
@@ -87,7 +115,14 @@ class JobStore {
 
   std::atomic<Phase> phase_{Phase::kIdle};
   std::unique_ptr<const Program> program_;  // written only in Loading, read only in Active
+  std::unique_ptr<const Program> mdi_;      // idem
+  const Program* running_{nullptr};         // program_ or mdi_: written by rt_begin (Active)
   std::atomic<std::size_t> count_{0};
+  std::atomic<std::size_t> mdi_count_{0};
+  std::atomic<JobSlot> next_slot_{JobSlot::kMain};
+  std::atomic<bool> next_dry_run_{false};
+  std::atomic<JobSlot> cur_slot_{JobSlot::kMain};
+  std::atomic<bool> cur_dry_run_{false};
   std::atomic<std::size_t> index_{0};
   std::atomic<std::int32_t> line_{0};
   std::atomic<std::uint32_t> program_id_{0};

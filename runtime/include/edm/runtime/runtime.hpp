@@ -19,6 +19,7 @@
 #include "edm/runtime/io_driver.hpp"
 #include "edm/runtime/job.hpp"
 #include "edm/runtime/machine.hpp"
+#include "edm/runtime/manual.hpp"
 #include "edm/runtime/program.hpp"
 #include "edm/runtime/retain.hpp"
 #include "edm/runtime/stats_json.hpp"
@@ -27,6 +28,7 @@
 #include "edm/runtime/trace.hpp"
 #include "edm/runtime/type_registry.hpp"
 #include "edm/runtime/variables.hpp"
+#include "edm/runtime/work_offsets.hpp"
 
 namespace edm::rt {
 
@@ -105,6 +107,10 @@ class Runtime {
   [[nodiscard]] const Config& config() const noexcept { return config_; }
   /// The loaded part program and its progress (DESIGN §2: the runtime owns it).
   [[nodiscard]] JobStore& job() noexcept { return job_; }
+  /// The operator's manual motion (reference, jog, touch-off): requests in, state out.
+  [[nodiscard]] ManualControl& manual() noexcept { return manual_; }
+  /// The work offsets G54…G59 (retained with the job record when there is a retain file).
+  [[nodiscard]] WorkOffsets& work_offsets() noexcept { return work_offsets_; }
   /// The safety supervisor of `machine.safety`, or nullptr when the config has none.
   [[nodiscard]] const Supervisor* supervisor() const noexcept { return supervisor_.get(); }
   /// Adds a consumer of every alarm (besides the log): called on the controlling thread, in
@@ -127,6 +133,8 @@ class Runtime {
   machining::MachineTables tables_;
   Machine machine_;
   JobStore job_;
+  ManualControl manual_;
+  WorkOffsets work_offsets_;
   std::unique_ptr<IoDriver> driver_;
   std::unique_ptr<Supervisor> supervisor_;  // after driver_: it points into the driver's pins
   std::vector<std::unique_ptr<Program>> programs_;

@@ -21,7 +21,13 @@
 //   ferror(v) = min_ferror_mm + (ferror_mm − min_ferror_mm) · min(1, |v| / v_max_mm_s)
 // where x_cmd, v_cmd integrate the supervised command through the axis's a_max_mm_s2 (the drive's
 // trajectory generator); they restart from the actual position on the first cycle, in OFF and
-// in FAULT/ESTOP.
+// in FAULT/ESTOP, and when homing sets an axis's encoder (ManualControl::position_epoch()).
+//
+// Referencing (issue 21): the range checks (141 outside, commands cut at the limits) apply to
+// the axes ManualControl says are referenced (X, Y, Z by name; an axis of another name always
+// counts as referenced). An unreferenced axis's coordinates are those of its power-on position,
+// so limits in them mean nothing; v_max and the following error still apply (LinuxCNC does the
+// same for unhomed joints).
 //
 // Alarms: source "safety.<axis>" (140, 141), "safety.<axis>.v_max" (141 warning),
 // "safety.electrode" (160), "safety.wire" (170). Each is raised every cycle its condition holds
@@ -41,6 +47,7 @@
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/machine.hpp"
+#include "edm/runtime/manual.hpp"
 #include "edm/runtime/pin.hpp"
 
 namespace edm::rt {
@@ -62,6 +69,7 @@ struct SupervisorSetup {
   double electrode_margin_mm{0.0};
   const Output<bool>* wire_broken{nullptr};
   std::vector<Input<bool>*> generator;
+  const ManualControl* manual{nullptr};  // referenced axes and position epoch; null: all referenced
 };
 
 class Supervisor {
@@ -88,6 +96,7 @@ class Supervisor {
  private:
   struct Axis {
     SupervisedAxis cfg;
+    int ref_bit{-1};           // bit of ManualControl::referenced(); -1: always referenced
     std::string source;        // "safety.X"
     std::string speed_source;  // "safety.X.v_max"
     bool tracking{false};      // the commanded-position model is running
@@ -99,7 +108,8 @@ class Supervisor {
     std::atomic<double> ferror_now_mm{0.0};
   };
 
-  static bool is_outside(const Axis& a, double x) noexcept;
+  [[nodiscard]] bool is_outside(const Axis& a, double x) const noexcept;
+  [[nodiscard]] bool referenced(const Axis& a) const noexcept;
   void check_machine(TimePoint now) noexcept;
   void check_axis(Axis& a, TimePoint now, bool track) noexcept;
   /// The command after the speed and range limits; raises/clears 141.
@@ -114,6 +124,8 @@ class Supervisor {
   double electrode_margin_mm_;
   const Output<bool>* wire_broken_;
   std::vector<Input<bool>*> generator_;
+  const ManualControl* manual_;
+  std::uint64_t epoch_seen_{0};
   double dt_s_;
   bool electrode_raised_{false};
   bool wire_raised_{false};

@@ -34,12 +34,13 @@ bool from_json(const Json& j, machining::MotionBlock& out, std::string& error);
 
 // ---- program checksum ---------------------------------------------------------------------
 // CRC-32 (IEEE 802.3, the zlib/PNG polynomial; Python: zlib.crc32) over each block's canonical
-// 98-byte little-endian record, in program order:
+// 114-byte little-endian record, in program order:
 //   u8 kind, i32 line, i32 col, f64 target.x/y/z, f64 centre.x/y/z, i32 turns, f64 feed_mm_s,
-//   i32 condition, f64 z_travel_mm, f64 final_radius_mm, f64 dwell_s, u8 on
-// (Python: struct.pack('<Bii6didi3dB', ...)). It covers the decoded values, so it catches a
+//   i32 condition, f64 z_travel_mm, f64 depth_mm, f64 depth_done_mm, f64 final_radius_mm,
+//   f64 dwell_s, u8 on
+// (Python: struct.pack('<Bii6didi5dB', ...)). It covers the decoded values, so it catches a
 // lost, repeated or reordered chunk and any number the JSON round trip changed.
-inline constexpr std::size_t kBlockRecordBytes = 98;
+inline constexpr std::size_t kBlockRecordBytes = 114;
 
 // Incremental: update() in any number of pieces gives the CRC of their concatenation.
 class Crc32 {
@@ -93,6 +94,15 @@ std::string to_line(const Json& j);
 // ---- status -------------------------------------------------------------------------------
 
 /// The `status` reply body and the `status` event body.
+/// The job a run from a block may resume: the one an unclean stop interrupted (until the next job
+/// begins) or the last one, when it was aborted (stop, fault, E-stop).
+struct LastJob {
+  std::string outcome;  // interrupted, aborted
+  std::uint64_t block{0};
+  std::int32_t line{0};
+  std::optional<double> depth_mm;  // retain.job_depth's variable then (the controller's estimate)
+};
+
 struct StatusMessage {
   std::string state;        // OFF, READY, RUNNING, HOLD, FAULT, ESTOP
   int cause{0};             // alarm code of the last entry into a safe state (0 = none)
@@ -103,6 +113,7 @@ struct StatusMessage {
   std::uint64_t job_block{0};  // index of the block being executed
   std::uint64_t job_blocks{0};
   std::int32_t job_line{0};                          // its G-code line
+  std::optional<LastJob> job_last;                   // job.last: a job that may be resumed
   std::vector<std::pair<std::string, double>> vars;  // the configured key variables
   std::uint64_t dropped{0};  // events this session has lost to a full queue (events only)
 };

@@ -1,0 +1,303 @@
+// The operator functions' ops (ops_operator.hpp; docs/protocol.md "Operator functions").
+#include "ops_operator.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+
+#include "server_impl.hpp"
+
+namespace edm::bridge::ops {
+namespace {
+
+constexpr char kAxisNames[3] = {'X', 'Y', 'Z'};
+
+int axis_index(const std::string& a) {
+  if (a == "X" || a == "x") return 0;
+  if (a == "Y" || a == "y") return 1;
+  if (a == "Z" || a == "z") return 2;
+  return -1;
+}
+
+/// Manual motion needs a machine that has it, READY, no job, and no other manual operation
+/// (a jog may replace a jog).
+std::optional<Body> manual_ready(rt::Runtime& rt, bool jog) {
+  const rt::ManualInfo info = rt.manual().info();
+  if (!info.available) {
+    return error(ErrorCode::kInvalidState, "this machine has no manual motion (no EdmJob)");
+  }
+  const rt::MachineState st = rt.machine().state();
+  if (st != rt::MachineState::kReady || rt.job().active()) {
+    return error(ErrorCode::kInvalidState,
+                 "manual motion needs the machine READY with no job running (it is " +
+                     std::string(rt::to_string(st)) + ")");
+  }
+  const rt::ManualStatus ms = rt.manual().status();
+  if (ms.busy && !(jog && ms.mode == rt::ManualMode::kJog)) {
+    return error(ErrorCode::kBusy, "a manual operation is running (" +
+                                       std::string(rt::to_string(ms.mode)) +
+                                       "): wait for it or send jog.stop");
+  }
+  return std::nullopt;
+}
+
+Body op_home(Session& s, const Json& msg) {
+  auto& rt = s.server().rt;
+  if (auto e = manual_ready(rt, false)) return *e;
+  if (!rt.manual().info().home) {
+    return error(ErrorCode::kInvalidState, "this machine has no reference switches wired");
+  }
+  std::uint8_t mask = 0x7;
+  if (auto it = msg.find("axes"); it != msg.end()) {
+    if (!it->is_string() || it->get_ref<const std::string&>().empty() ||
+        it->get_ref<const std::string&>().size() > 3) {
+      return error(ErrorCode::kBadRequest, "'axes' must be a string of X, Y, Z (e.g. \"XY\")");
+    }
+    mask = 0;
+    for (char c : it->get_ref<const std::string&>()) {
+      const int a = axis_index(std::string(1, c));
+      if (a < 0 || (mask >> a & 1U) != 0) {
+        return error(ErrorCode::kBadRequest, "'axes' must be a string of X, Y, Z (e.g. \"XY\")");
+      }
+      mask = static_cast<std::uint8_t>(mask | (1U << a));
+    }
+  }
+  rt::ManualRequest r;
+  r.op = rt::ManualOp::kHome;
+  r.axes = mask;
+  const std::uint64_t seq = rt.manual().request(r);
+  std::string axes;
+  for (int a = 0; a < 3; ++a) {
+    if ((mask >> a & 1U) != 0) axes += kAxisNames[a];
+  }
+  return Json{{"seq", seq}, {"axes", axes}};
+}
+
+Body op_jog(Session& s, const Json& msg) {
+  auto& rt = s.server().rt;
+  if (auto e = manual_ready(rt, true)) return *e;
+  const Json* axis = field(msg, "axis", [](const Json& j) { return j.is_string(); });
+  const int a = axis != nullptr ? axis_index(axis->get<std::string>()) : -1;
+  if (a < 0) return error(ErrorCode::kBadRequest, "'axis' must be \"X\", \"Y\" or \"Z\"");
+  const Json* dist = field(msg, "distance", [](const Json& j) { return j.is_number(); });
+  const Json* vel = field(msg, "velocity", [](const Json& j) { return j.is_number(); });
+  if ((dist == nullptr) == (vel == nullptr)) {
+    return error(ErrorCode::kBadRequest,
+                 "give either 'distance' (mm, incremental) or 'velocity' (mm/s, continuous)");
+  }
+  const rt::ManualInfo info = rt.manual().info();
+  rt::ManualRequest r;
+  r.axis = static_cast<std::uint8_t>(a);
+  if (dist != nullptr) {
+    const double d = dist->get<double>();
+    if (!std::isfinite(d) || std::abs(d) < info.jog_distance_min_mm ||
+        std::abs(d) > info.jog_distance_max_mm) {
+      return error(ErrorCode::kBadRequest, "'distance' must be 0.001 to 10 mm in magnitude");
+    }
+    r.op = rt::ManualOp::kJogDistance;
+    r.value = d;
+  } else {
+    const double v = vel->get<double>();
+    if (!std::isfinite(v) || std::abs(v) > info.jog_v_max_mm_s) {
+      return error(ErrorCode::kBadRequest, "'velocity' must be within ±" +
+                                               std::to_string(info.jog_v_max_mm_s) + " mm/s");
+    }
+    r.op = rt::ManualOp::kJogVelocity;
+    r.value = v;
+  }
+  return Json{{"seq", rt.manual().request(r)}, {"deadman_ms", info.deadman_ms}};
+}
+
+Body op_jog_stop(Session& s) {
+  rt::ManualRequest r;
+  r.op = rt::ManualOp::kStop;
+  return Json{{"seq", s.server().rt.manual().request(r)}};
+}
+
+Body op_touch(Session& s, const Json& msg) {
+  auto& rt = s.server().rt;
+  if (auto e = manual_ready(rt, false)) return *e;
+  if (!rt.manual().info().touch) {
+    return error(ErrorCode::kInvalidState, "this machine has no contact sensing wired");
+  }
+  const Json* t = field(msg, "target", [](const Json& j) { return j.is_string(); });
+  rt::TouchTarget target{};
+  if (t == nullptr || !rt::touch_target_from_string(t->get_ref<const std::string&>(), target)) {
+    return error(ErrorCode::kBadRequest,
+                 "'target' must be one of \"z\", \"x+\", \"x-\", \"y+\", \"y-\", \"center\"");
+  }
+  rt::ManualRequest r;
+  r.op = rt::ManualOp::kTouch;
+  r.target = target;
+  return Json{{"seq", rt.manual().request(r)}};
+}
+
+Json referenced_json(std::uint8_t mask) {
+  return Json{{"X", (mask & 1U) != 0}, {"Y", (mask & 2U) != 0}, {"Z", (mask & 4U) != 0}};
+}
+
+Body op_manual_status(Session& s) {
+  auto& m = s.server().rt.manual();
+  const rt::ManualStatus st = m.status();
+  Json out{{"mode", std::string(rt::to_string(st.mode))},
+           {"busy", st.busy},
+           {"seen_seq", st.seen_seq},
+           {"referenced", referenced_json(m.referenced())},
+           {"may_run_programs", m.may_run_programs()}};
+  const rt::ManualResult& r = st.result;
+  if (r.seq != 0) {
+    Json res{{"seq", r.seq},
+             {"op", std::string(rt::to_string(r.op))},
+             {"ok", r.ok},
+             {"error", std::string(rt::to_string(r.error))},
+             {"x", r.x},
+             {"y", r.y},
+             {"z", r.z},
+             {"t_s", r.t_s}};
+    if (r.op == rt::ManualOp::kTouch) {
+      res["target"] = std::string(rt::to_string(r.target));
+      if (r.target == rt::TouchTarget::kCenter) res["size"] = r.size;
+    }
+    out["result"] = std::move(res);
+  }
+  return out;
+}
+
+Json frame_json(const rt::WorkFrame& f) { return Json{{"x", f.x}, {"y", f.y}, {"z", f.z}}; }
+
+Body op_offset_get(Session& s) {
+  auto& w = s.server().rt.work_offsets();
+  Json frames = Json::object();
+  const auto all = w.all();
+  for (int i = 0; i < rt::WorkOffsets::kFrames; ++i) {
+    frames[rt::WorkOffsets::frame_name(i)] = frame_json(all[static_cast<std::size_t>(i)]);
+  }
+  return Json{{"frames", std::move(frames)}, {"generation", w.generation()}};
+}
+
+Body op_offset_set(Session& s, const Json& msg) {
+  auto& rt = s.server().rt;
+  const Json* f = field(msg, "frame", [](const Json& j) { return j.is_string(); });
+  const auto index =
+      f != nullptr ? rt::WorkOffsets::frame_index(f->get_ref<const std::string&>()) : std::nullopt;
+  if (!index) return error(ErrorCode::kBadRequest, "'frame' must be one of G54 … G59");
+  std::optional<double> v[3];
+  const char* keys[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    auto it = msg.find(keys[k]);
+    if (it == msg.end()) continue;
+    if (!it->is_number() || !std::isfinite(it->get<double>()) ||
+        std::abs(it->get<double>()) > 1e5) {
+      return error(ErrorCode::kBadRequest,
+                   std::string("'") + keys[k] + "' must be a finite number of mm (|v| ≤ 1e5)");
+    }
+    v[k] = it->get<double>();
+  }
+  if (!v[0] && !v[1] && !v[2]) {
+    return error(ErrorCode::kBadRequest, "give at least one of 'x', 'y', 'z'");
+  }
+  const rt::MachineState st = rt.machine().state();
+  if (rt.job().active() || st == rt::MachineState::kRunning || st == rt::MachineState::kHold) {
+    return error(ErrorCode::kInvalidState, "work offsets are not changed while a job runs");
+  }
+  const rt::WorkFrame nf = rt.work_offsets().set(*index, v[0], v[1], v[2]);
+  if (rt.retain() != nullptr) rt.retain()->flush();  // on disk before the reply
+  spdlog::info("bridge: session {} set {} to X{} Y{} Z{}", s.id(),
+               rt::WorkOffsets::frame_name(*index), nf.x, nf.y, nf.z);
+  Json out = frame_json(nf);
+  out["frame"] = rt::WorkOffsets::frame_name(*index);
+  out["generation"] = rt.work_offsets().generation();
+  return out;
+}
+
+}  // namespace
+
+Json manual_info_json(const rt::ManualInfo& info) {
+  return Json{{"available", info.available},
+              {"home", info.home},
+              {"touch", info.touch},
+              {"reference_required", info.reference_required},
+              {"deadman_ms", info.deadman_ms},
+              {"jog_v_max_mm_s", info.jog_v_max_mm_s},
+              {"jog_distance_mm", Json::array({info.jog_distance_min_mm, info.jog_distance_max_mm})},
+              {"electrode_d_mm", info.electrode_d_mm}};
+}
+
+std::optional<Body> read_upload_options(const Json& msg, rt::JobSlot& slot,
+                                        std::optional<std::uint64_t>& offsets_generation) {
+  slot = rt::JobSlot::kMain;
+  if (auto it = msg.find("slot"); it != msg.end()) {
+    if (*it == "mdi") {
+      slot = rt::JobSlot::kMdi;
+    } else if (*it != "main") {
+      return error(ErrorCode::kBadRequest, "'slot' must be \"main\" or \"mdi\"");
+    }
+  }
+  offsets_generation.reset();
+  if (auto it = msg.find("offsets_generation"); it != msg.end()) {
+    if (!it->is_number_unsigned()) {
+      return error(ErrorCode::kBadRequest, "'offsets_generation' must be an unsigned integer");
+    }
+    offsets_generation = it->get<std::uint64_t>();
+  }
+  return std::nullopt;
+}
+
+std::optional<Body> prepare_start(Session& s, const Json& msg) {
+  auto& srv = s.server();
+  auto& rt = srv.rt;
+  rt::StartOptions o;
+  if (auto it = msg.find("slot"); it != msg.end()) {
+    if (*it == "mdi") {
+      o.slot = rt::JobSlot::kMdi;
+    } else if (*it != "main") {
+      return error(ErrorCode::kBadRequest, "'slot' must be \"main\" or \"mdi\"");
+    }
+  }
+  if (auto it = msg.find("dry_run"); it != msg.end()) {
+    if (!it->is_boolean()) return error(ErrorCode::kBadRequest, "'dry_run' must be true or false");
+    o.dry_run = it->get<bool>();
+  }
+  const rt::JobStore& job = rt.job();
+  if (job.has_runner()) {
+    if (o.slot == rt::JobSlot::kMdi && job.loaded_mdi_blocks() == 0) {
+      return error(ErrorCode::kInvalidState,
+                   "cycle.start: no MDI program (program.begin with \"slot\": \"mdi\")");
+    }
+    if (o.slot == rt::JobSlot::kMain && job.loaded_blocks() == 0) {
+      return error(ErrorCode::kInvalidState,
+                   "cycle.start: no part program loaded (program.commit)");
+    }
+    const rt::ManualControl& m = rt.manual();
+    if (!m.may_run_programs()) {
+      return error(ErrorCode::kInvalidState,
+                   "machine not referenced: home every axis first (edmhmi home)");
+    }
+    if (m.status().busy) {
+      return error(ErrorCode::kInvalidState, "a manual operation is running (jog.stop first)");
+    }
+    const auto& gen = srv.committed_offsets[static_cast<std::size_t>(o.slot)];
+    if (gen && *gen != rt.work_offsets().generation()) {
+      return error(ErrorCode::kInvalidState,
+                   "the work offsets changed since the program was committed (generation " +
+                       std::to_string(*gen) + ", now " +
+                       std::to_string(rt.work_offsets().generation()) +
+                       "): interpret and commit it again");
+    }
+  }
+  rt.job().set_start_options(o);
+  return std::nullopt;
+}
+
+std::optional<Body> dispatch_operator(Session& s, const std::string& op, const Json& msg) {
+  if (op == "home") return op_home(s, msg);
+  if (op == "jog") return op_jog(s, msg);
+  if (op == "jog.stop") return op_jog_stop(s);
+  if (op == "touch") return op_touch(s, msg);
+  if (op == "manual.status") return op_manual_status(s);
+  if (op == "offset.get") return op_offset_get(s);
+  if (op == "offset.set") return op_offset_set(s, msg);
+  return std::nullopt;
+}
+
+}  // namespace edm::bridge::ops

@@ -1,0 +1,666 @@
+#include "edm/programs/manual_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "edm/machining/machine_tables.hpp"
+#include "edm/runtime/machine.hpp"
+
+namespace edm::programs {
+namespace {
+
+using rt::ManualError;
+using rt::ManualMode;
+using rt::ManualOp;
+using rt::TouchTarget;
+
+constexpr char kAxisName[3] = {'X', 'Y', 'Z'};
+// A reference within this of its target has arrived (the encoder resolves far coarser).
+constexpr double kArrived = 1e-7;
+
+int axis_of(char c) noexcept { return c == 'X' ? 0 : c == 'Y' ? 1 : c == 'Z' ? 2 : -1; }
+
+}  // namespace
+
+void ManualMotionParams::visit(rt::ParamVisitor& v) {
+  v.param("jog_v_max_mm_s", jog_v_max_mm_s,
+          {.unit = "mm/s", .description = "fastest continuous jog", .range = rt::kPositive});
+  v.param("accel_mm_s2", accel_mm_s2,
+          {.unit = "mm/s2", .description = "acceleration of manual moves", .range = rt::kPositive});
+  v.param("kp_per_s", kp_per_s,
+          {.unit = "1/s",
+           .description = "position gain that keeps the axis on its manual reference",
+           .range = rt::kNonNegative});
+  v.param("deadman", deadman,
+          {.unit = "s",
+           .description = "a continuous jog not refreshed for this long stops (dead-man)",
+           .range = rt::kPositive});
+  v.param("home_order", home_order,
+          {.description = "the order in which the axes are referenced (X, Y, Z each at most once)",
+           .load_time_only = true});
+  v.param("home_search_mm_s", home_search_mm_s,
+          {.unit = "mm/s", .description = "speed toward the reference switch",
+           .range = rt::kPositive});
+  v.param("home_latch_mm_s", home_latch_mm_s,
+          {.unit = "mm/s",
+           .description = "slow speed onto the switch where the position is set",
+           .range = rt::kPositive});
+  v.param("home_back_off_mm", home_back_off_mm,
+          {.unit = "mm", .description = "back-off from the switch before the slow latch",
+           .range = rt::kPositive});
+  v.param("home_search_max_mm", home_search_max_mm,
+          {.unit = "mm", .description = "longest search for the switch (else the homing fails)",
+           .range = rt::kPositive});
+  v.param("home_x_mm", home_x_mm,
+          {.unit = "mm", .description = "machine X of the X reference switch"});
+  v.param("home_y_mm", home_y_mm,
+          {.unit = "mm", .description = "machine Y of the Y reference switch"});
+  v.param("home_z_mm", home_z_mm,
+          {.unit = "mm", .description = "machine Z of the Z reference switch"});
+  v.param("touch_fast_mm_s", touch_fast_mm_s,
+          {.unit = "mm/s", .description = "first approach toward the work in touch mode",
+           .range = rt::kPositive});
+  v.param("touch_slow_mm_s", touch_slow_mm_s,
+          {.unit = "mm/s",
+           .description = "second approach: the touch is where it makes contact",
+           .range = rt::kPositive});
+  v.param("touch_max_mm", touch_max_mm,
+          {.unit = "mm", .description = "longest approach without contact (else no contact)",
+           .range = rt::kPositive});
+  v.param("touch_back_off_mm", touch_back_off_mm,
+          {.unit = "mm", .description = "back-off after each contact", .range = rt::kPositive});
+  v.param("electrode_d_mm", electrode_d_mm,
+          {.unit = "mm",
+           .description = "electrode diameter: an edge lies one radius beyond the axis at contact",
+           .range = rt::kNonNegative});
+  v.param("reference_required", reference_required,
+          {.description = "programs are refused until every axis is referenced",
+           .load_time_only = true});
+  v.param("referenced_at_start", referenced_at_start,
+          {.description = "absolute encoders: every axis counts as referenced at power-on",
+           .load_time_only = true});
+}
+
+std::vector<rt::ParamError> ManualMotionParams::validate() const {
+  std::vector<rt::ParamError> errs;
+  bool seen[3] = {false, false, false};
+  for (char c : home_order) {
+    const int a = axis_of(c);
+    if (a < 0 || seen[a]) {
+      errs.push_back({"home_order", "must list X, Y and Z, each at most once (got '" +
+                                        home_order + "')"});
+      break;
+    }
+    seen[a] = true;
+  }
+  if (touch_slow_mm_s > touch_fast_mm_s) {
+    errs.push_back({"touch_slow_mm_s", "must not exceed touch_fast_mm_s"});
+  }
+  if (home_latch_mm_s > home_search_mm_s) {
+    errs.push_back({"home_latch_mm_s", "must not exceed home_search_mm_s"});
+  }
+  return errs;
+}
+
+std::vector<rt::ParamError> ManualMotion::configure(const rt::BlockSetup& setup) {
+  manual_ = setup.manual;
+  tables_ = setup.tables;
+  dt_s_ = rt::to_seconds(setup.period);
+  if (manual_ == nullptr) return {{"", "ManualMotion needs the runtime's manual control"}};
+  return {};
+}
+
+void ManualMotion::bind() {
+  // After the YAML wiring: what is wired says what this machine can do.
+  rt::ManualInfo info;
+  info.available = true;
+  info.home = ref_x.connected() || ref_y.connected() || ref_z.connected();
+  info.touch = contact.connected();
+  info.reference_required = params_.reference_required;
+  info.deadman_ms = rt::to_seconds(params_.deadman) * 1e3;
+  info.jog_v_max_mm_s = params_.jog_v_max_mm_s;
+  info.electrode_d_mm = params_.electrode_d_mm;
+  manual_->attach(info, params_.referenced_at_start ? 0x7 : 0x0);
+}
+
+void ManualMotion::activate() noexcept {
+  step_ = Step::kIdle;
+  status_ = {};
+  active.set(false);
+  mode.set(0);
+  touch_mode.set(false);
+  vx_cmd_mm_s.set(0.0);
+  vy_cmd_mm_s.set(0.0);
+  vz_cmd_mm_s.set(0.0);
+  pos_set_x.set(false);
+  pos_set_y.set(false);
+  pos_set_z.set(false);
+  if (manual_ != nullptr) {
+    // Requests made before the first cycle are old news.
+    rt::ManualRequest r;
+    while (manual_->rt_poll(r, last_seq_)) {
+    }
+    status_.seen_seq = last_seq_;
+    referenced.set(manual_->referenced());
+    manual_->rt_publish(status_);
+  }
+}
+
+void ManualMotion::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
+  if (step_ != Step::kIdle) {
+    step_ = Step::kIdle;
+    status_.result.ok = false;
+    status_.result.error = ManualError::kInterrupted;
+    status_.result.seq = req_.seq;
+    status_.result.op = req_.op;
+    status_.result.target = req_.target;
+    status_.busy = false;
+    status_.mode = ManualMode::kIdle;
+  }
+  active.set(false);
+  touch_mode.set(false);
+  vx_cmd_mm_s.set(0.0);
+  vy_cmd_mm_s.set(0.0);
+  vz_cmd_mm_s.set(0.0);
+  mode.set(0);
+  if (manual_ != nullptr) manual_->rt_publish(status_);
+}
+
+double ManualMotion::pos(int axis) const noexcept {
+  return axis == 0 ? x_mm.get() : axis == 1 ? y_mm.get() : z_mm.get();
+}
+
+bool ManualMotion::switch_on(int axis) const noexcept {
+  return axis == 0 ? ref_x.get() : axis == 1 ? ref_y.get() : ref_z.get();
+}
+
+bool ManualMotion::is_referenced(int axis) const noexcept {
+  return (manual_->referenced() >> axis & 1U) != 0;
+}
+
+bool ManualMotion::limits(int axis, double& lo, double& hi) const noexcept {
+  const machining::AxisLimits* l = tables_ != nullptr ? tables_->axis(kAxisName[axis]) : nullptr;
+  if (l == nullptr || !is_referenced(axis)) return false;
+  lo = l->min_mm;
+  hi = l->max_mm;
+  return true;
+}
+
+void ManualMotion::begin_move(int axis, double target, double speed) noexcept {
+  if (axis != axis_) {  // a new axis: the old one holds where its reference stopped
+    hold_[axis_] = prof_.pos;
+    prof_.pos = hold_[axis];
+    prof_.vel = 0.0;
+    axis_ = axis;
+  }
+  prof_.target = target;
+  prof_.speed = speed;
+  prof_.done = false;
+  travel_from_ = prof_.pos;
+}
+
+void ManualMotion::stop_now() noexcept {
+  prof_.pos = pos(axis_);
+  prof_.vel = 0.0;
+  prof_.target = prof_.pos;
+  prof_.done = true;
+}
+
+void ManualMotion::step_profile(double dt) noexcept {
+  if (prof_.done) return;
+  const double a = params_.accel_mm_s2;
+  const double d = prof_.target - prof_.pos;
+  // The fastest speed from which the reference still stops at the target.
+  const double v_stop = std::sqrt(2.0 * a * std::abs(d));
+  const double v_des = std::copysign(std::min(prof_.speed, v_stop), d);
+  prof_.vel += std::clamp(v_des - prof_.vel, -a * dt, a * dt);
+  double next = prof_.pos + prof_.vel * dt;
+  if ((d > 0.0 && next >= prof_.target) || (d < 0.0 && next <= prof_.target) ||
+      std::abs(d) < kArrived) {
+    next = prof_.target;
+    prof_.vel = 0.0;
+    prof_.done = true;
+  }
+  prof_.pos = next;
+}
+
+void ManualMotion::command_axes() noexcept {
+  const double kp = params_.kp_per_s;
+  double v[3];
+  for (int k = 0; k < 3; ++k) {
+    const double ref = k == axis_ ? prof_.pos : hold_[k];
+    const double ff = k == axis_ ? prof_.vel : 0.0;
+    v[k] = ff + kp * (ref - pos(k));
+  }
+  vx_cmd_mm_s.set(v[0]);
+  vy_cmd_mm_s.set(v[1]);
+  vz_cmd_mm_s.set(v[2]);
+}
+
+void ManualMotion::finish(bool ok, ManualError e, const rt::CycleContext& ctx) noexcept {
+  step_ = Step::kIdle;
+  status_.result.seq = req_.seq;
+  status_.result.op = req_.op;
+  status_.result.target = req_.target;
+  status_.result.ok = ok;
+  status_.result.error = e;
+  status_.result.t_s = rt::to_seconds(ctx.release);
+  status_.busy = false;
+  status_.mode = ManualMode::kIdle;
+  active.set(false);
+  touch_mode.set(false);
+  vx_cmd_mm_s.set(0.0);
+  vy_cmd_mm_s.set(0.0);
+  vz_cmd_mm_s.set(0.0);
+}
+
+void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx) noexcept {
+  if (r.op == ManualOp::kStop) {
+    if (step_ != Step::kIdle) finish(false, ManualError::kStopped, ctx);
+    return;
+  }
+  if (step_ == Step::kJog && r.op == ManualOp::kJogVelocity && req_.op == ManualOp::kJogVelocity &&
+      r.axis == req_.axis && r.value == req_.value) {
+    refreshed_ = ctx.release;  // the same jog again: the dead-man is refreshed
+    req_.seq = r.seq;
+    return;
+  }
+  if (step_ != Step::kIdle) {
+    // Another request while busy: only a jog replaces a jog (a new speed or axis); anything
+    // else is refused (the bridge refuses it first; this is the RT side's own guard).
+    if (!(step_ == Step::kJog && (r.op == ManualOp::kJogVelocity ||
+                                  r.op == ManualOp::kJogDistance))) {
+      return;
+    }
+  }
+  const bool was_idle = step_ == Step::kIdle;
+  req_ = r;
+  status_.result = {};
+  status_.result.seq = 0;
+  if (was_idle) {
+    for (int k = 0; k < 3; ++k) hold_[k] = pos(k);
+    axis_ = 0;
+    prof_ = {};
+    prof_.pos = hold_[0];
+  }
+  for (int k = 0; k < 3; ++k) start_[k] = k == axis_ ? prof_.pos : hold_[k];
+  refreshed_ = ctx.release;
+  switch (r.op) {
+    case ManualOp::kJogDistance:
+    case ManualOp::kJogVelocity: {
+      const int a = r.axis;
+      if (a < 0 || a > 2 || !std::isfinite(r.value)) {
+        finish(false, ManualError::kBadRequest, ctx);
+        return;
+      }
+      const double from = a == axis_ ? prof_.pos : hold_[a];
+      double lo = 0.0, hi = 0.0;
+      const bool limited = limits(a, lo, hi);
+      if (r.op == ManualOp::kJogDistance) {
+        const double d = std::abs(r.value);
+        if (d < 0.001 - 1e-12 || d > 10.0 + 1e-12) {
+          finish(false, ManualError::kBadRequest, ctx);
+          return;
+        }
+        const double target = from + r.value;
+        if (limited && (target < lo || target > hi)) {
+          finish(false, ManualError::kSoftLimit, ctx);
+          return;
+        }
+        begin_move(a, target, params_.jog_v_max_mm_s);
+      } else {
+        const double v = r.value;
+        if (std::abs(v) > params_.jog_v_max_mm_s + 1e-12) {
+          finish(false, ManualError::kBadRequest, ctx);
+          return;
+        }
+        if (v == 0.0) {
+          if (!was_idle) {
+            begin_move(a, a == axis_ ? prof_.pos : hold_[a], params_.jog_v_max_mm_s);
+            prof_.target = prof_.pos + std::copysign(prof_.vel * prof_.vel /
+                                                         (2.0 * params_.accel_mm_s2),
+                                                     prof_.vel);
+          } else {
+            finish(true, ManualError::kNone, ctx);
+            return;
+          }
+        } else {
+          const double far = v > 0.0 ? (limited ? hi : from + params_.home_search_max_mm)
+                                     : (limited ? lo : from - params_.home_search_max_mm);
+          begin_move(a, far, std::abs(v));
+        }
+      }
+      step_ = Step::kJog;
+      status_.mode = ManualMode::kJog;
+      break;
+    }
+    case ManualOp::kHome:
+      if (!(ref_x.connected() || ref_y.connected() || ref_z.connected())) {
+        finish(false, ManualError::kNotAvailable, ctx);
+        return;
+      }
+      home_todo_ = r.axes & 0x7;
+      home_next_ = 0;
+      status_.mode = ManualMode::kHome;
+      step_ = Step::kHomeSettle;  // next_home_axis() picks the first
+      next_home_axis(ctx);
+      break;
+    case ManualOp::kTouch:
+      if (!contact.connected()) {
+        finish(false, ManualError::kNotAvailable, ctx);
+        return;
+      }
+      if (contact.get()) {
+        finish(false, ManualError::kAlreadyInContact, ctx);
+        return;
+      }
+      touch_index_ = 0;
+      status_.mode = ManualMode::kTouch;
+      touch_mode.set(true);
+      begin_touch_side();
+      break;
+    case ManualOp::kNone:
+    case ManualOp::kStop:
+      return;
+  }
+  if (step_ != Step::kIdle) {
+    status_.busy = true;
+    active.set(true);
+  }
+}
+
+void ManualMotion::next_home_axis(const rt::CycleContext& ctx) noexcept {
+  while (home_next_ < params_.home_order.size()) {
+    const int a = axis_of(params_.home_order[home_next_++]);
+    if (a < 0 || (home_todo_ >> a & 1U) == 0) continue;
+    const bool wired = a == 0 ? ref_x.connected() : a == 1 ? ref_y.connected() : ref_z.connected();
+    if (!wired) {
+      finish(false, ManualError::kNotAvailable, ctx);
+      return;
+    }
+    begin_move(a, a == axis_ ? prof_.pos : hold_[a], params_.home_search_mm_s);
+    prof_.done = true;
+    step_ = Step::kHomeOff;
+    return;
+  }
+  finish(true, ManualError::kNone, ctx);
+  status_.result.x = x_mm.get();
+  status_.result.y = y_mm.get();
+  status_.result.z = z_mm.get();
+}
+
+void ManualMotion::begin_touch_side() noexcept {
+  int a = 2;
+  side_ = -1;
+  TouchTarget t = req_.target;
+  if (t == TouchTarget::kCenter) {
+    t = touch_index_ == 0   ? TouchTarget::kXPlus
+        : touch_index_ == 1 ? TouchTarget::kXMinus
+        : touch_index_ == 2 ? TouchTarget::kYPlus
+                            : TouchTarget::kYMinus;
+  }
+  switch (t) {
+    case TouchTarget::kZ:
+      a = 2;
+      side_ = -1;
+      break;
+    case TouchTarget::kXPlus:
+      a = 0;
+      side_ = 1;
+      break;
+    case TouchTarget::kXMinus:
+      a = 0;
+      side_ = -1;
+      break;
+    case TouchTarget::kYPlus:
+      a = 1;
+      side_ = 1;
+      break;
+    case TouchTarget::kYMinus:
+      a = 1;
+      side_ = -1;
+      break;
+    case TouchTarget::kCenter:
+      break;
+  }
+  const double from = a == axis_ ? prof_.pos : hold_[a];
+  start_[a] = from;
+  begin_move(a, from + side_ * params_.touch_max_mm, params_.touch_fast_mm_s);
+  step_ = Step::kTouchFast;
+}
+
+void ManualMotion::next_touch(const rt::CycleContext& ctx) noexcept {
+  const double r = 0.5 * params_.electrode_d_mm;
+  if (req_.target != TouchTarget::kCenter) {
+    finish(true, ManualError::kNone, ctx);
+    status_.result.x = x_mm.get();
+    status_.result.y = y_mm.get();
+    status_.result.z = z_mm.get();
+    switch (req_.target) {
+      case TouchTarget::kZ:
+        status_.result.z = found_;
+        break;
+      case TouchTarget::kXPlus:
+        status_.result.x = found_ + r;
+        break;
+      case TouchTarget::kXMinus:
+        status_.result.x = found_ - r;
+        break;
+      case TouchTarget::kYPlus:
+        status_.result.y = found_ + r;
+        break;
+      case TouchTarget::kYMinus:
+        status_.result.y = found_ - r;
+        break;
+      case TouchTarget::kCenter:
+        break;
+    }
+    return;
+  }
+  contact_[touch_index_] = found_;
+  ++touch_index_;
+  if (touch_index_ == 1 || touch_index_ == 3) {  // back to the start, then the other side
+    begin_move(axis_, start_[axis_], params_.touch_fast_mm_s);
+    step_ = Step::kReturn;
+  } else if (touch_index_ == 2 || touch_index_ == 4) {  // to the centre of the two contacts
+    begin_move(axis_, 0.5 * (contact_[touch_index_ - 2] + contact_[touch_index_ - 1]),
+               params_.touch_fast_mm_s);
+    step_ = Step::kCentre;
+  }
+}
+
+rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
+  pos_set_x.set(false);
+  pos_set_y.set(false);
+  pos_set_z.set(false);
+  if (manual_ == nullptr) return rt::BlockStatus::kOk;
+
+  rt::ManualRequest r;
+  const bool fresh = manual_->rt_poll(r, last_seq_);
+  if (fresh) status_.seen_seq = r.seq;
+  if (!enable.get()) {
+    if (step_ != Step::kIdle) finish(false, ManualError::kInterrupted, ctx);
+    // A request made while not READY is answered at once.
+    if (fresh && r.op != ManualOp::kStop && r.op != ManualOp::kNone) {
+      req_ = r;
+      finish(false, ManualError::kInterrupted, ctx);
+    }
+    referenced.set(manual_->referenced());
+    mode.set(0);
+    manual_->rt_publish(status_);
+    return rt::BlockStatus::kOk;
+  }
+  if (fresh) start(r, ctx);
+
+  const double dt = dt_s_;
+  switch (step_) {
+    case Step::kIdle:
+      break;
+    case Step::kJog:
+      step_profile(dt);
+      if (req_.op == ManualOp::kJogVelocity && req_.value != 0.0 &&
+          ctx.release - refreshed_ > params_.deadman) {
+        // Dead-man: decelerate to a stop from where the reference is.
+        const double v = prof_.vel;
+        prof_.target = prof_.pos + std::copysign(v * v / (2.0 * params_.accel_mm_s2), v);
+        req_.value = 0.0;
+        status_.result.error = ManualError::kDeadman;
+      }
+      if (prof_.done) {
+        const ManualError e = status_.result.error;
+        finish(e == ManualError::kNone, e, ctx);
+      }
+      break;
+    case Step::kHomeOff:
+      if (switch_on(axis_)) {
+        if (prof_.done) begin_move(axis_, prof_.pos - params_.home_search_max_mm,
+                                   params_.home_search_mm_s);
+        step_profile(dt);
+        if (std::abs(prof_.pos - travel_from_) > params_.home_search_max_mm) {
+          finish(false, ManualError::kNoSwitch, ctx);
+        }
+      } else {
+        stop_now();
+        begin_move(axis_, prof_.pos + params_.home_search_max_mm, params_.home_search_mm_s);
+        step_ = Step::kHomeSearch;
+      }
+      break;
+    case Step::kHomeSearch:
+      if (switch_on(axis_)) {
+        stop_now();
+        begin_move(axis_, prof_.pos - params_.home_back_off_mm, params_.home_search_mm_s);
+        step_ = Step::kHomeBack;
+      } else {
+        step_profile(dt);
+        if (prof_.done) finish(false, ManualError::kNoSwitch, ctx);
+      }
+      break;
+    case Step::kHomeBack:
+      step_profile(dt);
+      if (prof_.done) {
+        if (switch_on(axis_)) {
+          finish(false, ManualError::kNoSwitch, ctx);  // it did not release: a stuck switch
+        } else {
+          begin_move(axis_, prof_.pos + 2.0 * params_.home_back_off_mm, params_.home_latch_mm_s);
+          step_ = Step::kHomeLatch;
+        }
+      }
+      break;
+    case Step::kHomeLatch:
+      if (switch_on(axis_)) {
+        stop_now();
+        const double v = axis_ == 0   ? params_.home_x_mm
+                         : axis_ == 1 ? params_.home_y_mm
+                                      : params_.home_z_mm;
+        (axis_ == 0 ? pos_value_x_mm : axis_ == 1 ? pos_value_y_mm : pos_value_z_mm).set(v);
+        (axis_ == 0 ? pos_set_x : axis_ == 1 ? pos_set_y : pos_set_z).set(true);
+        settle_cycles_ = 0;
+        step_ = Step::kHomeSettle;
+      } else {
+        step_profile(dt);
+        if (prof_.done) finish(false, ManualError::kNoSwitch, ctx);
+      }
+      break;
+    case Step::kHomeSettle:
+      // The driver sets the encoder at the end of the latch cycle; the reading jumps in the
+      // next. Still meanwhile; then every reference restarts from the new readings.
+      if (++settle_cycles_ >= 2) {
+        manual_->bump_position_epoch();
+        manual_->set_referenced(axis_);
+        for (int k = 0; k < 3; ++k) hold_[k] = pos(k);
+        stop_now();
+        next_home_axis(ctx);
+      } else if (settle_cycles_ == 1) {
+        manual_->bump_position_epoch();  // the reading has jumped: restart the supervisor's model
+      }
+      break;
+    case Step::kTouchFast:
+      if (contact.get()) {
+        stop_now();
+        begin_move(axis_, prof_.pos - side_ * params_.touch_back_off_mm, params_.touch_fast_mm_s);
+        step_ = Step::kTouchBack;
+      } else {
+        step_profile(dt);
+        if (prof_.done) {  // no contact within touch_max_mm: back to the start, fail
+          begin_move(axis_, start_[axis_], params_.touch_fast_mm_s);
+          status_.result.error = ManualError::kNoContact;
+          step_ = Step::kReturn;
+        }
+      }
+      break;
+    case Step::kTouchBack:
+      step_profile(dt);
+      if (prof_.done && !contact.get()) {
+        begin_move(axis_, prof_.pos + side_ * 2.0 * params_.touch_back_off_mm,
+                   params_.touch_slow_mm_s);
+        step_ = Step::kTouchSlow;
+      }
+      break;
+    case Step::kTouchSlow:
+      if (contact.get()) {
+        found_ = pos(axis_);
+        stop_now();
+        begin_move(axis_, prof_.pos - side_ * params_.touch_back_off_mm, params_.touch_fast_mm_s);
+        step_ = Step::kTouchOff;
+      } else {
+        step_profile(dt);
+        if (prof_.done) {
+          begin_move(axis_, start_[axis_], params_.touch_fast_mm_s);
+          status_.result.error = ManualError::kNoContact;
+          step_ = Step::kReturn;
+        }
+      }
+      break;
+    case Step::kTouchOff:
+      step_profile(dt);
+      if (prof_.done) {
+        if (req_.target == TouchTarget::kCenter) {
+          next_touch(ctx);
+        } else {  // every single touch ends back at its start point
+          begin_move(axis_, start_[axis_], params_.touch_fast_mm_s);
+          step_ = Step::kReturn;
+        }
+      }
+      break;
+    case Step::kReturn:
+      step_profile(dt);
+      if (prof_.done) {
+        if (status_.result.error != ManualError::kNone) {
+          finish(false, status_.result.error, ctx);
+        } else if (req_.target == TouchTarget::kCenter && touch_index_ < 4) {
+          begin_touch_side();
+        } else {
+          next_touch(ctx);
+        }
+      }
+      break;
+    case Step::kCentre:
+      step_profile(dt);
+      if (prof_.done) {
+        if (touch_index_ >= 4) {
+          finish(true, ManualError::kNone, ctx);
+          const double radius = 0.5 * params_.electrode_d_mm;
+          status_.result.x = 0.5 * (contact_[0] + contact_[1]);
+          status_.result.y = 0.5 * (contact_[2] + contact_[3]);
+          status_.result.z = z_mm.get();
+          status_.result.size = (contact_[0] + radius) - (contact_[1] - radius);
+        } else {
+          begin_touch_side();
+        }
+      }
+      break;
+  }
+  if (step_ == Step::kHomeSettle) {  // the readings jump: no position correction now
+    vx_cmd_mm_s.set(0.0);
+    vy_cmd_mm_s.set(0.0);
+    vz_cmd_mm_s.set(0.0);
+  } else if (step_ != Step::kIdle) {
+    command_axes();
+  }
+  mode.set(static_cast<std::int64_t>(status_.mode));
+  referenced.set(manual_->referenced());
+  manual_->rt_publish(status_);
+  return rt::BlockStatus::kOk;
+}
+
+}  // namespace edm::programs
