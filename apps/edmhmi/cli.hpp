@@ -3,6 +3,7 @@
 // (DESIGN §4: exit 0 ok, 1 runtime failure or alarm, 2 bad input.)
 
 #include <atomic>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,12 +22,33 @@ inline constexpr int kExitInterrupted = 130;
 /// The arguments of each command, filled by CLI11 in main.cpp.
 struct CheckArgs {
   std::string machine{EDM_DEFAULT_MACHINE};
+  std::string offsets;  // --offsets FILE: the work frames as offset.get returns them; "" = zero
   std::string part;
 };
 struct RunArgs {
   bool detach{false};
   bool quiet{false};
+  bool dry_run{false};
+  int from_line{0};                  // --from N: resume at source line N (0: from the start)
+  std::optional<double> depth_done;  // --depth-done MM
   std::string part;
+};
+struct HomeArgs {
+  std::string axes;  // "" = every axis
+};
+struct JogArgs {
+  std::string axis;
+  std::optional<double> distance;  // incremental, mm
+  std::optional<double> velocity;  // continuous, mm/s
+  double for_s{0.0};               // continuous: seconds (0: until Ctrl-C)
+};
+struct TouchArgs {
+  std::string target;
+  std::string set_frame;  // --set G54..G59: the result goes into this frame
+};
+struct OffsetArgs {
+  std::vector<std::string> words;  // [G54..G59] [X.. Y.. Z..]
+  bool json{false};
 };
 struct WatchArgs {
   double rate_hz{5.0};
@@ -71,6 +93,11 @@ int cmd_status(const edm::hmi::ConnectionSettings& settings);
 int cmd_stats(const edm::hmi::ConnectionSettings& settings);
 int cmd_machine(std::string_view command, const edm::hmi::ConnectionSettings& settings);
 int cmd_override(double percent, const edm::hmi::ConnectionSettings& settings);
+int cmd_home(const HomeArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_jog(const JogArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_touch(const TouchArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_offset(const OffsetArgs& args, const edm::hmi::ConnectionSettings& settings);
+int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& settings);
 int cmd_watch(const WatchArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_trace(const TraceArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings);

@@ -1,13 +1,17 @@
-// edmhmi run [--detach] [--quiet] PART.nc — interpret against the machine's own tables, upload,
-// start, show progress, print the job report (docs/hmi.md).
+// edmhmi run [--detach] [--quiet] [--dry-run] [--from N [--depth-done MM]] PART.nc — interpret
+// against the machine's own tables and work offsets, upload, start, show progress, print the job
+// report (docs/hmi.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "cli.hpp"
 #include "edm/hmi/gcode.hpp"
 #include "edm/hmi/job_runner.hpp"
+#include "edm/hmi/resume.hpp"
 
 namespace edmhmi {
 
@@ -53,6 +57,63 @@ class ProgressPrinter {
   std::uint64_t last_block_{~std::uint64_t{0}};
 };
 
+std::string xyz(const edm::machining::Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "X %.3f Y %.3f Z %.3f", v.x, v.y, v.z);
+  return buf;
+}
+
+/// --from N: the depth the drilling block on that line already has — --depth-done, else the
+/// runtime's record of the last job when it ended on that very line, else 0 — said on stderr.
+/// Returns the plan, or prints why not and returns nullopt.
+std::optional<edm::hmi::ResumePlan> plan_from(const RunArgs& args, const edm::hmi::GcodeResult& g,
+                                              const edm::hmi::MachineView& machine) {
+  edm::hmi::ResumePlan plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, 0.0);
+  if (plan.ok() && plan.drill) {
+    double depth = 0.0;
+    std::string why;
+    if (args.depth_done) {
+      depth = *args.depth_done;
+      why = "--depth-done";
+    } else if (!machine.last_job) {
+      why = "the runtime has no record of a last job";
+    } else if (machine.last_job->line != plan.line) {
+      why = "the last job (" + machine.last_job->outcome + ") ended on line " +
+            std::to_string(machine.last_job->line) + ", not on line " + std::to_string(plan.line);
+    } else if (!machine.last_job->depth_mm) {
+      why = "the last job's record has no depth";
+    } else {
+      depth = std::max(0.0, *machine.last_job->depth_mm);
+      why = "the runtime's record of the last job (" + machine.last_job->outcome + " on line " +
+            std::to_string(plan.line) + ")";
+    }
+    std::fprintf(stderr, "edmhmi: line %d drills on from %.4f mm deep (%s)\n", plan.line, depth,
+                 why.c_str());
+    plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, depth);
+  } else if (plan.ok() && args.depth_done && *args.depth_done > 0.0) {
+    plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, *args.depth_done);
+  }
+  if (!plan.ok()) {
+    std::fprintf(stderr, "%s: --from %d: %s\n", args.part.c_str(), args.from_line,
+                 plan.error.c_str());
+    return std::nullopt;
+  }
+  const edm::machining::MotionBlock& first = plan.blocks[plan.prologue];
+  std::fprintf(stderr,
+               "edmhmi: resuming at line %d (block %zu of %zu): rapid up to Z %.3f, over and down "
+               "to %s, then rotation %s, flushing %s, E%d\n",
+               plan.line, plan.first + 1, g.blocks.size(), plan.clearance_z_mm,
+               xyz(plan.blocks[plan.prologue - 4].target).c_str(),
+               plan.blocks[plan.prologue - 3].on ? "on" : "off",
+               plan.blocks[plan.prologue - 2].on ? "on" : "off",
+               plan.blocks[plan.prologue - 1].condition);
+  if (plan.drill) {
+    std::fprintf(stderr, "edmhmi: line %d: depth done %.4f mm, Z travel %.4f mm\n", first.line,
+                 plan.depth_done_mm, plan.blocks[*plan.drill].z_travel_mm);
+  }
+  return plan;
+}
+
 }  // namespace
 
 int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
@@ -72,8 +133,10 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
   }
   // The program starts where the electrode is now, against the conditions and limits of the
   // machine it runs on.
+  // In work coordinates: the frames are the machine's (offset.get).
   edm::hmi::GcodeOptions options;
   options.start_mm = machine.position;
+  options.offsets = machine.offsets;
   const edm::hmi::GcodeResult g = edm::hmi::interpret_gcode(text, part, machine.tables, options);
   if (!g.ok()) {
     for (const std::string& m : g.messages()) std::fprintf(stderr, "%s\n", m.c_str());
@@ -86,12 +149,31 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
                  part.c_str(), g.blocks.size(), g.drill_blocks, g.drill_depth_mm,
                  g.electrode_wear_mm, machine.name.c_str(), settings.host.c_str(),
                  unsigned{settings.port});
+    if (!machine.offsets_known) {
+      std::fprintf(stderr,
+                   "edmhmi: this edmplc has no work offsets (offset.get): G54..G59 are 0\n");
+    }
   }
 
   edm::hmi::RunRequest req;
   req.part = part;
   req.machine = machine.name;
   req.blocks = g.blocks;
+  req.frames = g.frames;
+  if (args.from_line > 0) {
+    std::optional<edm::hmi::ResumePlan> plan = plan_from(args, g, machine);
+    if (!plan) return kExitBadInput;
+    req.blocks = std::move(plan->blocks);
+    req.frames = std::move(plan->frames);
+  } else if (args.depth_done) {
+    return usage("run: --depth-done goes with --from N");
+  }
+  req.dry_run = args.dry_run;
+  if (args.dry_run && !quiet) {
+    std::fprintf(stderr,
+                 "edmhmi: dry run: the generator stays off; drilling and orbit blocks are "
+                 "skipped\n");
+  }
   req.detach = detach;
   ProgressPrinter printer(quiet);
   edm::hmi::RunCallbacks cb;

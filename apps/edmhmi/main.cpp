@@ -1,7 +1,8 @@
 // edmhmi — the HMI process's command line (DESIGN §4, docs/hmi.md). One file per command group:
 // cmd_check.cpp (offline interpretation), cmd_run.cpp (upload, start, follow, report),
-// cmd_status.cpp (status, stats), cmd_machine.cpp (hold, resume, stop, estop, reset),
-// cmd_watch.cpp (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
+// cmd_status.cpp (status, stats), cmd_machine.cpp (hold, resume, stop, estop, reset, override),
+// cmd_manual.cpp (home, jog, touch), cmd_offset.cpp (offset), cmd_mdi.cpp (mdi), cmd_watch.cpp
+// (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
 
 #include <csignal>
 #include <cstdio>
@@ -44,6 +45,9 @@ int run(int argc, char** argv) {
                                    "interpret PART.nc offline against a machine's "
                                    "conditions and soft limits; nothing is sent");
   c->add_option("--machine", check.machine, "the machine config")->capture_default_str();
+  c->add_option("--offsets", check.offsets,
+                "the work frames G54..G59 as JSON, as `edmhmi offset --json` prints them "
+                "(default: all zero)");
   c->add_option("PART.nc", check.part, "the part program")->required();
 
   RunArgs run;
@@ -53,6 +57,16 @@ int run(int argc, char** argv) {
       "not finish or an alarm came");
   r->add_flag("--detach", run.detach, "return once the job has started");
   r->add_flag("--quiet", run.quiet, "no progress, only the report");
+  r->add_flag("--dry-run", run.dry_run,
+              "the motion with the generator off: drilling and orbit blocks are skipped");
+  r->add_option("--from", run.from_line,
+                "resume at source line N (the first block whose line is >= N), after a safe "
+                "re-approach")
+      ->check(CLI::PositiveNumber);
+  r->add_option("--depth-done", run.depth_done,
+                "with --from at a drilling line: the depth the hole already has, mm (default: "
+                "the runtime's record of the interrupted job)")
+      ->check(edm::apps::kFinite);
   r->add_option("PART.nc", run.part, "the part program")->required();
 
   app.add_subcommand("status", "machine state, job, key variables, last job's figures");
@@ -86,6 +100,37 @@ int run(int argc, char** argv) {
   ov->add_option("PERCENT", override_pct, "percent of the programmed feed")
       ->required()
       ->check(CLI::Range(0.0, 150.0));
+
+  HomeArgs home;
+  CLI::App* h = app.add_subcommand("home", "reference the axes (all, or e.g. Z or XY)");
+  h->add_option("AXES", home.axes, "some of X, Y, Z (default: every axis)");
+
+  JogArgs jog;
+  CLI::App* j = app.add_subcommand(
+      "jog", "move one axis: DIST mm (incremental), or --velocity V mm/s while held");
+  j->add_option("AXIS", jog.axis, "X, Y or Z")->required();
+  j->add_option("DIST", jog.distance, "mm, 0.001..10 in magnitude; the sign is the direction")
+      ->check(edm::apps::kFinite);
+  j->add_option("--velocity", jog.velocity, "mm/s; the sign is the direction")
+      ->check(edm::apps::kFinite);
+  j->add_option("--for", jog.for_s, "with --velocity: seconds (default: until Ctrl-C)")
+      ->check(edm::apps::kPositive);
+
+  TouchArgs touch;
+  CLI::App* tc =
+      app.add_subcommand("touch", "touch off by electrical contact: z, x+, x-, y+, y- or center");
+  tc->add_option("TARGET", touch.target, "z | x+ | x- | y+ | y- | center")->required();
+  tc->add_option("--set", touch.set_frame, "put the result into this work frame (G54..G59)");
+
+  OffsetArgs offset;
+  CLI::App* of = app.add_subcommand(
+      "offset", "print the work frames, or set one: offset G54 X12.5 Y-3 Z-41.25");
+  of->add_option("WORDS", offset.words, "[G54..G59] [X<mm>] [Y<mm>] [Z<mm>]");
+  of->add_flag("--json", offset.json, "print the frames as JSON (for check --offsets)");
+
+  std::string mdi_line;
+  CLI::App* md = app.add_subcommand("mdi", "run one G-code line from where the electrode is");
+  md->add_option("LINE", mdi_line, "the G-code line, quoted")->required();
 
   ServeArgs serve;
   CLI::App* s = app.add_subcommand("serve", "the operator's page in a browser (docs/web.md)");
@@ -127,6 +172,11 @@ int run(int argc, char** argv) {
     return cmd_serve(serve, settings);
   }
   if (command == "override") return cmd_override(override_pct, settings);
+  if (command == "home") return cmd_home(home, settings);
+  if (command == "jog") return cmd_jog(jog, settings);
+  if (command == "touch") return cmd_touch(touch, settings);
+  if (command == "offset") return cmd_offset(offset, settings);
+  if (command == "mdi") return cmd_mdi(mdi_line, settings);
   return cmd_machine(command, settings);
 }
 

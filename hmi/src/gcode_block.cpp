@@ -33,7 +33,13 @@ struct CodeGroup {
 };
 constexpr CodeGroup kCodeGroups[] = {
     {'G', {0, 10, 20, 30}, 4, &Block::motion_g, "motion codes (modal group 1: G00 G01 G02 G03)"},
-    {'G', {40, 1600}, 2, &Block::nonmodal_g, "non-modal codes (group 0: G04 G160)"},
+    {'G',
+     {40, 1600, 920, 921},
+     4,
+     &Block::nonmodal_g,
+     "non-modal codes (group 0: G04 G160 G92 G92.1)"},
+    {'G', {540, 550, 560, 570}, 4, &Block::frame_g, "work-frame codes (modal group 12: G54..G59)"},
+    {'G', {580, 590}, 2, &Block::frame_g, "work-frame codes (modal group 12: G54..G59)"},
     {'G', {170}, 1, &Block::plane_g, "plane codes (modal group 2)"},
     {'G', {210}, 1, &Block::units_g, "unit codes (modal group 6)"},
     {'G', {900, 910}, 2, &Block::distance_g, "distance-mode codes (modal group 3: G90 G91)"},
@@ -71,6 +77,16 @@ class Sorter {
       error(b, &w, "unknown M code " + word_text(w));
     } else if (code == 180 || code == 190) {
       error(b, &w, word_text(w) + " is not supported: arcs are in the XY plane only (G17)");
+    } else if (code == 591 || code == 592 || code == 593) {
+      error(b, &w, word_text(w) + " is not supported: the work frames are G54..G59");
+    } else if (code == 530) {
+      error(b, &w,
+            word_text(w) +
+                " (a move in machine coordinates) is not supported: select a work "
+                "frame G54..G59 whose offset is zero instead");
+    } else if (code == 922 || code == 923) {
+      error(b, &w,
+            word_text(w) + " is not supported: G92 offsets are not retained; G92.1 clears them");
     } else if (code == 200) {
       error(b, &w, word_text(w) + " (inch units) is not supported: this dialect is mm only (G21)");
     } else {
@@ -132,14 +148,33 @@ class Sorter {
       }
     }
     if (!ok) return false;
-    // G04 and G160 run on their own: no motion code, axis or centre words beside them.
-    if (b.nonmodal_g != nullptr) {
-      for (const Word* w : {b.motion_g, b['X'], b['Y'], b['Z'], b['I'], b['J']}) {
-        if (w != nullptr) {
-          error(b, w, word_text(*w) + " cannot share a block with " + word_text(*b.nonmodal_g));
-          ok = false;
-        }
+    if (b.nonmodal_g == nullptr) return ok;
+    const int nonmodal = code10(*b.nonmodal_g);
+    // G04, G160 and G92.1 run on their own: no motion code, axis or centre words beside them;
+    // G92's axis words are its own (the coordinates the current point gets).
+    const bool g92 = nonmodal == 920;
+    for (const Word* w : {b.motion_g, g92 ? nullptr : b['X'], g92 ? nullptr : b['Y'],
+                          g92 ? nullptr : b['Z'], b['I'], b['J']}) {
+      if (w != nullptr) {
+        error(b, w, word_text(*w) + " cannot share a block with " + word_text(*b.nonmodal_g));
+        ok = false;
       }
+    }
+    if (g92 && b.first_axis() == nullptr) {
+      error(b, b.nonmodal_g,
+            "G92 needs X, Y and/or Z (the coordinates the current point is to have)");
+      ok = false;
+    }
+    // Which comes first, the new frame or the offset change, is a guess either way: refuse it.
+    if ((g92 || nonmodal == 921) && b.frame_g != nullptr) {
+      const bool frame_first = b.frame_g->col < b.nonmodal_g->col;
+      const Word* second = frame_first ? b.nonmodal_g : b.frame_g;
+      const Word* first = frame_first ? b.frame_g : b.nonmodal_g;
+      error(b, second,
+            word_text(*second) + " conflicts with " + word_text(*first) +
+                " in the same block: select the work frame and set or clear the G92 offset in "
+                "separate blocks");
+      ok = false;
     }
     return ok;
   }

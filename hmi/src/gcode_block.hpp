@@ -17,7 +17,8 @@ struct Block {
   int line{0};
   const Word* first{nullptr};
   const Word* motion_g{nullptr};        // group 1: G00 G01 G02 G03
-  const Word* nonmodal_g{nullptr};      // group 0: G04 G160
+  const Word* nonmodal_g{nullptr};      // group 0: G04 G160 G92 G92.1
+  const Word* frame_g{nullptr};         // group 12: G54 .. G59
   const Word* plane_g{nullptr};         // group 2: G17
   const Word* units_g{nullptr};         // group 6: G21
   const Word* distance_g{nullptr};      // group 3: G90 G91

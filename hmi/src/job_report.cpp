@@ -25,6 +25,48 @@ std::string percent(const std::optional<double>& f) {
   return f ? fmt("%.2f %%", *f * 100.0) : std::string("n/a");
 }
 
+std::string xyz(const machining::Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f Z %.4f", v.x, v.y, v.z);
+  return buf;
+}
+
+std::string xy(const machining::Vec3& v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f", v.x, v.y);
+  return buf;
+}
+
+/// The work frame, the holes and the end position, in work and machine coordinates. Without the
+/// program's frames (`edmhmi status` after a restart) only the machine's end position.
+template <class Row>
+void position_rows(const JobReport& r, Row&& row) {
+  const std::optional<BlockFrame>& frame = r.targets.end_frame;
+  if (frame) {
+    row("work frame", frame_name(frame->frame) + (frame->g92 ? " + G92" : "") + ", origin at " +
+                          xyz(frame->offset_mm) + " machine");
+  }
+  const std::vector<HolePosition>& holes = r.targets.holes;
+  for (std::size_t i = 0; i < holes.size() && i < kReportHoles; ++i) {
+    const HolePosition& h = holes[i];
+    row("hole (line " + std::to_string(h.line) + ")", xy(h.work_mm) + " " + frame_name(h.frame) +
+                                                          " = " + xy(h.machine_mm) + " machine, " +
+                                                          fmt("%.4f mm deep", h.depth_mm));
+  }
+  if (holes.size() > kReportHoles) {
+    row("", "... and " + std::to_string(holes.size() - kReportHoles) + " more holes");
+  }
+  const JobFigures& f = r.end;
+  if (!f.x_mm || !f.y_mm || !f.z_mm) return;
+  const machining::Vec3 machine{*f.x_mm, *f.y_mm, *f.z_mm};
+  if (frame) {
+    row("end position", xyz(to_work(machine, frame->offset_mm)) + " " + frame_name(frame->frame) +
+                            " = " + xyz(machine) + " machine");
+  } else {
+    row("end position", xyz(machine) + " machine");
+  }
+}
+
 }  // namespace
 
 std::optional<double> JobFigures::short_fraction() const {
@@ -68,16 +110,37 @@ JobFigures figures_from_status(const bridge::StatusMessage& s) {
   return f;
 }
 
+double drill_depth_of(const machining::MotionBlock& b) noexcept {
+  return b.depth_mm > 0.0 ? b.depth_mm : -b.target.z;
+}
+
 ProgramTargets program_targets(const std::vector<machining::MotionBlock>& blocks) {
   ProgramTargets t;
   t.blocks = blocks.size();
   for (const auto& b : blocks) {
     if (b.kind == MotionKind::kDrill)
-      t.deepest_drill_mm = std::max(t.deepest_drill_mm, -b.target.z);
+      t.deepest_drill_mm = std::max(t.deepest_drill_mm, drill_depth_of(b));
     if (b.kind == MotionKind::kOrbitFinish) {
       t.largest_radius_mm = std::max(t.largest_radius_mm, b.final_radius_mm);
     }
   }
+  return t;
+}
+
+ProgramTargets program_targets(const std::vector<machining::MotionBlock>& blocks,
+                               const std::vector<BlockFrame>& frames) {
+  ProgramTargets t = program_targets(blocks);
+  if (frames.size() != blocks.size() || blocks.empty()) return t;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const machining::MotionBlock& b = blocks[i];
+    if (b.kind != MotionKind::kDrill) continue;
+    t.holes.push_back({.line = b.line,
+                       .machine_mm = b.target,
+                       .work_mm = to_work(b.target, frames[i].offset_mm),
+                       .frame = frames[i].frame,
+                       .depth_mm = drill_depth_of(b)});
+  }
+  t.end_frame = frames.back();
   return t;
 }
 
@@ -170,6 +233,7 @@ std::string format_report(const JobReport& r) {
     used += fmt(", %.3f mm measured", *r.electrode_at_start_mm - *f.electrode_mm);
   }
   row("electrode used", used);
+  position_rows(r, row);
   if (f.electrode_mm) row("electrode left", fmt("%.3f mm", *f.electrode_mm));
   row("pulses", f.pulses ? fmt("%.0f", *f.pulses) : std::string("n/a"));
   row("short circuits", percent(f.short_fraction()));

@@ -1,5 +1,6 @@
 #include "edm/hmi/job_runner.hpp"
 
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -80,6 +81,37 @@ std::string describe_alarm(const Json& e) {
          "): " + e.value("text", std::string());
 }
 
+std::optional<LastJob> last_job_from_status(const Json& status) {
+  const auto job = status.find("job");
+  if (job == status.end() || !job->is_object()) return std::nullopt;
+  const auto last = job->find("last");
+  if (last == job->end() || !last->is_object()) return std::nullopt;
+  try {
+    LastJob j;
+    j.outcome = last->value("outcome", std::string());
+    j.block = last->value("block", std::uint64_t{0});
+    j.line = last->value("line", std::int32_t{0});
+    if (const auto d = last->find("depth_mm"); d != last->end() && d->is_number()) {
+      const double v = d->get<double>();
+      if (std::isfinite(v)) j.depth_mm = v;
+    }
+    return j;
+  } catch (const Json::exception&) {
+    return std::nullopt;
+  }
+}
+
+WorkOffsets fetch_offsets(bridge::Client& client) {
+  const bridge::Reply r = client.request("offset.get");
+  if (!r) throw bridge::ClientError("offset.get: " + reply_error(r), r.code);
+  WorkOffsets o;
+  std::string error;
+  if (!offsets_from_json(r.body, o, error)) {
+    throw bridge::ClientError("offset.get: malformed reply: " + error);
+  }
+  return o;
+}
+
 MachineView fetch_machine(bridge::Client& client) {
   MachineView m;
   const bridge::Reply info = client.request("machine.info");
@@ -88,13 +120,30 @@ MachineView fetch_machine(bridge::Client& client) {
   if (!bridge::from_json(info.body, m.tables, m.name, error)) {
     throw bridge::ClientError("machine.info: malformed reply: " + error);
   }
+  if (const auto manual = info.body.find("manual");
+      manual != info.body.end() && manual->is_object()) {
+    if (const auto d = manual->find("deadman_ms"); d != manual->end() && d->is_number()) {
+      const double v = d->get<double>();
+      if (std::isfinite(v) && v > 0.0) m.deadman_ms = v;
+    }
+  }
   const bridge::Reply st = client.request("status");
   if (!st || !bridge::from_json(st.body, m.status, error)) {
     throw bridge::ClientError("status: " + (st ? "malformed reply: " + error : reply_error(st)),
                               st.code);
   }
+  m.last_job = last_job_from_status(st.body);
   const JobFigures f = figures_from_status(m.status);
   m.position = {f.x_mm.value_or(0.0), f.y_mm.value_or(0.0), f.z_mm.value_or(0.0)};
+  const bridge::Reply off = client.request("offset.get");
+  if (off) {
+    if (!offsets_from_json(off.body, m.offsets, error)) {
+      throw bridge::ClientError("offset.get: malformed reply: " + error);
+    }
+    m.offsets_known = true;
+  } else if (off.code != bridge::ErrorCode::kUnknownOp) {
+    throw bridge::ClientError("offset.get: " + reply_error(off), off.code);
+  }
   return m;
 }
 
@@ -118,7 +167,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
                    "); clear the cause, then edmhmi reset");
   }
 
-  const bridge::Reply up = client.upload_program(req.blocks);
+  const bridge::Reply up = client.upload_program(req.blocks, 4096, req.slot);
   if (!up) {
     RunResult r = refused("program refused: " + reply_error(up));
     r.locations = commit_issues(up, req.part);
@@ -161,14 +210,17 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   if (const bridge::Reply s = client.subscribe({"status", "alarm", "progress"}, req.rate_hz); !s) {
     return refused("subscribe: " + reply_error(s));
   }
-  if (const bridge::Reply s = client.request("cycle.start"); !s) {
+  Json start = Json::object();
+  if (!req.slot.empty()) start["slot"] = req.slot;
+  if (req.dry_run) start["dry_run"] = true;
+  if (const bridge::Reply s = client.request("cycle.start", start); !s) {
     return refused("cycle.start: " + reply_error(s));
   }
 
   RunResult result;
   result.report.part = req.part;
   result.report.machine = req.machine;
-  result.report.targets = program_targets(req.blocks);
+  result.report.targets = program_targets(req.blocks, req.frames);
   result.report.electrode_at_start_mm = figures_from_status(before).electrode_mm;
   if (req.detach) {
     result.outcome = RunOutcome::kDetached;
@@ -256,7 +308,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
     if (last.job_block < req.blocks.size()) {
       const machining::MotionBlock& b = req.blocks[last.job_block];
       v.kind = b.kind;
-      if (b.kind == machining::MotionKind::kDrill) v.drill_target_mm = -b.target.z;
+      if (b.kind == machining::MotionKind::kDrill) v.drill_target_mm = drill_depth_of(b);
     }
     v.elapsed_s =
         v.figures.time_s.value_or(std::chrono::duration<double>(Clock::now() - t0).count());

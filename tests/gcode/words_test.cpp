@@ -135,7 +135,7 @@ TEST(GcodeModalGroups, OneWordPerGroupPerBlock) {
             "group 6)");
   EXPECT_EQ(first_error("G04 P1 G160 R1"),
             "t.nc:1:8: 'G160' conflicts with 'G04' in the same block: both are non-modal codes "
-            "(group 0: G04 G160)");
+            "(group 0: G04 G160 G92 G92.1)");
   EXPECT_EQ(first_error("M03 M05"),
             "t.nc:1:5: 'M05' conflicts with 'M03' in the same block: both are rotation codes "
             "(modal group 7: M03 M05)");

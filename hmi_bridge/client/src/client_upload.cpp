@@ -13,8 +13,10 @@ constexpr std::size_t kChunkBytes = 512 * 1024;  // well under the server's 1 Mi
 }  // namespace
 
 Reply Client::upload_program(std::span<const machining::MotionBlock> blocks,
-                             std::size_t chunk_blocks) {
-  Reply r = request("program.begin", {{"blocks", blocks.size()}});
+                             std::size_t chunk_blocks, std::string_view slot) {
+  Json begin = {{"blocks", blocks.size()}};
+  if (!slot.empty()) begin["slot"] = std::string(slot);
+  Reply r = request("program.begin", begin);
   if (!r) {
     return r;
   }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "edm/bridge/codec.hpp"
+#include "edm/hmi/work_offsets.hpp"
 #include "edm/machining/motion_block.hpp"
 
 namespace edm::hmi {
@@ -32,13 +33,32 @@ struct JobFigures {
 
 JobFigures figures_from_status(const bridge::StatusMessage& s);
 
+/// A drilled hole of the program: where (both coordinate systems) and how deep.
+struct HolePosition {
+  std::int32_t line{0};
+  machining::Vec3 machine_mm{};  // the drilling block's target: X, Y and the nominal bottom Z
+  machining::Vec3 work_mm{};     // the same in its work frame
+  std::uint8_t frame{0};         // 0 = G54 .. 5 = G59
+  double depth_mm{0.0};          // below the work surface (MotionBlock::depth_mm)
+};
+
+/// A drilling block's depth below the work surface: depth_mm, or −target.z for a block made
+/// without work offsets (depth_mm 0, machine Z 0 the surface).
+double drill_depth_of(const machining::MotionBlock& b) noexcept;
+
 /// What the program asked for, from its motion blocks.
 struct ProgramTargets {
   std::size_t blocks{0};
-  double deepest_drill_mm{0.0};   // max −target.z of the drilling blocks (0: none)
-  double largest_radius_mm{0.0};  // max final_radius_mm of the orbit-finishing blocks (0: none)
+  double deepest_drill_mm{0.0};     // max drill_depth_of() of the drilling blocks (0: none)
+  double largest_radius_mm{0.0};    // max final_radius_mm of the orbit-finishing blocks (0: none)
+  std::vector<HolePosition> holes;  // with frames only: each drilling block, in order
+  std::optional<BlockFrame> end_frame;  // with frames only: the frame of the last block
 };
 ProgramTargets program_targets(const std::vector<machining::MotionBlock>& blocks);
+/// With the work frame of each block (GcodeResult::frames, same size as `blocks`): also the
+/// holes and the frame at the end, for the report's work and machine coordinates.
+ProgramTargets program_targets(const std::vector<machining::MotionBlock>& blocks,
+                               const std::vector<BlockFrame>& frames);
 
 /// The live view the progress line is drawn from.
 struct ProgressView {
@@ -79,7 +99,10 @@ struct JobReport {
 /// FAULT/ESTOP: an older cause is stale), blocks done (all of them when finished) and the figures.
 void fill_from_status(JobReport& r, const bridge::StatusMessage& s);
 
-/// The multi-line report edmhmi prints at the end of `run` (and `status` of a finished job).
+/// The multi-line report edmhmi prints at the end of `run` (and `status` of a finished job). With
+/// the program's frames known it also shows the work frame, each hole (up to kReportHoles) and the
+/// end position in work and machine coordinates.
+inline constexpr std::size_t kReportHoles = 10;
 std::string format_report(const JobReport& r);
 
 }  // namespace edm::hmi

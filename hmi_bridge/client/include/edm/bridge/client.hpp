@@ -118,9 +118,11 @@ class Client {
   Reply trace_stop();
 
   /// program.begin / program.chunk × n / program.commit with the CRC-32 checksum. Returns the
-  /// commit's reply, or the first failed one (then program.abort is sent).
+  /// commit's reply, or the first failed one (then program.abort is sent). `slot` names the
+  /// program slot in program.begin ("main" or "mdi", docs/protocol.md); empty = the server's
+  /// default (main), the field is then not sent.
   Reply upload_program(std::span<const machining::MotionBlock> blocks,
-                       std::size_t chunk_blocks = 4096);
+                       std::size_t chunk_blocks = 4096, std::string_view slot = {});
 
   /// Closes and connects again with the last options, then replays subscriptions and trace.
   /// Throws ClientError like connect().
