@@ -19,7 +19,8 @@ void Plant::init_work() noexcept {
                   p.encoder_offset_z_mm - p.work_surface_z_mm};
   ref_pos_mm_ = {p.ref_x_mm, p.ref_y_mm, p.ref_z_mm - p.work_surface_z_mm};
   for (std::size_t a = 0; a < 3; ++a) {
-    ref_trip_mm_[a] = ref_pos_mm_[a] + p.ref_repeat_um * 1e-3 * normal(seed_, Stream::kRefSwitch, a);
+    ref_trip_mm_[a] =
+        ref_pos_mm_[a] + p.ref_repeat_um * 1e-3 * normal(seed_, Stream::kRefSwitch, a);
     ref_on_[a] = axes_[a].position_mm() >= ref_trip_mm_[a];
   }
   switch (tool_) {
@@ -104,8 +105,8 @@ double Plant::touch_distance_um() const noexcept {
   tool.y_mm = axes_[1].position_mm();
   WorkSolid work = work_;
   if (tool_ != Tool::kWire && hole_started_ && hole_bottom_mm_ < 0.0) {
-    const double hw = tool_ == Tool::kTube ? mean_wall_radius_mm()
-                                           : p.tool_width_mm / 2.0 + p.side_gap_mm;
+    const double hw =
+        tool_ == Tool::kTube ? mean_wall_radius_mm() : p.tool_width_mm / 2.0 + p.side_gap_mm;
     const double hl = tool_ == Tool::kTube ? hw : p.tool_length_mm / 2.0 + p.side_gap_mm;
     work.hole = {hole_cx_mm_, hole_cy_mm_, hw, hl, tool_ == Tool::kTube};
     work.hole_depth_mm = -hole_bottom_mm_;

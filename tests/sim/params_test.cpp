@@ -94,9 +94,9 @@ TEST(SimParams, every_field_but_the_electrode_length_and_the_hole_is_load_time_o
   } check;
   SimParams p;
   p.visit(check);
-  EXPECT_EQ(check.runtime_writable,
-            (std::vector<std::string>{"electrode_length_mm", "hole_depth_mm", "hole_x_mm",
-                                      "hole_y_mm"}));
+  EXPECT_EQ(
+      check.runtime_writable,
+      (std::vector<std::string>{"electrode_length_mm", "hole_depth_mm", "hole_x_mm", "hole_y_mm"}));
 }
 
 TEST(SimParams, wire_break_shape_must_be_a_whole_number_in_range) {

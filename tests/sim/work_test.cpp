@@ -45,7 +45,8 @@ bool run_until(Plant& p, const PlantCommands& c, double max_ms,
 }
 
 void run_ms(Plant& p, const PlantCommands& c, double ms) {
-  run_until(p, c, ms, [](const PlantState&) { return false; }, 1000);
+  run_until(
+      p, c, ms, [](const PlantState&) { return false; }, 1000);
 }
 
 PlantCommands velocity(double vx, double vy, double vz) {
@@ -208,14 +209,13 @@ std::vector<double> x_trips(const SimParams& p, std::uint64_t seed, int n) {
   std::vector<double> trips;
   EXPECT_FALSE(plant.state().ref_x);
   for (int k = 0; k < n; ++k) {
-    const bool tripped = run_until(plant, velocity(0.2, 0.0, 0.0), 2000,
-                                   [](const PlantState& s) { return s.ref_x; }, 25);
+    const bool tripped = run_until(
+        plant, velocity(0.2, 0.0, 0.0), 2000, [](const PlantState& s) { return s.ref_x; }, 25);
     EXPECT_TRUE(tripped);
     trips.push_back(plant.state().machine_x_mm);
     const double back_to = plant.state().machine_x_mm - 0.06;
-    EXPECT_TRUE(run_until(plant, velocity(-2.0, 0.0, 0.0), 2000, [&](const PlantState& s) {
-      return s.machine_x_mm < back_to;
-    }));
+    EXPECT_TRUE(run_until(plant, velocity(-2.0, 0.0, 0.0), 2000,
+                          [&](const PlantState& s) { return s.machine_x_mm < back_to; }));
     EXPECT_FALSE(plant.state().ref_x);
   }
   return trips;
@@ -248,8 +248,8 @@ TEST(SimWork, the_z_switch_is_in_machine_coordinates_whatever_the_work_and_encod
   p.ref_z_mm = -199.0;
   Plant plant(p, 2);
   EXPECT_FALSE(plant.state().ref_z);
-  ASSERT_TRUE(run_until(plant, velocity(0.0, 0.0, 0.5), 5000,
-                        [](const PlantState& s) { return s.ref_z; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, velocity(0.0, 0.0, 0.5), 5000, [](const PlantState& s) { return s.ref_z; }, 25));
   EXPECT_NEAR(plant.state().machine_z_mm, -199.0, 3e-3);
   EXPECT_NEAR(plant.state().z_mm, -199.0 - 1234.0, 3e-3);
 }
@@ -292,14 +292,17 @@ std::vector<double> z_touches(const SimParams& p, std::uint64_t seed, int n) {
   Plant plant(p, seed);
   std::vector<double> heights;
   // Slowly enough that the axis settles (a speed change of Δv overshoots by ≈ Δv/ω_n).
-  run_until(plant, touching(0.0, 0.0, -0.2), 1000,
-            [](const PlantState& s) { return s.gap_um < 10.0; }, 25);
+  run_until(
+      plant, touching(0.0, 0.0, -0.2), 1000, [](const PlantState& s) { return s.gap_um < 10.0; },
+      25);
   for (int k = 0; k < n; ++k) {
-    EXPECT_TRUE(run_until(plant, touching(0.0, 0.0, -0.02), 2000,
-                          [](const PlantState& s) { return s.touch_contact; }, 25));
+    EXPECT_TRUE(run_until(
+        plant, touching(0.0, 0.0, -0.02), 2000, [](const PlantState& s) { return s.touch_contact; },
+        25));
     heights.push_back(plant.state().gap_um);  // the tip above the surface (no wear)
-    EXPECT_TRUE(run_until(plant, touching(0.0, 0.0, 0.2), 2000,
-                          [](const PlantState& s) { return s.gap_um > 8.0; }, 25));
+    EXPECT_TRUE(run_until(
+        plant, touching(0.0, 0.0, 0.2), 2000, [](const PlantState& s) { return s.gap_um > 8.0; },
+        25));
     EXPECT_FALSE(plant.state().touch_contact);
   }
   return heights;
@@ -341,11 +344,13 @@ TEST(SimWork, an_x_edge_touch_below_the_surface_senses_the_face) {
   ASSERT_LT(plant.state().machine_z_mm, -1.0);
   EXPECT_FALSE(plant.state().touch_contact);
   // Fast to 0.1 mm from the face (a stop from 5 mm/s overshoots by tens of µm), then slowly.
-  ASSERT_TRUE(run_until(plant, touching(-5.0, 0.0, 0.0), 1000,
-                        [](const PlantState& s) { return s.machine_x_mm < 57.6; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, touching(-5.0, 0.0, 0.0), 1000,
+      [](const PlantState& s) { return s.machine_x_mm < 57.6; }, 25));
   EXPECT_FALSE(plant.state().touch_contact);
-  ASSERT_TRUE(run_until(plant, touching(-0.02, 0.0, 0.0), 8000,
-                        [](const PlantState& s) { return s.touch_contact; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, touching(-0.02, 0.0, 0.0), 8000, [](const PlantState& s) { return s.touch_contact; },
+      25));
   const double side_gap_um = (plant.state().machine_x_mm - 0.5 - 57.0) * 1e3;
   EXPECT_GT(side_gap_um, 1.0 - 4 * 0.3);
   EXPECT_LT(side_gap_um, 1.0 + 4 * 0.3 + 0.01);
@@ -356,10 +361,12 @@ TEST(SimWork, a_sinking_electrode_touches_an_edge_with_its_side) {
   p.start_y_mm = -70.0;                      // the −Y face at −50
   Plant plant(p, 9);
   run_ms(plant, velocity(0.0, 0.0, -10.0), 100);
-  ASSERT_TRUE(run_until(plant, touching(0.0, 5.0, 0.0), 5000,
-                        [](const PlantState& s) { return s.machine_y_mm > -55.1; }, 25));
-  ASSERT_TRUE(run_until(plant, touching(0.0, 0.02, 0.0), 8000,
-                        [](const PlantState& s) { return s.touch_contact; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, touching(0.0, 5.0, 0.0), 5000,
+      [](const PlantState& s) { return s.machine_y_mm > -55.1; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, touching(0.0, 0.02, 0.0), 8000, [](const PlantState& s) { return s.touch_contact; },
+      25));
   EXPECT_NEAR((-50.0 - (plant.state().machine_y_mm + 5.0)) * 1e3, 1.0, 4 * 0.3 + 0.01);
 }
 
@@ -370,14 +377,16 @@ std::vector<double> bore_touches(Plant& plant) {
   for (const auto& d : dirs) {
     const double x0 = plant.state().machine_x_mm, y0 = plant.state().machine_y_mm;
     // Fast to within 0.1 mm of the wall would need to know it: approach at 0.5 mm/s instead.
-    EXPECT_TRUE(run_until(plant, touching(0.5 * d[0], 0.5 * d[1], 0.0), 20000,
-                          [](const PlantState& s) { return s.touch_contact; }, 25));
+    EXPECT_TRUE(run_until(
+        plant, touching(0.5 * d[0], 0.5 * d[1], 0.0), 20000,
+        [](const PlantState& s) { return s.touch_contact; }, 25));
     at.push_back(d[0] != 0 ? plant.state().machine_x_mm : plant.state().machine_y_mm);
-    EXPECT_TRUE(run_until(plant, touching(-2.0 * d[0], -2.0 * d[1], 0.0), 5000,
-                          [&](const PlantState& s) {
-                            return std::hypot(s.machine_x_mm - x0, s.machine_y_mm - y0) < 0.01;
-                          },
-                          25));
+    EXPECT_TRUE(run_until(
+        plant, touching(-2.0 * d[0], -2.0 * d[1], 0.0), 5000,
+        [&](const PlantState& s) {
+          return std::hypot(s.machine_x_mm - x0, s.machine_y_mm - y0) < 0.01;
+        },
+        25));
     EXPECT_FALSE(plant.state().touch_contact);
   }
   return at;
@@ -475,8 +484,9 @@ TEST(SimWork, a_z_touch_over_a_drilled_hole_finds_its_bottom) {
   Plant plant(p, 4);
   run_until(plant, touching(0.0, 0.0, -2.0), 3000,
             [](const PlantState& s) { return s.machine_z_mm < -2.9; });
-  ASSERT_TRUE(run_until(plant, touching(0.0, 0.0, -0.02), 6000,
-                        [](const PlantState& s) { return s.touch_contact; }, 25));
+  ASSERT_TRUE(run_until(
+      plant, touching(0.0, 0.0, -0.02), 6000, [](const PlantState& s) { return s.touch_contact; },
+      25));
   EXPECT_NEAR(plant.state().machine_z_mm, -3.0 + 1e-3, 4 * 0.3e-3 + 1e-5);
 }
 

@@ -113,7 +113,7 @@ struct SimParams {
   double tool_width_mm{10.0};     // block
   double tool_length_mm{10.0};    // block
   double wire_d_mm{0.25};         // wire diameter D
-  // Tube/block length sticking out, consumed by wear. The one parameter writable at run time:
+  // Tube/block length sticking out, consumed by wear. Writable at run time (as is the hole below):
   // a write says "the electrode now measures this" (a retained length restored at start, an
   // electrode change); the driver reads the length left back through it (docs/simulator.md §5a).
   double electrode_length_mm{300.0};
@@ -237,7 +237,8 @@ struct SimParams {
   std::int64_t max_pulses_per_advance{100000};  // per advance_to(); beyond it pulses pause
 
   /// Declares every field (unit, description, range) in declaration order; all are load time
-  /// only (the Plant resolves them once). Non-RT.
+  /// only (the Plant resolves them once) but electrode_length_mm, hole_depth_mm, hole_x_mm and
+  /// hole_y_mm, which the driver applies to the plant. Non-RT.
   void visit(edm::rt::ParamVisitor& v);
   /// Every problem with the values: each field against its range, then (only if all are in
   /// range) cross_field_errors(). Empty means valid. Non-RT.

@@ -142,7 +142,7 @@ class Plant {
   [[nodiscard]] bool generator_enabled() const noexcept;
   [[nodiscard]] double tool_z_mm(std::int64_t t_ns) const noexcept;  // axis z extrapolated
   [[nodiscard]] double front_gap_um(double z_mm) const noexcept;
-  [[nodiscard]] double depth_mm() const noexcept;  // of the hole under the electrode
+  [[nodiscard]] double depth_mm() const noexcept;   // of the hole under the electrode
   [[nodiscard]] double bottom_mm() const noexcept;  // z of what is under the electrode
   [[nodiscard]] double wall_gap_um(std::size_t j) const noexcept;
   [[nodiscard]] double gap_volume_mm3(double gap_um) const noexcept;

@@ -32,9 +32,9 @@ struct Section {
 
 /// The work as the touch sensing sees it, in the plant's frame (surface at z = 0).
 struct WorkSolid {
-  Section block;        // rectangle
-  Section bore;         // disc; none() = no bore (through)
-  Section hole;         // the drilled hole (disc or rectangle); none() = no hole
+  Section block;  // rectangle
+  Section bore;   // disc; none() = no bore (through)
+  Section hole;   // the drilled hole (disc or rectangle); none() = no hole
   double hole_depth_mm{0.0};
 };
 
