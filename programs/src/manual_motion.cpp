@@ -17,6 +17,11 @@ using rt::TouchTarget;
 constexpr char kAxisName[3] = {'X', 'Y', 'Z'};
 // A reference within this of its target has arrived (the encoder resolves far coarser).
 constexpr double kArrived = 1e-7;
+// In position: every axis within this of its reference (the encoder's quantum) ...
+constexpr double kInPositionMm = 0.001;
+// ... for this many consecutive cycles, or at most kSettleLimit after the reference arrived.
+constexpr int kInPositionCycles = 5;
+constexpr rt::Duration kSettleLimit = std::chrono::milliseconds(500);
 
 int axis_of(char c) noexcept { return c == 'X' ? 0 : c == 'Y' ? 1 : c == 'Z' ? 2 : -1; }
 
@@ -254,6 +259,14 @@ void ManualMotion::finish(bool ok, ManualError e, const rt::CycleContext& ctx) n
   vz_cmd_mm_s.set(0.0);
 }
 
+void ManualMotion::finish_settled(bool ok, ManualError e, const rt::CycleContext& ctx) noexcept {
+  pending_ok_ = ok;
+  pending_error_ = e;
+  settle_until_ = ctx.release + kSettleLimit;
+  settle_cycles_ = 0;
+  step_ = Step::kInPosition;
+}
+
 void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx) noexcept {
   if (r.op == ManualOp::kStop) {
     if (step_ != Step::kIdle) finish(false, ManualError::kStopped, ctx);
@@ -350,14 +363,11 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
         finish(false, ManualError::kNotAvailable, ctx);
         return;
       }
-      if (contact.get()) {
-        finish(false, ManualError::kAlreadyInContact, ctx);
-        return;
-      }
       touch_index_ = 0;
       status_.mode = ManualMode::kTouch;
-      touch_mode.set(true);
-      begin_touch_side();
+      touch_mode.set(true);  // the sensing voltage first: contact reads only in touch mode
+      settle_cycles_ = 0;
+      step_ = Step::kTouchArm;
       break;
     case ManualOp::kNone:
     case ManualOp::kStop:
@@ -432,7 +442,7 @@ void ManualMotion::begin_touch_side() noexcept {
 void ManualMotion::next_touch(const rt::CycleContext& ctx) noexcept {
   const double r = 0.5 * params_.electrode_d_mm;
   if (req_.target != TouchTarget::kCenter) {
-    finish(true, ManualError::kNone, ctx);
+    finish_settled(true, ManualError::kNone, ctx);
     status_.result.x = x_mm.get();
     status_.result.y = y_mm.get();
     status_.result.z = z_mm.get();
@@ -508,7 +518,7 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
       }
       if (prof_.done) {
         const ManualError e = status_.result.error;
-        finish(e == ManualError::kNone, e, ctx);
+        finish_settled(e == ManualError::kNone, e, ctx);
       }
       break;
     case Step::kHomeOff:
@@ -574,6 +584,31 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
         manual_->bump_position_epoch();  // the reading has jumped: restart the supervisor's model
       }
       break;
+    case Step::kInPosition: {
+      // The mechanics follow the reference with a lag: the operation ends when every axis has
+      // stood within kInPositionMm of its reference for kInPositionCycles (or after
+      // kSettleLimit, whichever is first), so a jog's distance or a touch's return is exact.
+      bool in = std::abs(prof_.pos - pos(axis_)) <= kInPositionMm;
+      for (int k = 0; k < 3; ++k) {
+        if (k != axis_) in = in && std::abs(hold_[k] - pos(k)) <= kInPositionMm;
+      }
+      settle_cycles_ = in ? settle_cycles_ + 1 : 0;
+      if (settle_cycles_ >= kInPositionCycles || ctx.release >= settle_until_) {
+        finish(pending_ok_, pending_error_, ctx);
+      }
+      break;
+    }
+    case Step::kTouchArm:
+      // The driver switches to touch mode at the end of the first cycle; the contact it senses
+      // reads from the next.
+      if (++settle_cycles_ >= 2) {
+        if (contact.get()) {
+          finish(false, ManualError::kAlreadyInContact, ctx);
+        } else {
+          begin_touch_side();
+        }
+      }
+      break;
     case Step::kTouchFast:
       if (contact.get()) {
         stop_now();
@@ -626,7 +661,7 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
       step_profile(dt);
       if (prof_.done) {
         if (status_.result.error != ManualError::kNone) {
-          finish(false, status_.result.error, ctx);
+          finish_settled(false, status_.result.error, ctx);
         } else if (req_.target == TouchTarget::kCenter && touch_index_ < 4) {
           begin_touch_side();
         } else {
@@ -638,12 +673,13 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
       step_profile(dt);
       if (prof_.done) {
         if (touch_index_ >= 4) {
-          finish(true, ManualError::kNone, ctx);
+          finish_settled(true, ManualError::kNone, ctx);
           const double radius = 0.5 * params_.electrode_d_mm;
           status_.result.x = 0.5 * (contact_[0] + contact_[1]);
           status_.result.y = 0.5 * (contact_[2] + contact_[3]);
           status_.result.z = z_mm.get();
-          status_.result.size = (contact_[0] + radius) - (contact_[1] - radius);
+          // The Y pair is touched at the X centre: a true diameter (the X pair may be a chord).
+          status_.result.size = (contact_[2] + radius) - (contact_[3] - radius);
         } else {
           begin_touch_side();
         }

@@ -119,12 +119,14 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
     kHomeBack,
     kHomeLatch,
     kHomeSettle,
+    kTouchArm,   // touch mode on, waiting for the first contact reading
     kTouchFast,
     kTouchBack,
     kTouchSlow,
     kTouchOff,
     kReturn,     // back to the start point (no contact, centre-finding)
     kCentre,     // to the centre of the two contacts
+    kInPosition, // the reference has arrived: waiting for the axes to settle on it
   };
   /// One axis's reference: a trapezoidal move to `target` at `speed`.
   struct Profile {
@@ -135,6 +137,8 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
 
   void start(const rt::ManualRequest& r, const rt::CycleContext& ctx) noexcept;
   void finish(bool ok, rt::ManualError e, const rt::CycleContext& ctx) noexcept;
+  /// finish() once the axes stand on their references (kInPosition).
+  void finish_settled(bool ok, rt::ManualError e, const rt::CycleContext& ctx) noexcept;
   void begin_move(int axis, double target, double speed) noexcept;
   void stop_now() noexcept;  // the reference stops where the axis is
   void step_profile(double dt) noexcept;
@@ -163,6 +167,9 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   double travel_from_{0.0};
   rt::TimePoint refreshed_{};
   int settle_cycles_{0};
+  rt::TimePoint settle_until_{};
+  bool pending_ok_{false};
+  rt::ManualError pending_error_{rt::ManualError::kNone};
   // Home.
   std::uint8_t home_todo_{0};  // axes left to reference
   std::size_t home_next_{0};   // index into home_order

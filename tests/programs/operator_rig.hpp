@@ -1,0 +1,98 @@
+#pragma once
+// The drill machine (config/machines/drill-sim.yaml) with the work placed where the program does
+// not know it (the simulator's work_* parameters) and incremental encoders, on a virtual clock:
+// the rig of the operator functions' tests (issue 21). Requests go through the runtime's
+// ManualControl exactly as the bridge's home / jog / touch ops send them.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "edm/runtime/clock.hpp"
+#include "edm/runtime/config.hpp"
+#include "edm/runtime/manual.hpp"
+#include "edm/runtime/runtime.hpp"
+#include "edm/runtime/scheduler.hpp"
+#include "edm/sim/sim_driver.hpp"
+#include "sim_machine.hpp"
+#include "support/files.hpp"
+
+namespace edm::test {
+
+struct OperatorRig {
+  std::unique_ptr<rt::Runtime> runtime;
+  rt::VirtualClock clock;
+  std::unique_ptr<rt::VirtualScheduler> sched;
+  rt::TimePoint now{};
+
+  /// `sim_params`: extra simulator parameters ("work_surface_z_mm: -7.3, …"); `manual`: the
+  /// job's manual child's parameters ("referenced_at_start: false, …").
+  OperatorRig(const std::string& sim_params, const std::string& manual, int seed = 1) {
+    std::string text =
+        read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
+    replace_once(text, "params: {preset: drill, seed: 1, wall_sparks: true}",
+                 "params: {preset: drill, seed: 1, wall_sparks: true" +
+                     (sim_params.empty() ? std::string() : ", " + sim_params) + "}");
+    replace_once(text, "params: {drill: {spark_gap_offset_um: 30.3}}",
+                 "params: {drill: {spark_gap_offset_um: 30.3}" +
+                     (manual.empty() ? std::string() : ", manual: {" + manual + "}") + "}");
+    runtime = build_sim_machine(rt::parse_config_text(text, "drill-sim-operator.yaml"),
+                                seeded(seed));
+    runtime->machine().command(rt::MachineCommand::kPowerOn);
+    std::vector<rt::Task*> tasks;
+    for (const auto& t : runtime->tasks()) {
+      t->detach_trace();
+      tasks.push_back(t.get());
+    }
+    sched = std::make_unique<rt::VirtualScheduler>(tasks, clock);
+    run_for(std::chrono::milliseconds(5));
+  }
+
+  void run_for(rt::Duration d) {
+    now += d;
+    sched->run_until(now);
+  }
+  rt::ManualControl& manual() { return runtime->manual(); }
+  const sim::PlantState& truth() {
+    return dynamic_cast<sim::SimDriver&>(runtime->driver()).plant().state();
+  }
+  double read(const char* name) { return runtime->variables().read(name).value_or(1e9); }
+
+  /// Sends `r` and runs until the runtime has taken it and is no longer busy (at most `limit`).
+  rt::ManualResult request(rt::ManualRequest r,
+                           rt::Duration limit = std::chrono::seconds(120)) {
+    const std::uint64_t seq = manual().request(r);
+    const rt::TimePoint end = now + limit;
+    while (now < end) {
+      run_for(std::chrono::milliseconds(1));
+      const rt::ManualStatus s = manual().status();
+      if (s.seen_seq >= seq && !s.busy) return s.result;
+    }
+    ADD_FAILURE() << "manual request " << seq << " still busy after the limit";
+    return manual().status().result;
+  }
+  rt::ManualResult home(std::uint8_t axes = 0x7) {
+    rt::ManualRequest r;
+    r.op = rt::ManualOp::kHome;
+    r.axes = axes;
+    return request(r);
+  }
+  rt::ManualResult jog(int axis, double mm) {
+    rt::ManualRequest r;
+    r.op = rt::ManualOp::kJogDistance;
+    r.axis = static_cast<std::uint8_t>(axis);
+    r.value = mm;
+    return request(r);
+  }
+  rt::ManualResult touch(rt::TouchTarget t) {
+    rt::ManualRequest r;
+    r.op = rt::ManualOp::kTouch;
+    r.target = t;
+    return request(r);
+  }
+};
+
+}  // namespace edm::test
