@@ -1,0 +1,296 @@
+// The operator functions' ops (issue 21) on an in-process drill machine (the simulator, virtual
+// clock paced 10x) with a bridge: roles, precise refusals of bad requests and of requests in the
+// wrong state, a jog and a work offset through the protocol, the reference requirement and the
+// offset generation at cycle.start, and MDI that never replaces the loaded part program.
+#include <gtest/gtest.h>
+
+#include "bridge_fixture.hpp"
+#include "edm/machining/motion_block.hpp"
+#include "programs/sim_machine.hpp"
+
+namespace edm::bridge::test {
+namespace {
+
+using machining::MotionBlock;
+using machining::MotionKind;
+using namespace std::chrono_literals;
+
+constexpr const char* kOp = "op-secret-0123456789";
+constexpr const char* kViewer = "viewer-secret-0123456789";
+
+class OperatorOps : public ::testing::Test {
+ protected:
+  void start(const std::string& manual_params = "") {
+    std::string text = edm::test::read_file(std::string(EDM_SOURCE_DIR) +
+                                            "/config/machines/drill-sim.yaml");
+    if (!manual_params.empty()) {
+      edm::test::replace_once(text, "params: {drill: {spark_gap_offset_um: 30.3}}",
+                              "params: {drill: {spark_gap_offset_um: 30.3}, manual: {" +
+                                  manual_params + "}}");
+    }
+    rt_ = edm::test::build_sim_machine(rt::parse_config_text(text, "drill-sim.yaml"));
+    ServerOptions o;
+    o.port = 0;
+    o.token_file = dir_.file("op.token");
+    o.viewer_token_file = dir_.file("viewer.token");
+    write_token(o.token_file, kOp, 0600);
+    write_token(o.viewer_token_file, kViewer, 0600);
+    server_ = std::make_unique<Server>(*rt_, o);
+    server_->start();
+    runner_ = std::thread([this] {
+      rt::RunOptions ro;
+      ro.clock = rt::ClockKind::kVirtual;
+      ro.speed = 10.0;
+      ro.stop = &stop_;
+      rt_->run(ro);
+    });
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (rt_->machine().state() == rt::MachineState::kOff &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::yield();
+    }
+    ASSERT_EQ(op_.connect(opts(kOp)), Role::kOperator);
+    ASSERT_EQ(viewer_.connect(opts(kViewer)), Role::kViewer);
+  }
+  void TearDown() override {
+    stop_ = true;
+    if (runner_.joinable()) runner_.join();
+    if (server_) server_->stop();
+  }
+  ClientOptions opts(const std::string& token) const {
+    ClientOptions o;
+    o.port = server_->port();
+    o.token = token;
+    o.timeout = 10s;
+    return o;
+  }
+  /// Polls manual.status until the request `seq` is done; returns the final status.
+  Json wait_manual(std::uint64_t seq) {
+    Json st;
+    const auto deadline = std::chrono::steady_clock::now() + 60s;
+    while (std::chrono::steady_clock::now() < deadline) {
+      const Reply r = viewer_.request("manual.status");
+      EXPECT_TRUE(r.ok) << r.body;
+      st = r.body;
+      if (st.value("seen_seq", 0U) >= seq && !st.value("busy", true)) return st;
+      std::this_thread::sleep_for(20ms);  // polling an observable status, as edmhmi does
+    }
+    ADD_FAILURE() << "manual request " << seq << " not done: " << st;
+    return st;
+  }
+  double var(const char* name) { return rt_->variables().read(name).value_or(1e9); }
+  void wait_for_busy() {
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (!rt_->manual().status().busy) {
+      ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the jog never started";
+      std::this_thread::yield();
+    }
+  }
+
+  edm::test::TempDir dir_{"edm-operator-ops"};
+  std::unique_ptr<rt::Runtime> rt_;
+  std::unique_ptr<Server> server_;
+  std::atomic<bool> stop_{false};
+  std::thread runner_;
+  Client op_, viewer_;
+};
+
+TEST_F(OperatorOps, ViewersMayWatchButNeverMove) {
+  start();
+  for (const auto& [op, params] : std::vector<std::pair<const char*, Json>>{
+           {"home", Json::object()},
+           {"jog", {{"axis", "X"}, {"distance", 1.0}}},
+           {"jog.stop", Json::object()},
+           {"touch", {{"target", "z"}}},
+           {"offset.set", {{"frame", "G54"}, {"x", 1.0}}}}) {
+    expect_error(viewer_.request(op, params), ErrorCode::kForbidden);
+  }
+  EXPECT_TRUE(viewer_.request("manual.status"));
+  EXPECT_TRUE(viewer_.request("offset.get"));
+  EXPECT_EQ(rt_->manual().status().seen_seq, 0U) << "nothing reached the runtime";
+  const Reply info = viewer_.request("machine.info");
+  ASSERT_TRUE(info);
+  EXPECT_TRUE(info.body["manual"]["available"].get<bool>());
+  EXPECT_TRUE(info.body["manual"]["home"].get<bool>());
+  EXPECT_TRUE(info.body["manual"]["touch"].get<bool>());
+  EXPECT_NE(std::find(info.body["ops"].begin(), info.body["ops"].end(), Json("touch")),
+            info.body["ops"].end());
+}
+
+TEST_F(OperatorOps, BadRequestsAreRefusedPrecisely) {
+  start();
+  const std::vector<std::pair<const char*, Json>> bad = {
+      {"jog", Json::object()},
+      {"jog", {{"axis", "W"}, {"distance", 1.0}}},
+      {"jog", {{"axis", 5}, {"distance", 1.0}}},
+      {"jog", {{"axis", "X"}}},
+      {"jog", {{"axis", "X"}, {"distance", 1.0}, {"velocity", 1.0}}},
+      {"jog", {{"axis", "X"}, {"distance", 10.5}}},
+      {"jog", {{"axis", "X"}, {"distance", 0.0001}}},
+      {"jog", {{"axis", "X"}, {"distance", "1"}}},
+      {"jog", {{"axis", "X"}, {"velocity", 50.0}}},
+      {"jog", {{"axis", "X"}, {"velocity", 1e308}}},
+      {"touch", Json::object()},
+      {"touch", {{"target", "q"}}},
+      {"touch", {{"target", 3}}},
+      {"home", {{"axes", "XX"}}},
+      {"home", {{"axes", "W"}}},
+      {"home", {{"axes", ""}}},
+      {"home", {{"axes", 5}}},
+      {"offset.set", {{"frame", "G60"}, {"x", 1.0}}},
+      {"offset.set", {{"frame", "G5"}, {"x", 1.0}}},
+      {"offset.set", {{"frame", "G54"}}},
+      {"offset.set", {{"frame", "G54"}, {"x", "abc"}}},
+      {"offset.set", {{"frame", "G54"}, {"x", 1e9}}},
+      {"cycle.start", {{"slot", "other"}}},
+      {"cycle.start", {{"dry_run", "yes"}}},
+      {"program.begin", {{"blocks", 1}, {"slot", "x"}}},
+      {"program.begin", {{"blocks", 1}, {"offsets_generation", -1}}},
+  };
+  for (const auto& [op, params] : bad) {
+    const Reply r = op_.request(op, params);
+    EXPECT_FALSE(r.ok) << op << " " << params;
+    EXPECT_EQ(r.code, ErrorCode::kBadRequest) << op << " " << params << " → " << r.body;
+  }
+  EXPECT_EQ(rt_->manual().status().seen_seq, 0U) << "nothing reached the runtime";
+  EXPECT_EQ(rt_->work_offsets().generation(), 0U);
+  EXPECT_EQ(rt_->machine().state(), rt::MachineState::kReady);
+}
+
+TEST_F(OperatorOps, ManualMotionOnlyWhenReadyAndIdle) {
+  start("deadman: 60s");  // the slow jog below must outlast the requests that test it
+  ASSERT_TRUE(op_.request("estop"));
+  for (const auto& [op, params] : std::vector<std::pair<const char*, Json>>{
+           {"home", Json::object()},
+           {"jog", {{"axis", "X"}, {"distance", 1.0}}},
+           {"touch", {{"target", "z"}}}}) {
+    expect_error(op_.request(op, params), ErrorCode::kInvalidState);
+  }
+  EXPECT_TRUE(op_.request("jog.stop")) << "a stop is always accepted";
+  ASSERT_TRUE(op_.request("reset"));
+  // A jog through the protocol moves the axis by exactly its distance.
+  const double x0 = var("io.x_mm");
+  const Reply r = op_.request("jog", {{"axis", "X"}, {"distance", -1.25}});
+  ASSERT_TRUE(r) << r.body;
+  const Json st = wait_manual(r.body["seq"].get<std::uint64_t>());
+  EXPECT_TRUE(st["result"]["ok"].get<bool>()) << st;
+  EXPECT_NEAR(var("io.x_mm") - x0, -1.25, 0.0015);
+  // While one manual operation runs, another (not a jog) is busy.
+  const Reply slow = op_.request("jog", {{"axis", "Y"}, {"velocity", 0.5}});
+  ASSERT_TRUE(slow);
+  wait_for_busy();
+  expect_error(op_.request("home", {{"axes", "Z"}}), ErrorCode::kBusy);
+  expect_error(op_.request("cycle.start"), ErrorCode::kInvalidState);
+  const Reply stop = op_.request("jog.stop");
+  ASSERT_TRUE(stop);
+  const Json stopped = wait_manual(stop.body["seq"].get<std::uint64_t>());
+  EXPECT_FALSE(stopped["busy"].get<bool>());
+  EXPECT_EQ(stopped["result"]["error"], "stopped by the operator");
+}
+
+TEST_F(OperatorOps, WorkOffsetsAreSetReadAndRefusedDuringAJob) {
+  start();
+  Reply r = op_.request("offset.set", {{"frame", "G55"}, {"x", 12.5}, {"z", -7.25}});
+  ASSERT_TRUE(r) << r.body;
+  EXPECT_EQ(r.body["frame"], "G55");
+  EXPECT_EQ(r.body["generation"], 1);
+  r = viewer_.request("offset.get");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r.body["frames"]["G55"]["x"], 12.5);
+  EXPECT_EQ(r.body["frames"]["G55"]["y"], 0.0);
+  EXPECT_EQ(r.body["frames"]["G55"]["z"], -7.25);
+  EXPECT_EQ(r.body["frames"]["G54"]["x"], 0.0);
+  // A program interpreted with generation 1, then the offsets change: the start is refused.
+  MotionBlock dwell;
+  dwell.kind = MotionKind::kDwell;
+  dwell.dwell_s = 0.05;
+  dwell.line = 1;
+  MotionBlock end;
+  end.kind = MotionKind::kEnd;
+  end.line = 2;
+  const std::vector<MotionBlock> prog{dwell, end};
+  UploadOptions uo;
+  uo.offsets_generation = 1;
+  ASSERT_TRUE(op_.upload_program(prog, uo));
+  ASSERT_TRUE(op_.request("offset.set", {{"frame", "G54"}, {"y", 3.0}}));
+  const Reply refused = op_.request("cycle.start");
+  expect_error(refused, ErrorCode::kInvalidState);
+  EXPECT_NE(refused.body.dump().find("work offsets changed"), std::string::npos);
+  uo.offsets_generation = 2;
+  ASSERT_TRUE(op_.upload_program(prog, uo));
+  // A long dwell: offsets are refused while it runs.
+  dwell.dwell_s = 30.0;
+  const std::vector<MotionBlock> long_prog{dwell, end};
+  ASSERT_TRUE(op_.upload_program(long_prog, uo));
+  ASSERT_TRUE(op_.request("cycle.start"));
+  expect_error(op_.request("offset.set", {{"frame", "G54"}, {"x", 1.0}}),
+               ErrorCode::kInvalidState);
+  expect_error(op_.request("jog", {{"axis", "X"}, {"distance", 1.0}}), ErrorCode::kInvalidState);
+  ASSERT_TRUE(op_.request("cycle.stop"));
+  EXPECT_EQ(rt_->work_offsets().get(0).x, 0.0);
+}
+
+TEST_F(OperatorOps, ProgramsWaitForTheReferenceWhenRequired) {
+  start("referenced_at_start: false, reference_required: true");
+  MotionBlock end;
+  end.kind = MotionKind::kEnd;
+  end.line = 1;
+  const std::vector<MotionBlock> prog{end};
+  ASSERT_TRUE(op_.upload_program(prog));
+  const Reply r = op_.request("cycle.start");
+  expect_error(r, ErrorCode::kInvalidState);
+  EXPECT_NE(r.body.dump().find("not referenced"), std::string::npos) << r.body;
+  const Reply h = op_.request("home", {{"axes", "ZXY"}});
+  ASSERT_TRUE(h) << h.body;
+  EXPECT_EQ(h.body["axes"], "XYZ");
+  const Json st = wait_manual(h.body["seq"].get<std::uint64_t>());
+  EXPECT_TRUE(st["result"]["ok"].get<bool>()) << st;
+  EXPECT_TRUE(st["referenced"]["X"].get<bool>());
+  EXPECT_TRUE(st["may_run_programs"].get<bool>());
+  EXPECT_TRUE(op_.request("cycle.start"));
+}
+
+TEST_F(OperatorOps, MdiRunsBesideTheLoadedProgramWithoutReplacingIt) {
+  start();
+  MotionBlock dwell;
+  dwell.kind = MotionKind::kDwell;
+  dwell.dwell_s = 0.01;
+  dwell.line = 7;
+  MotionBlock end;
+  end.kind = MotionKind::kEnd;
+  end.line = 8;
+  const std::vector<MotionBlock> main_prog{dwell, dwell, end};
+  ASSERT_TRUE(op_.upload_program(main_prog));
+  expect_error(op_.request("cycle.start", {{"slot", "mdi"}}), ErrorCode::kInvalidState);
+  MotionBlock move;
+  move.kind = MotionKind::kRapid;
+  move.line = 1;
+  move.target = {var("io.x_mm") + 2.0, var("io.y_mm"), var("io.z_mm")};
+  UploadOptions uo;
+  uo.slot = "mdi";
+  const std::vector<MotionBlock> mdi{move, end};
+  const double x0 = var("io.x_mm");
+  ASSERT_TRUE(op_.upload_program(mdi, uo));
+  EXPECT_EQ(rt_->job().loaded_blocks(), 3U) << "the part program is kept";
+  ASSERT_TRUE(op_.request("cycle.start", {{"slot", "mdi"}}));
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (rt_->job().progress().jobs_started == 0 || rt_->job().active()) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline);
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(rt_->job().progress().outcome, rt::JobOutcome::kFinished);
+  EXPECT_EQ(rt_->job().progress().slot, rt::JobSlot::kMdi);
+  EXPECT_NEAR(var("io.x_mm") - x0, 2.0, 0.01);  // EdmJob's in-position band
+  EXPECT_EQ(rt_->job().loaded_blocks(), 3U);
+  // The part program still runs as loaded.
+  ASSERT_TRUE(op_.request("cycle.start"));
+  while (rt_->job().progress().jobs_started < 2 || rt_->job().active()) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline);
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_EQ(rt_->job().progress().slot, rt::JobSlot::kMain);
+  EXPECT_EQ(rt_->job().progress().block_count, 3U);
+}
+
+}  // namespace
+}  // namespace edm::bridge::test
