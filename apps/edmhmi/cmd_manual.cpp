@@ -6,7 +6,6 @@
 #include <thread>
 
 #include "cli.hpp"
-#include "edm/hmi/job_runner.hpp"
 #include "edm/hmi/manual.hpp"
 
 namespace edmhmi {
@@ -17,66 +16,69 @@ using edm::bridge::Json;
 using edm::bridge::Reply;
 using Clock = std::chrono::steady_clock;
 
-/// The seq of the last finished manual operation before ours (nullopt: none yet), so the wait
-/// cannot take an older result for ours. Prints and returns false when manual.status fails.
-bool seq_before(edm::bridge::Client& client, std::optional<std::uint64_t>& seq) {
-  const Reply r = client.request("manual.status");
-  if (!r) {
-    report_error("manual.status", r);
-    return false;
+const std::atomic<bool> kNever{false};
+
+/// The request's sequence number from the op's reply; 0 (and a message) when it has none.
+std::uint64_t request_seq(std::string_view op, const Reply& r) {
+  const std::uint64_t seq = r.body.value("seq", std::uint64_t{0});
+  if (seq == 0) {
+    std::fprintf(stderr, "edmhmi: %s: the reply names no request seq; cannot follow it\n",
+                 std::string(op).c_str());
   }
-  edm::hmi::ManualStatus s;
-  std::string error;
-  if (!edm::hmi::manual_status_from_json(r.body, s, error)) {
-    std::fprintf(stderr, "edmhmi: manual.status: malformed reply: %s\n", error.c_str());
-    return false;
-  }
-  seq = s.result ? std::optional(s.result->seq) : std::nullopt;
-  return true;
+  return seq;
 }
 
-/// Waits for the operation to end and prints its result. An interrupt sends jog.stop (the
-/// runtime's stop of a manual motion) and waits for the stop. Returns the exit code and, through
-/// `result`, what the runtime reported.
-int finish(edm::bridge::Client& client, std::optional<std::uint64_t> seq,
-           std::optional<edm::hmi::ManualResult>* result = nullptr) {
-  edm::hmi::ManualWait w = edm::hmi::wait_manual(client, seq, interrupted());
-  if (w.interrupted) {
-    const Reply stop = client.request("jog.stop");
-    std::fprintf(stderr, "edmhmi: interrupted: jog.stop %s\n",
-                 stop ? "sent" : ("refused: " + stop.message).c_str());
-    static const std::atomic<bool> kNever{false};
-    w = edm::hmi::wait_manual(client, seq, kNever, std::chrono::milliseconds(50),
-                              std::chrono::seconds(10));
-    if (w.done) std::printf("%s\n", edm::hmi::format_manual_result(*w.status.result).c_str());
-    return kExitInterrupted;
-  }
+/// Prints the result of a finished wait; the exit code for it.
+int print_result(const edm::hmi::ManualWait& w) {
   if (!w.done) {
     std::fprintf(stderr, "edmhmi: %s\n", w.error.c_str());
     return kExitFailure;
   }
   std::printf("%s\n", edm::hmi::format_manual_result(*w.status.result).c_str());
   std::fflush(stdout);
-  if (result != nullptr) *result = w.status.result;
   return w.status.result->ok ? kExitOk : kExitFailure;
 }
 
-int continuous_jog(edm::bridge::Client& client, char axis, double velocity, double for_s,
-                   std::optional<std::uint64_t> seq) {
-  double deadman_ms = 500.0;  // a runtime that does not say: refresh often enough for any
-  if (const Reply info = client.request("machine.info"); info) {
-    const auto manual = info.body.find("manual");
-    if (manual != info.body.end() && manual->is_object()) {
-      deadman_ms = manual->value("deadman_ms", deadman_ms);
-    }
+/// jog.stop, then waits (at most 10 s) until the runtime has taken it and ended the motion.
+edm::hmi::ManualWait stop_and_wait(edm::bridge::Client& client, std::uint64_t result_from) {
+  const Reply stop = client.request("jog.stop");
+  if (!stop) {
+    report_error("jog.stop", stop);
+    edm::hmi::ManualWait w;
+    w.error = "jog.stop refused: " + stop.message;
+    return w;
   }
-  const auto period = edm::hmi::jog_refresh_period(deadman_ms);
+  return edm::hmi::wait_manual(client, stop.body.value("seq", result_from), result_from, kNever,
+                               std::chrono::milliseconds(50), std::chrono::seconds(10));
+}
+
+/// Waits for request `seq` to end and prints its result. Ctrl-C sends jog.stop (it stops any
+/// manual motion: home, jog, touch) and waits for the stop. `result` gets what the runtime said.
+int finish(edm::bridge::Client& client, std::uint64_t seq,
+           std::optional<edm::hmi::ManualResult>* result = nullptr) {
+  const edm::hmi::ManualWait w = edm::hmi::wait_manual(client, seq, seq, interrupted());
+  if (w.interrupted) {
+    std::fprintf(stderr, "edmhmi: interrupted: sending jog.stop\n");
+    const edm::hmi::ManualWait s = stop_and_wait(client, seq);
+    if (s.done) std::printf("%s\n", edm::hmi::format_manual_result(*s.status.result).c_str());
+    return kExitInterrupted;
+  }
+  if (result != nullptr && w.done) *result = w.status.result;
+  return print_result(w);
+}
+
+int continuous_jog(edm::bridge::Client& client, char axis, double velocity, double for_s) {
   const Json params = {{"axis", std::string(1, axis)}, {"velocity", velocity}};
   Reply r = client.request("jog", params);
   if (!r) return report_error("jog", r);
-  std::fprintf(stderr, "edmhmi: jogging %c at %g mm/s%s (refreshed every %lld ms; Ctrl-C stops)\n",
-               axis, velocity, for_s > 0.0 ? (" for " + std::to_string(for_s) + " s").c_str() : "",
-               static_cast<long long>(period.count()));
+  const std::uint64_t first = request_seq("jog", r);
+  if (first == 0) return kExitFailure;
+  // Refreshed well inside the runtime's dead-man time: a dead edmhmi stops the axis there.
+  const auto period = edm::hmi::jog_refresh_period(r.body.value("deadman_ms", 500.0));
+  std::fprintf(
+      stderr, "edmhmi: jogging %c at %g mm/s, refreshed every %lld ms; %s\n", axis, velocity,
+      static_cast<long long>(period.count()),
+      for_s > 0.0 ? ("stops after " + std::to_string(for_s) + " s").c_str() : "Ctrl-C stops");
   const Clock::time_point t0 = Clock::now();
   Clock::time_point next = t0 + period;
   int code = kExitOk;
@@ -86,22 +88,13 @@ int continuous_jog(edm::bridge::Client& client, char axis, double velocity, doub
     std::this_thread::sleep_until(next);  // the dead-man refresh deadline
     next += period;
     r = client.request("jog", params);
-    if (!r) {  // e.g. a soft limit reached, an alarm: the runtime has stopped the axis
+    if (!r) {  // e.g. the machine left READY: the runtime has stopped the axis
       code = report_error("jog", r);
       break;
     }
   }
-  const Reply stop = client.request("jog.stop");
-  if (!stop) report_error("jog.stop", stop);
-  static const std::atomic<bool> kNever{false};
-  const edm::hmi::ManualWait w = edm::hmi::wait_manual(client, seq, kNever);
-  if (!w.done) {
-    std::fprintf(stderr, "edmhmi: %s\n", w.error.c_str());
-    return kExitFailure;
-  }
-  std::printf("%s\n", edm::hmi::format_manual_result(*w.status.result).c_str());
-  if (code == kExitOk && !w.status.result->ok) code = kExitFailure;
-  return interrupted().load() && code == kExitOk ? kExitOk : code;
+  const int stopped = print_result(stop_and_wait(client, first));
+  return code != kExitOk ? code : stopped;
 }
 
 }  // namespace
@@ -115,12 +108,11 @@ int cmd_home(const HomeArgs& args, const edm::hmi::ConnectionSettings& settings)
   }
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
-  std::optional<std::uint64_t> seq;
-  if (!seq_before(client, seq)) return kExitFailure;
   const Reply r = client.request("home", params);
   if (!r) return report_error("home", r);
-  std::fprintf(stderr, "edmhmi: homing %s\n",
-               r.body.value("axes", params.value("axes", std::string("XYZ"))).c_str());
+  const std::uint64_t seq = request_seq("home", r);
+  if (seq == 0) return kExitFailure;
+  std::fprintf(stderr, "edmhmi: homing %s\n", r.body.value("axes", std::string("?")).c_str());
   return finish(client, seq);
 }
 
@@ -140,13 +132,12 @@ int cmd_jog(const JogArgs& args, const edm::hmi::ConnectionSettings& settings) {
   if (args.for_s > 0.0 && !args.velocity) return usage("jog: --for goes with --velocity");
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
-  std::optional<std::uint64_t> seq;
-  if (!seq_before(client, seq)) return kExitFailure;
-  if (args.velocity) return continuous_jog(client, *axis, *args.velocity, args.for_s, seq);
+  if (args.velocity) return continuous_jog(client, *axis, *args.velocity, args.for_s);
   const Reply r =
       client.request("jog", {{"axis", std::string(1, *axis)}, {"distance", *args.distance}});
   if (!r) return report_error("jog", r);
-  return finish(client, seq);
+  const std::uint64_t seq = request_seq("jog", r);
+  return seq == 0 ? kExitFailure : finish(client, seq);
 }
 
 int cmd_touch(const TouchArgs& args, const edm::hmi::ConnectionSettings& settings) {
@@ -160,10 +151,10 @@ int cmd_touch(const TouchArgs& args, const edm::hmi::ConnectionSettings& setting
   }
   edm::bridge::Client client;
   if (!connect(client, settings)) return kExitFailure;
-  std::optional<std::uint64_t> seq;
-  if (!seq_before(client, seq)) return kExitFailure;
   const Reply r = client.request("touch", {{"target", std::string(edm::hmi::to_string(*target))}});
   if (!r) return report_error("touch", r);
+  const std::uint64_t seq = request_seq("touch", r);
+  if (seq == 0) return kExitFailure;
   std::optional<edm::hmi::ManualResult> result;
   const int code = finish(client, seq, &result);
   if (code != kExitOk || frame.empty()) return code;

@@ -30,6 +30,7 @@ int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& setting
   req.blocks = g.blocks;
   req.frames = g.frames;
   req.slot = "mdi";
+  req.offsets_generation = machine.offsets_generation;
   edm::hmi::RunCallbacks cb;
   cb.alarm = [](const std::string& a) { std::fprintf(stderr, "ALARM %s\n", a.c_str()); };
   cb.note = [](const std::string& n) { std::fprintf(stderr, "edmhmi: %s\n", n.c_str()); };

@@ -149,7 +149,7 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
                  part.c_str(), g.blocks.size(), g.drill_blocks, g.drill_depth_mm,
                  g.electrode_wear_mm, machine.name.c_str(), settings.host.c_str(),
                  unsigned{settings.port});
-    if (!machine.offsets_known) {
+    if (!machine.offsets_generation) {
       std::fprintf(stderr,
                    "edmhmi: this edmplc has no work offsets (offset.get): G54..G59 are 0\n");
     }
@@ -160,6 +160,7 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
   req.machine = machine.name;
   req.blocks = g.blocks;
   req.frames = g.frames;
+  req.offsets_generation = machine.offsets_generation;
   if (args.from_line > 0) {
     std::optional<edm::hmi::ResumePlan> plan = plan_from(args, g, machine);
     if (!plan) return kExitBadInput;

@@ -81,27 +81,7 @@ std::string describe_alarm(const Json& e) {
          "): " + e.value("text", std::string());
 }
 
-std::optional<LastJob> last_job_from_status(const Json& status) {
-  const auto job = status.find("job");
-  if (job == status.end() || !job->is_object()) return std::nullopt;
-  const auto last = job->find("last");
-  if (last == job->end() || !last->is_object()) return std::nullopt;
-  try {
-    LastJob j;
-    j.outcome = last->value("outcome", std::string());
-    j.block = last->value("block", std::uint64_t{0});
-    j.line = last->value("line", std::int32_t{0});
-    if (const auto d = last->find("depth_mm"); d != last->end() && d->is_number()) {
-      const double v = d->get<double>();
-      if (std::isfinite(v)) j.depth_mm = v;
-    }
-    return j;
-  } catch (const Json::exception&) {
-    return std::nullopt;
-  }
-}
-
-WorkOffsets fetch_offsets(bridge::Client& client) {
+WorkOffsets fetch_offsets(bridge::Client& client, std::uint64_t* generation) {
   const bridge::Reply r = client.request("offset.get");
   if (!r) throw bridge::ClientError("offset.get: " + reply_error(r), r.code);
   WorkOffsets o;
@@ -109,6 +89,7 @@ WorkOffsets fetch_offsets(bridge::Client& client) {
   if (!offsets_from_json(r.body, o, error)) {
     throw bridge::ClientError("offset.get: malformed reply: " + error);
   }
+  if (generation != nullptr) *generation = r.body.value("generation", std::uint64_t{0});
   return o;
 }
 
@@ -132,17 +113,15 @@ MachineView fetch_machine(bridge::Client& client) {
     throw bridge::ClientError("status: " + (st ? "malformed reply: " + error : reply_error(st)),
                               st.code);
   }
-  m.last_job = last_job_from_status(st.body);
+  m.last_job = m.status.job_last;
   const JobFigures f = figures_from_status(m.status);
   m.position = {f.x_mm.value_or(0.0), f.y_mm.value_or(0.0), f.z_mm.value_or(0.0)};
-  const bridge::Reply off = client.request("offset.get");
-  if (off) {
-    if (!offsets_from_json(off.body, m.offsets, error)) {
-      throw bridge::ClientError("offset.get: malformed reply: " + error);
-    }
-    m.offsets_known = true;
-  } else if (off.code != bridge::ErrorCode::kUnknownOp) {
-    throw bridge::ClientError("offset.get: " + reply_error(off), off.code);
+  try {
+    std::uint64_t generation = 0;
+    m.offsets = fetch_offsets(client, &generation);
+    m.offsets_generation = generation;
+  } catch (const bridge::ClientError& e) {
+    if (e.code() != bridge::ErrorCode::kUnknownOp) throw;  // an edmplc without work offsets
   }
   return m;
 }
@@ -167,7 +146,10 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
                    "); clear the cause, then edmhmi reset");
   }
 
-  const bridge::Reply up = client.upload_program(req.blocks, 4096, req.slot);
+  bridge::UploadOptions upload;
+  upload.slot = req.slot;
+  upload.offsets_generation = req.offsets_generation;
+  const bridge::Reply up = client.upload_program(req.blocks, upload);
   if (!up) {
     RunResult r = refused("program refused: " + reply_error(up));
     r.locations = commit_issues(up, req.part);

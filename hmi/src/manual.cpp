@@ -28,6 +28,9 @@ bool manual_status_from_json(const Json& j, ManualStatus& out, std::string& erro
     ManualStatus s;
     s.mode = j.value("mode", std::string());
     s.busy = j.value("busy", false);
+    if (const auto seen = j.find("seen_seq"); seen != j.end()) {
+      s.seen_seq = seen->get<std::uint64_t>();
+    }
     if (const auto ref = j.find("referenced"); ref != j.end() && ref->is_object()) {
       for (std::size_t i = 0; i < 3; ++i) {
         const std::string axis(1, "XYZ"[i]);
@@ -44,6 +47,7 @@ bool manual_status_from_json(const Json& j, ManualStatus& out, std::string& erro
       r.x_mm = finite(*res, "x");
       r.y_mm = finite(*res, "y");
       r.z_mm = finite(*res, "z");
+      if (r.target == "center") r.size_mm = finite(*res, "size");
       s.result = std::move(r);
     }
     out = std::move(s);
@@ -150,10 +154,18 @@ std::string format_manual_result(const ManualResult& r) {
     s += buf;
   }
   if (r.x_mm || r.y_mm || r.z_mm) s += " (machine)";
+  if (r.size_mm) {
+    std::snprintf(buf, sizeof buf, ", bore diameter %.4f", *r.size_mm);
+    s += buf;
+  }
   return s;
 }
 
-ManualWait wait_manual(bridge::Client& client, std::optional<std::uint64_t> seq_before,
+bool manual_done(const ManualStatus& s, std::uint64_t seq, std::uint64_t result_from) noexcept {
+  return !s.busy && (!s.seen_seq || *s.seen_seq >= seq) && s.result && s.result->seq >= result_from;
+}
+
+ManualWait wait_manual(bridge::Client& client, std::uint64_t seq, std::uint64_t result_from,
                        const std::atomic<bool>& interrupt, std::chrono::milliseconds period,
                        std::chrono::milliseconds timeout) {
   ManualWait w;
@@ -175,8 +187,7 @@ ManualWait wait_manual(bridge::Client& client, std::optional<std::uint64_t> seq_
       w.error = "manual.status: malformed reply: " + error;
       return w;
     }
-    const std::optional<ManualResult>& res = w.status.result;
-    if (!w.status.busy && res && (!seq_before || res->seq > *seq_before)) {
+    if (manual_done(w.status, seq, result_from)) {
       w.done = true;
       return w;
     }

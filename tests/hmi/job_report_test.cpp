@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "edm/hmi/gcode.hpp"
+
 namespace edm::hmi::test {
 namespace {
 
@@ -284,6 +286,87 @@ TEST(FormatProgress, BlockBarAndAFinishedJobAtHundredPercent) {
   const std::string done = format_progress(v, 10);
   EXPECT_EQ(done.rfind("[##########] 100% block 14/14", 0), 0u) << done;
   EXPECT_NE(done.find("ETA 0:00  READY"), std::string::npos) << done;
+}
+
+// A hole drilled in G55, whose origin is at machine (-30, 40, -35): the report names the frame
+// and gives the hole and the end position in both coordinate systems.
+TEST(FormatReport, PositionsInWorkAndMachineCoordinates) {
+  machining::MachineTables tables;
+  tables.conditions.push_back({.e = 1, .name = "drill", .wear_ratio = 0.5});
+  GcodeOptions o;
+  o.offsets.frame[1] = {-30.0, 40.0, -35.0};
+  o.start_mm = {0.0, 0.0, 10.0};
+  const GcodeResult g = interpret_gcode(
+      "G55\nG00 X2 Y-1 Z5\nG00 Z0.5\nE1\nG01 Z-4 F60\nE0\nG00 Z5\nM30\n", "h.nc", tables, o);
+  ASSERT_TRUE(g.ok());
+  JobReport r = sample_report();
+  r.targets = program_targets(g.blocks, g.frames);
+  ASSERT_EQ(r.targets.holes.size(), 1u);
+  EXPECT_EQ(r.targets.holes[0].line, 5);
+  EXPECT_EQ(r.targets.holes[0].machine_mm, (machining::Vec3{-28.0, 39.0, -39.0}));
+  EXPECT_EQ(r.targets.holes[0].work_mm, (machining::Vec3{2.0, -1.0, -4.0}));
+  EXPECT_DOUBLE_EQ(r.targets.deepest_drill_mm, 4.0);  // from G55's Z0, not machine Z 0
+  r.end.x_mm = -28.0;
+  r.end.y_mm = 39.0;
+  r.end.z_mm = -30.0;
+  const std::string text = format_report(r);
+  EXPECT_NE(text.find(row("work frame", "G55, origin at X -30.0000 Y 40.0000 Z -35.0000 machine")),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find(row("hole (line 5)",
+                          "X 2.0000 Y -1.0000 G55 = X -28.0000 Y 39.0000 "
+                          "machine, 4.0000 mm deep")),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find(row("end position",
+                          "X 2.0000 Y -1.0000 Z 5.0000 G55 = X -28.0000 Y "
+                          "39.0000 Z -30.0000 machine")),
+            std::string::npos)
+      << text;
+}
+
+TEST(FormatReport, G92IsNamedAndManyHolesAreCut) {
+  machining::MachineTables tables;
+  tables.conditions.push_back({.e = 1, .name = "drill", .wear_ratio = 0.5});
+  std::string text = "G00 Z1\nG92 Z0.5\nE1\n";
+  for (int i = 0; i < 12; ++i) text += "G00 X" + std::to_string(i) + "\nG01 Z-1 F60\n";
+  text += "M30\n";
+  const GcodeResult g = interpret_gcode(text, "row.nc", tables);
+  ASSERT_TRUE(g.ok());
+  JobReport r = sample_report();
+  r.targets = program_targets(g.blocks, g.frames);
+  EXPECT_EQ(r.targets.holes.size(), 12u);
+  r.end = {};  // no position: no end row
+  const std::string out = format_report(r);
+  EXPECT_NE(out.find(row("work frame", "G54 + G92, origin at X 0.0000 Y 0.0000 Z 0.5000 machine")),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find(row("", "... and 2 more holes")), std::string::npos) << out;
+  EXPECT_EQ(out.find("end position"), std::string::npos) << out;
+}
+
+TEST(FormatReport, WithoutTheProgramOnlyTheMachinePosition) {
+  JobReport r = sample_report();
+  r.end.x_mm = 1.0;
+  r.end.y_mm = 2.0;
+  r.end.z_mm = 3.0;
+  const std::string text = format_report(r);
+  EXPECT_NE(text.find(row("end position", "X 1.0000 Y 2.0000 Z 3.0000 machine")), std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("work frame"), std::string::npos) << text;
+}
+
+TEST(ProgramTargets, DepthComesFromDepthMmOrTheOldMachineZ0) {
+  MotionBlock d{};
+  d.kind = MotionKind::kDrill;
+  d.target = {0, 0, -30.0};
+  EXPECT_DOUBLE_EQ(drill_depth_of(d), 30.0);  // no depth_mm: machine Z 0 is the surface
+  d.depth_mm = 6.0;
+  EXPECT_DOUBLE_EQ(drill_depth_of(d), 6.0);
+  EXPECT_DOUBLE_EQ(program_targets({d}).deepest_drill_mm, 6.0);
+  // Frames of the wrong size are ignored, not misread.
+  EXPECT_TRUE(program_targets({d}, {}).holes.empty());
+  EXPECT_FALSE(program_targets({d}, {}).end_frame.has_value());
 }
 
 }  // namespace

@@ -13,9 +13,18 @@ constexpr std::size_t kChunkBytes = 512 * 1024;  // well under the server's 1 Mi
 }  // namespace
 
 Reply Client::upload_program(std::span<const machining::MotionBlock> blocks,
-                             std::size_t chunk_blocks, std::string_view slot) {
+                             std::size_t chunk_blocks) {
+  UploadOptions o;
+  o.chunk_blocks = chunk_blocks;
+  return upload_program(blocks, o);
+}
+
+Reply Client::upload_program(std::span<const machining::MotionBlock> blocks,
+                             const UploadOptions& options) {
+  const std::size_t chunk_blocks = options.chunk_blocks;
   Json begin = {{"blocks", blocks.size()}};
-  if (!slot.empty()) begin["slot"] = std::string(slot);
+  if (!options.slot.empty()) begin["slot"] = options.slot;
+  if (options.offsets_generation) begin["offsets_generation"] = *options.offsets_generation;
   Reply r = request("program.begin", begin);
   if (!r) {
     return r;

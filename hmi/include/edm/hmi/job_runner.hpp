@@ -25,35 +25,25 @@
 
 namespace edm::hmi {
 
-/// The runtime's record of the last job that ended (status "job": {"last": ...}).
-struct LastJob {
-  std::string outcome;  // finished, aborted, interrupted
-  std::uint64_t block{0};
-  std::int32_t line{0};
-  std::optional<double> depth_mm;  // the depth the hole had when the job ended (mm)
-};
-
-/// status.job.last of a status reply or event; nullopt when absent or malformed.
-std::optional<LastJob> last_job_from_status(const bridge::Json& status);
-
 /// What the machine says about itself before a program is interpreted for it.
 struct MachineView {
   std::string name;
   machining::MachineTables tables;
   machining::Vec3 position{};  // io.x_mm / io.y_mm / io.z_mm of the status (0 when absent)
   bridge::StatusMessage status;
-  std::optional<LastJob> last_job;   // status.job.last
-  WorkOffsets offsets;               // offset.get (zero when the runtime has no such op)
-  bool offsets_known{false};         // offset.get answered
-  std::optional<double> deadman_ms;  // machine.info "manual": {"deadman_ms"}
+  std::optional<bridge::LastJob> last_job;  // status job.last: a job that may be resumed
+  WorkOffsets offsets;                      // offset.get (zero when the runtime has no such op)
+  std::optional<std::uint64_t> offsets_generation;  // offset.get's generation (absent: no op)
+  std::optional<double> deadman_ms;                 // machine.info "manual": {"deadman_ms"}
 };
 
 /// machine.info + status + offset.get. Throws bridge::ClientError when one is refused or
 /// malformed (an older runtime's unknown_op for offset.get leaves the offsets zero).
 MachineView fetch_machine(bridge::Client& client);
 
-/// offset.get. Throws bridge::ClientError when refused or malformed.
-WorkOffsets fetch_offsets(bridge::Client& client);
+/// offset.get: the frames and their generation. Throws bridge::ClientError when refused or
+/// malformed.
+WorkOffsets fetch_offsets(bridge::Client& client, std::uint64_t* generation = nullptr);
 
 struct RunRequest {
   std::string part;  // the part program's name (messages and report)
@@ -61,9 +51,10 @@ struct RunRequest {
   std::vector<machining::MotionBlock> blocks;
   std::vector<BlockFrame> frames;  // the work frame of each block (for the report), or empty
   std::string slot;                // program slot: "" (main, the default) or "mdi"
-  bool dry_run{false};             // cycle.start {"dry_run": true}: generator off, no drilling
-  bool detach{false};              // return once the cycle has started
-  int rate_hz{10};                 // status events while following the job
+  std::optional<std::uint64_t> offsets_generation;  // the offsets the blocks were made with
+  bool dry_run{false};  // cycle.start {"dry_run": true}: generator off, no drilling
+  bool detach{false};   // return once the cycle has started
+  int rate_hz{10};      // status events while following the job
   std::chrono::milliseconds lost_limit{std::chrono::seconds(60)};  // give up after this offline
 };
 

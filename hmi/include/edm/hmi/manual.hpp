@@ -3,11 +3,12 @@
 // (home), jog, touch-off and work offsets. The runtime runs them under its safety supervisor;
 // edmhmi sends the op, then follows `manual.status` until the operation is done.
 //
-//   home {"axes"?: "XYZ"}                       → {"axes": "ZXY"}
-//   jog {"axis", "distance"} | {"axis", "velocity"}, jog.stop
-//   touch {"target": "z|x+|x-|y+|y-|center"}
-//   manual.status → {"mode", "busy", "referenced", "result": {"seq", "op", "target", "ok",
-//                    "error", "x", "y", "z"}}
+//   home {"axes"?: "XYZ"}                       → {"seq", "axes": "ZXY"}
+//   jog {"axis", "distance"} | {"axis", "velocity"} → {"seq", "deadman_ms"}; jog.stop → {"seq"}
+//   touch {"target": "z|x+|x-|y+|y-|center"}    → {"seq"}
+//   manual.status → {"mode", "busy", "seen_seq", "referenced", "result": {"seq", "op", "target",
+//                    "ok", "error", "x", "y", "z", "size"}}
+// Every request gets a sequence number; the result names the request it answers.
 //   offset.get, offset.set {"frame", "x"?, "y"?, "z"?}
 //
 // Non-RT. The parsing and checking functions are pure (thread-compatible); wait_manual() calls
@@ -28,17 +29,19 @@ namespace edm::hmi {
 
 /// The last finished manual operation, as the runtime reports it.
 struct ManualResult {
-  std::uint64_t seq{0};  // grows by one per finished operation
+  std::uint64_t seq{0};  // the request it answers
   std::string op;        // home, jog, touch
   std::string target;    // touch: z, x+, x-, y+, y-, center
   bool ok{false};
   std::string error;
   std::optional<double> x_mm, y_mm, z_mm;  // machine coordinates (touch: surface, edge, centre)
+  std::optional<double> size_mm;           // touch center: the bore's diameter
 };
 
 struct ManualStatus {
   std::string mode;  // idle, home, jog, touch
   bool busy{false};
+  std::optional<std::uint64_t> seen_seq;            // the newest request the runtime has taken
   std::array<std::optional<bool>, 3> referenced{};  // X, Y, Z (absent: not reported)
   std::optional<ManualResult> result;
 };
@@ -79,13 +82,19 @@ struct ManualWait {
   ManualStatus status;      // the last one read
 };
 
-/// Polls manual.status every `period` until an operation newer than `seq_before` (the result's
-/// seq before the op was sent; nullopt: there was no result yet) has finished and the machine is
-/// not busy, `interrupt` is set, or `timeout` passes.
-ManualWait wait_manual(bridge::Client& client, std::optional<std::uint64_t> seq_before,
+/// Polls manual.status every `period` until the runtime has taken request `seq`, is not busy
+/// and its last result answers a request at or after `result_from` (for one request: its own
+/// seq; after a continuous jog's jog.stop, the first jog's), or `interrupt` is set, or `timeout`
+/// passes.
+ManualWait wait_manual(bridge::Client& client, std::uint64_t seq, std::uint64_t result_from,
                        const std::atomic<bool>& interrupt,
                        std::chrono::milliseconds period = std::chrono::milliseconds(50),
                        std::chrono::milliseconds timeout = std::chrono::minutes(30));
+
+/// manual.status's view of request `seq` (see wait_manual): done when taken, not busy and
+/// answered by a result at or after `result_from`.
+[[nodiscard]] bool manual_done(const ManualStatus& s, std::uint64_t seq,
+                               std::uint64_t result_from) noexcept;
 
 /// The jog refresh period for the runtime's dead-man timeout: deadman/3, at least 10 ms.
 std::chrono::milliseconds jog_refresh_period(double deadman_ms) noexcept;

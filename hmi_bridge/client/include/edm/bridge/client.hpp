@@ -59,6 +59,16 @@ struct ClientOptions {
   ClientTls tls;
 };
 
+/// program.begin's options (docs/protocol.md).
+struct UploadOptions {
+  std::size_t chunk_blocks{4096};
+  /// "main" or "mdi"; empty = the server's default (main), the field is then not sent.
+  std::string slot;
+  /// The offset.get generation the blocks were interpreted with: cycle.start refuses the program
+  /// once the work offsets have changed since. Absent: not checked.
+  std::optional<std::uint64_t> offsets_generation;
+};
+
 /// Could not connect or the hello was refused. what() says why (with the server's error code).
 class ClientError : public std::runtime_error {
  public:
@@ -118,11 +128,12 @@ class Client {
   Reply trace_stop();
 
   /// program.begin / program.chunk × n / program.commit with the CRC-32 checksum. Returns the
-  /// commit's reply, or the first failed one (then program.abort is sent). `slot` names the
-  /// program slot in program.begin ("main" or "mdi", docs/protocol.md); empty = the server's
-  /// default (main), the field is then not sent.
+  /// commit's reply, or the first failed one (then program.abort is sent).
   Reply upload_program(std::span<const machining::MotionBlock> blocks,
-                       std::size_t chunk_blocks = 4096, std::string_view slot = {});
+                       std::size_t chunk_blocks = 4096);
+  /// The same with program.begin's options: the slot, the work-offset generation.
+  Reply upload_program(std::span<const machining::MotionBlock> blocks,
+                       const UploadOptions& options);
 
   /// Closes and connects again with the last options, then replays subscriptions and trace.
   /// Throws ClientError like connect().
