@@ -93,9 +93,9 @@ void EdmJob::bind_self() {
   lin_.start.connect(lin_start);
   lin_.hold.connect(lin_hold);
   lin_.load.connect(lin_load);
-  lin_.load_x_mm.follow(x_mm);
-  lin_.load_y_mm.follow(y_mm);
-  lin_.load_z_mm.follow(z_mm);
+  lin_.load_x_mm.connect(move_from_x_mm);
+  lin_.load_y_mm.connect(move_from_y_mm);
+  lin_.load_z_mm.connect(move_from_z_mm);
   lin_.lx_mm.connect(lin_lx_mm);
   lin_.ly_mm.connect(lin_ly_mm);
   lin_.lz_mm.connect(lin_lz_mm);
@@ -104,8 +104,8 @@ void EdmJob::bind_self() {
   arc_.start.connect(arc_start);
   arc_.hold.connect(arc_hold);
   arc_.load.connect(arc_load);
-  arc_.load_x_mm.follow(x_mm);
-  arc_.load_y_mm.follow(y_mm);
+  arc_.load_x_mm.connect(move_from_x_mm);
+  arc_.load_y_mm.connect(move_from_y_mm);
   arc_.cw.connect(arc_cw);
   arc_.full_circle.connect(arc_full_circle);
   arc_.turns.connect(arc_turns);
@@ -205,9 +205,16 @@ void EdmJob::set_reference(double x, double y, double z, double vx, double vy, d
 
 void EdmJob::hold_position() noexcept { set_reference(hold_x_, hold_y_, hold_z_, 0.0, 0.0, 0.0); }
 
+void EdmJob::set_move_from() noexcept {
+  move_from_x_mm.set(hold_valid_ ? hold_x_ : x_mm.get());
+  move_from_y_mm.set(hold_valid_ ? hold_y_ : y_mm.get());
+  move_from_z_mm.set(hold_valid_ ? hold_z_ : z_mm.get());
+}
+
 bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                         rt::BlockStatus& status) noexcept {
-  if (step_ == Step::kEnter) {  // sync the interpolator to the actual position
+  if (step_ == Step::kEnter) {  // sync the interpolator to where the move starts
+    set_move_from();
     lin_load.set(true);
     status = rt::worst(status, step(lin_, ctx));
     step_ = Step::kLoad;
@@ -216,9 +223,9 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
   }
   if (step_ == Step::kLoad) {
     lin_load.set(false);
-    lin_lx_mm.set(b.target.x - x_mm.get());
-    lin_ly_mm.set(b.target.y - y_mm.get());
-    lin_lz_mm.set(b.target.z - z_mm.get());
+    lin_lx_mm.set(b.target.x - move_from_x_mm.get());
+    lin_ly_mm.set(b.target.y - move_from_y_mm.get());
+    lin_lz_mm.set(b.target.z - move_from_z_mm.get());
     const double f = b.kind == MotionKind::kRapid
                          ? params_.rapid_speed_mm_s
                          : (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s);
@@ -244,6 +251,7 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
 bool EdmJob::run_arc(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                      rt::BlockStatus& status) noexcept {
   if (step_ == Step::kEnter) {
+    set_move_from();
     arc_load.set(true);
     status = rt::worst(status, step(arc_, ctx));
     step_ = Step::kLoad;
@@ -251,7 +259,7 @@ bool EdmJob::run_arc(const MotionBlock& b, const rt::CycleContext& ctx, bool hol
     return false;
   }
   if (step_ == Step::kLoad) {
-    const double x = x_mm.get(), y = y_mm.get();
+    const double x = move_from_x_mm.get(), y = move_from_y_mm.get();
     arc_load.set(false);
     arc_cw.set(b.kind == MotionKind::kArcCw);
     arc_i_mm.set(b.centre.x - x);

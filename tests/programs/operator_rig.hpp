@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "edm/machining/program_check.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/manual.hpp"
@@ -86,6 +87,30 @@ struct OperatorRig {
     r.axis = static_cast<std::uint8_t>(axis);
     r.value = mm;
     return request(r);
+  }
+  /// Checks `blocks` from the current position as program.commit does, loads them into `slot`,
+  /// starts and runs until the job ends (or `limit`); true when it finished.
+  bool run_program(std::vector<machining::MotionBlock> blocks, rt::JobSlot slot,
+                   rt::Duration limit = std::chrono::seconds(600)) {
+    const machining::Vec3 at{read("io.x_mm"), read("io.y_mm"), read("io.z_mm")};
+    const auto issues = machining::check_program(blocks, runtime->tables(), at);
+    EXPECT_TRUE(issues.empty()) << "line " << issues.front().line << ": "
+                                << issues.front().message;
+    if (!issues.empty()) return false;
+    auto& job = runtime->job();
+    const auto loaded =
+        slot == rt::JobSlot::kMdi ? job.load_mdi(std::move(blocks)) : job.load(std::move(blocks));
+    EXPECT_EQ(loaded, rt::LoadResult::kOk);
+    const std::uint64_t started = job.progress().jobs_started;
+    job.set_start_options({slot, false});
+    EXPECT_EQ(runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+    const rt::TimePoint end = now + limit;
+    while (now < end) {
+      run_for(std::chrono::milliseconds(10));
+      if (job.progress().jobs_started > started && !job.active()) break;
+      if (rt::is_safe_state(runtime->machine().state())) break;
+    }
+    return job.progress().outcome == rt::JobOutcome::kFinished;
   }
   rt::ManualResult touch(rt::TouchTarget t) {
     rt::ManualRequest r;

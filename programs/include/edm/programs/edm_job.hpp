@@ -154,6 +154,13 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<double> arc_ex_mm{pins_, "arc_ex_mm", "mm"};
   rt::Output<double> arc_ey_mm{pins_, "arc_ey_mm", "mm"};
   rt::Output<double> arc_feed_mm_min{pins_, "arc_feed_mm_min", "mm/min"};
+  // Where the next interpolated move starts: the reference the last move ended on while it is
+  // valid (a job's moves chain on their references, so the mechanics' settling error never
+  // accumulates from block to block), else the actual position (after power-on, manual motion, a
+  // safe state).
+  rt::Output<double> move_from_x_mm{pins_, "move_from_x_mm", "mm"};
+  rt::Output<double> move_from_y_mm{pins_, "move_from_y_mm", "mm"};
+  rt::Output<double> move_from_z_mm{pins_, "move_from_z_mm", "mm"};
   rt::Output<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
   rt::Output<double> y_ref_mm{pins_, "y_ref_mm", "mm"};
   rt::Output<double> z_ref_mm{pins_, "z_ref_mm", "mm"};
@@ -186,6 +193,8 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   bool run_finish(const machining::MotionBlock& b, bool hold) noexcept;
   void set_reference(double x, double y, double z, double vx, double vy, double vz) noexcept;
   void hold_position() noexcept;
+  /// Sets move_from_* (see there) for the move that starts this cycle.
+  void set_move_from() noexcept;
   void stop_outputs() noexcept;
   [[nodiscard]] bool in_position() const noexcept;
 
