@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cli.hpp"
+#include "edm/hmi/job_report.hpp"
 #include "edm/hmi/manual.hpp"
 
 namespace edmhmi {
@@ -28,15 +29,30 @@ std::uint64_t request_seq(std::string_view op, const Reply& r) {
   return seq;
 }
 
-/// Prints the result of a finished wait; the exit code for it.
-int print_result(const edm::hmi::ManualWait& w) {
+/// "position X .. Y .. Z .. (machine)" from the status, "" when it has none.
+std::string position(edm::bridge::Client& client) {
+  const Reply r = client.request("status");
+  edm::bridge::StatusMessage s;
+  std::string error;
+  if (!r || !edm::bridge::from_json(r.body, s, error)) return "";
+  const edm::hmi::JobFigures f = edm::hmi::figures_from_status(s);
+  if (!f.x_mm || !f.y_mm || !f.z_mm) return "";
+  return "position " + edm::hmi::format_xyz({*f.x_mm, *f.y_mm, *f.z_mm}) + " (machine)";
+}
+
+/// Prints the result of a finished wait (and where the axes are now); the exit code for it.
+/// `stopped_ok`: an end by jog.stop is the expected end (a continuous jog).
+int print_result(edm::bridge::Client& client, const edm::hmi::ManualWait& w,
+                 bool stopped_ok = false) {
   if (!w.done) {
     std::fprintf(stderr, "edmhmi: %s\n", w.error.c_str());
     return kExitFailure;
   }
-  std::printf("%s\n", edm::hmi::format_manual_result(*w.status.result).c_str());
+  const edm::hmi::ManualResult& r = *w.status.result;
+  std::printf("%s\n", edm::hmi::format_manual_result(r).c_str());
+  if (const std::string p = position(client); !p.empty()) std::printf("%s\n", p.c_str());
   std::fflush(stdout);
-  return w.status.result->ok ? kExitOk : kExitFailure;
+  return r.ok || (stopped_ok && r.error == edm::hmi::kStoppedByOperator) ? kExitOk : kExitFailure;
 }
 
 /// jog.stop, then waits (at most 10 s) until the runtime has taken it and ended the motion.
@@ -60,11 +76,11 @@ int finish(edm::bridge::Client& client, std::uint64_t seq,
   if (w.interrupted) {
     std::fprintf(stderr, "edmhmi: interrupted: sending jog.stop\n");
     const edm::hmi::ManualWait s = stop_and_wait(client, seq);
-    if (s.done) std::printf("%s\n", edm::hmi::format_manual_result(*s.status.result).c_str());
+    if (s.done) print_result(client, s);
     return kExitInterrupted;
   }
   if (result != nullptr && w.done) *result = w.status.result;
-  return print_result(w);
+  return print_result(client, w);
 }
 
 int continuous_jog(edm::bridge::Client& client, char axis, double velocity, double for_s) {
@@ -93,7 +109,7 @@ int continuous_jog(edm::bridge::Client& client, char axis, double velocity, doub
       break;
     }
   }
-  const int stopped = print_result(stop_and_wait(client, first));
+  const int stopped = print_result(client, stop_and_wait(client, first), /*stopped_ok=*/true);
   return code != kExitOk ? code : stopped;
 }
 

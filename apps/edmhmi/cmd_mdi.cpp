@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cli.hpp"
+#include "edm/hmi/job_report.hpp"
 #include "edm/hmi/job_runner.hpp"
 #include "edm/hmi/mdi.hpp"
 
@@ -49,10 +50,8 @@ int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& setting
     const edm::machining::Vec3 m{*f.x_mm, *f.y_mm, *f.z_mm};
     const edm::hmi::BlockFrame& fr = g.frames.back();
     const edm::machining::Vec3 w = edm::hmi::to_work(m, fr.offset_mm);
-    char buf[200];
-    std::snprintf(buf, sizeof buf, "; at X %.4f Y %.4f Z %.4f %s = X %.4f Y %.4f Z %.4f machine",
-                  w.x, w.y, w.z, edm::hmi::frame_name(fr.frame).c_str(), m.x, m.y, m.z);
-    where = buf;
+    where = "; at " + edm::hmi::format_xyz(w) + " " + edm::hmi::frame_name(fr.frame) + " = " +
+            edm::hmi::format_xyz(m) + " machine";
   }
   std::printf("mdi: %s (%zu blocks)%s\n", r.report.outcome.c_str(), g.blocks.size(), where.c_str());
   if (r.outcome == RunOutcome::kInterrupted) return kExitInterrupted;

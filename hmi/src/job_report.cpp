@@ -25,15 +25,14 @@ std::string percent(const std::optional<double>& f) {
   return f ? fmt("%.2f %%", *f * 100.0) : std::string("n/a");
 }
 
-std::string xyz(const machining::Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f Z %.4f", v.x, v.y, v.z);
-  return buf;
-}
+/// A coordinate that rounds to 0 at 4 decimals prints as 0, not -0.
+double tidy(double mm) { return std::fabs(mm) < 5e-5 ? 0.0 : mm; }
+
+std::string xyz(const machining::Vec3& v) { return format_xyz(v); }
 
 std::string xy(const machining::Vec3& v) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f", v.x, v.y);
+  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f", tidy(v.x), tidy(v.y));
   return buf;
 }
 
@@ -68,6 +67,12 @@ void position_rows(const JobReport& r, Row&& row) {
 }
 
 }  // namespace
+
+std::string format_xyz(const machining::Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "X %.4f Y %.4f Z %.4f", tidy(v.x), tidy(v.y), tidy(v.z));
+  return buf;
+}
 
 std::optional<double> JobFigures::short_fraction() const {
   if (!pulses || !shorts || *pulses <= 0.0) return std::nullopt;

@@ -198,6 +198,16 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   if (const bridge::Reply s = client.request("cycle.start", start); !s) {
     return refused("cycle.start: " + reply_error(s));
   }
+  // Snapshots taken before the start (the reply comes after them on the connection) show the
+  // previous job: skip them.
+  std::uint64_t seen = 0;
+  {
+    std::lock_guard lock(inbox.mutex);
+    seen = inbox.status_count;
+  }
+  // The MDI slot's load does not change job.generation (that counts main programs): an MDI job is
+  // known by the machine leaving RUNNING after the start instead.
+  const bool mdi = req.slot == "mdi";
 
   RunResult result;
   result.report.part = req.part;
@@ -215,7 +225,6 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   bool stop_sent = false;
   Clock::time_point stop_sent_at{};
   DepthRate rate;
-  std::uint64_t seen = 0;
   StatusMessage last = before;
   for (;;) {
     std::optional<StatusMessage> st;
@@ -278,7 +287,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
     }
     if (!st) continue;
     last = *st;
-    if (last.job_generation != generation) continue;  // not our program (yet)
+    if (!mdi && last.job_generation != generation) continue;  // not our program (yet)
 
     ProgressView v;
     v.state = last.state;
@@ -307,14 +316,17 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
       }
     }
     if (cb.progress) cb.progress(v);
-    if (last.job_outcome == "finished" || last.job_outcome == "aborted") break;
+    const bool ended = last.job_outcome == "finished" || last.job_outcome == "aborted";
+    if (ended && (!mdi || (last.state != "RUNNING" && last.state != "HOLD"))) break;
   }
 
   // The final figures: one more status, so the report shows the job's last cycle.
   StatusMessage final_status = last;
   if (const bridge::Reply st = client.request("status"); st) {
     StatusMessage s;
-    if (bridge::from_json(st.body, s, error) && s.job_generation == generation) final_status = s;
+    if (bridge::from_json(st.body, s, error) && (mdi || s.job_generation == generation)) {
+      final_status = s;
+    }
   }
   {  // alarms that came with the end
     std::lock_guard lock(inbox.mutex);

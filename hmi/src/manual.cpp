@@ -144,13 +144,20 @@ std::optional<Json> offset_set_for_touch(std::string_view frame, TouchTarget t,
 std::string format_manual_result(const ManualResult& r) {
   std::string s = r.op.empty() ? std::string("manual operation") : r.op;
   if (!r.target.empty()) s += " " + r.target;
-  s += r.ok ? " ok" : " failed";
-  if (!r.ok && !r.error.empty()) s += ": " + r.error;
+  if (r.ok) {
+    s += " ok";
+  } else if (r.error == kStoppedByOperator) {
+    s += " " + r.error;  // the expected end of a continuous jog, not a failure
+  } else {
+    s += " failed";
+    if (!r.error.empty()) s += ": " + r.error;
+  }
   char buf[48];
+  if (r.op != "touch") return s;  // only a touch's coordinates are a result (the place found)
   for (auto [name, v] :
        {std::pair{"X", &r.x_mm}, std::pair{"Y", &r.y_mm}, std::pair{"Z", &r.z_mm}}) {
     if (!*v) continue;
-    std::snprintf(buf, sizeof buf, " %s %.4f", name, **v);
+    std::snprintf(buf, sizeof buf, " %s %.4f", name, std::fabs(**v) < 5e-5 ? 0.0 : **v);
     s += buf;
   }
   if (r.x_mm || r.y_mm || r.z_mm) s += " (machine)";

@@ -71,8 +71,9 @@ bridge::Json to_json(const WorkOffsets& offsets) {
 
 std::string format_frame(int index, const machining::Vec3& v) {
   char buf[96];
-  std::snprintf(buf, sizeof buf, "%s  X %9.4f  Y %9.4f  Z %9.4f", frame_name(index).c_str(), v.x,
-                v.y, v.z);
+  auto tidy = [](double mm) { return std::fabs(mm) < 5e-5 ? 0.0 : mm; };  // no "-0.0000"
+  std::snprintf(buf, sizeof buf, "%s  X %9.4f  Y %9.4f  Z %9.4f", frame_name(index).c_str(),
+                tidy(v.x), tidy(v.y), tidy(v.z));
   return buf;
 }
 

@@ -137,6 +137,13 @@ TEST(TouchSet, PutsTheTouchedAxesIntoTheFrame) {
   no_y.y_mm.reset();
   EXPECT_FALSE(offset_set_for_touch("G54", TouchTarget::kCenter, no_y).has_value());
   EXPECT_EQ(format_manual_result(failed), "touch z failed: no_contact");
+  // A home or jog result's coordinates are not a finding: not printed.
+  ManualResult jog = result(3, "jog");
+  jog.x_mm = jog.y_mm = jog.z_mm = 0.0;
+  EXPECT_EQ(format_manual_result(jog), "jog ok");
+  jog.ok = false;
+  jog.error = std::string(kStoppedByOperator);
+  EXPECT_EQ(format_manual_result(jog), "jog stopped by the operator");
 }
 
 TEST(WorkFrames, NamesAndIndices) {

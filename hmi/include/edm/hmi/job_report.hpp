@@ -78,6 +78,9 @@ struct ProgressView {
 /// over the blocks, then numbers, elapsed time, ETA and the state.
 std::string format_progress(const ProgressView& v, int bar_width = 24);
 
+/// "X 1.2500 Y -3.0000 Z 0.0000" (mm, 4 decimals; a value that rounds to 0 prints as 0, not -0).
+std::string format_xyz(const machining::Vec3& v);
+
 /// "1:02:03" / "2:03" style.
 std::string format_duration(double seconds);
 

@@ -71,7 +71,12 @@ std::string_view to_string(TouchTarget t) noexcept;
 std::optional<bridge::Json> offset_set_for_touch(std::string_view frame, TouchTarget t,
                                                  const ManualResult& r);
 
-/// "touch x+ ok: X 12.3456" / "home ok" / "jog failed: soft limit".
+/// The runtime's error text of a manual operation ended by jog.stop (ManualError::kStopped): the
+/// expected end of a continuous jog.
+inline constexpr std::string_view kStoppedByOperator = "stopped by the operator";
+
+/// "touch x+ ok X 12.3456 (machine)" / "home ok" / "jog failed: <the runtime's error>"; the
+/// coordinates only for a touch (they are what it found).
 std::string format_manual_result(const ManualResult& r);
 
 /// What wait_manual saw.
