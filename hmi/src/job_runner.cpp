@@ -17,6 +17,9 @@ using Clock = std::chrono::steady_clock;
 
 bool is_safe_state(const std::string& state) { return state == "FAULT" || state == "ESTOP"; }
 
+/// Runtime seconds after which a status snapshot surely postdates a cycle.start (many cycles).
+constexpr double kMdiSettleS = 0.1;
+
 /// Events arrive on the client's I/O thread; the runner reads them on its own.
 struct Inbox {
   std::mutex mutex;
@@ -159,7 +162,11 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   const auto generation = up.body.value("generation", std::uint64_t{0});
 
   Inbox inbox;
-  client.set_event_handler([&inbox](const Json& ev) {
+  // An alarm raised before this job (e.g. 182 at power-on, acknowledged by a reset) may reach a
+  // fresh subscriber late (the runtime broadcasts in batches): only those of the job's own time
+  // belong to its report.
+  const double since_s = before.t_s;
+  client.set_event_handler([&inbox, since_s](const Json& ev) {
     const std::string kind = ev.value("event", std::string());
     std::lock_guard lock(inbox.mutex);
     if (kind == "status") {
@@ -170,6 +177,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
         ++inbox.status_count;
       }
     } else if (kind == "alarm") {
+      if (ev.value("t_s", since_s) < since_s) return;  // older than the job
       inbox.alarms.emplace_back(describe_alarm(ev), ev.value("severity", std::string()) == "fault");
     } else {
       return;  // progress and trace events: the status carries what the runner needs
@@ -205,9 +213,18 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
     std::lock_guard lock(inbox.mutex);
     seen = inbox.status_count;
   }
-  // The MDI slot's load does not change job.generation (that counts main programs): an MDI job is
-  // known by the machine leaving RUNNING after the start instead.
+  // The MDI slot's load does not change job.generation (that counts main programs): an MDI job's
+  // end is the machine leaving RUNNING after it was seen running — or, for a job too short to be
+  // seen, a snapshot taken well after the start (a status event may carry a snapshot a cycle
+  // older than the start, with the previous job's outcome).
   const bool mdi = req.slot == "mdi";
+  double mdi_after_t_s = 0.0;
+  if (mdi) {
+    StatusMessage now;
+    const bridge::Reply st = client.request("status");
+    if (st && bridge::from_json(st.body, now, error)) mdi_after_t_s = now.t_s + kMdiSettleS;
+  }
+  bool seen_running = false;
 
   RunResult result;
   result.report.part = req.part;
@@ -316,8 +333,10 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
       }
     }
     if (cb.progress) cb.progress(v);
+    const bool running = last.state == "RUNNING" || last.state == "HOLD";
+    if (running || last.job_outcome == "running") seen_running = true;
     const bool ended = last.job_outcome == "finished" || last.job_outcome == "aborted";
-    if (ended && (!mdi || (last.state != "RUNNING" && last.state != "HOLD"))) break;
+    if (ended && (!mdi || (!running && (seen_running || last.t_s > mdi_after_t_s)))) break;
   }
 
   // The final figures: one more status, so the report shows the job's last cycle.
