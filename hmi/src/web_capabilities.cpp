@@ -77,6 +77,14 @@ std::vector<std::string> probe_ops(const std::string& host, std::uint16_t port,
   return known;
 }
 
+std::vector<std::string> operator_function_ops() {
+  std::vector<std::string> ops;
+  for (const OperatorFunction& f : kOperatorFunctions) {
+    if (std::find(ops.begin(), ops.end(), f.op) == ops.end()) ops.emplace_back(f.op);
+  }
+  return ops;
+}
+
 Json capabilities_json(const Json& machine_info, const std::vector<std::string>* probed) {
   std::vector<std::string> ops;
   std::string source = "none";
@@ -89,11 +97,31 @@ Json capabilities_json(const Json& machine_info, const std::vector<std::string>*
     source = "probe";
     ops = *probed;
   }
-  Json caps = {{"source", source}};
-  for (const OperatorFunction& f : kOperatorFunctions) {
-    caps[std::string(f.key)] = std::find(ops.begin(), ops.end(), f.op) != ops.end();
+  const auto has = [&ops](std::string_view op) {
+    return std::find(ops.begin(), ops.end(), op) != ops.end();
+  };
+  Json manual = nullptr;
+  if (machine_info.is_object() && machine_info.contains("manual") &&
+      machine_info["manual"].is_object()) {
+    manual = machine_info["manual"];
   }
-  caps["work_coordinates"] = caps["offsets"];
+  Json caps = {{"source", source}, {"manual", manual}};
+  Json why = Json::object();
+  for (const OperatorFunction& f : kOperatorFunctions) {
+    bool ok = has(f.op);
+    if (!ok) {
+      why[std::string(f.key)] = "not supported by this edmplc";
+    } else if (!f.manual.empty()) {
+      const std::string flag(f.manual);
+      ok = manual.is_object() && manual.contains(flag) && manual[flag].is_boolean() &&
+           manual[flag].get<bool>();
+      if (!ok) why[std::string(f.key)] = f.why;
+    }
+    caps[std::string(f.key)] = ok;
+  }
+  caps["work_coordinates"] = has("offset.get");
+  caps["manual_status"] = has("manual.status");
+  caps["why"] = std::move(why);
   return caps;
 }
 

@@ -78,7 +78,12 @@ std::vector<WebSeries> choose_series(const Json& var_list) {
 }  // namespace
 
 WebHub::WebHub(boost::asio::io_context& ioc, bridge::Client& client, ConnectionSettings settings)
-    : ioc_(ioc), client_(client), settings_(std::move(settings)), job_(client), timer_(ioc) {
+    : ioc_(ioc),
+      client_(client),
+      settings_(std::move(settings)),
+      job_(client),
+      manual_(client),
+      timer_(ioc) {
   for (Worker& w : workers_) w.thread = std::thread([this, &w] { worker_loop(w); });
 }
 
@@ -87,25 +92,27 @@ WebHub::~WebHub() { stop(); }
 void WebHub::start() {
   std::string error;
   if (!job_.refresh_machine(error)) throw bridge::ClientError(error);
-  const Json info = job_.machine_info();
-  std::vector<std::string> wanted;
-  for (const OperatorFunction& f : kOperatorFunctions) wanted.emplace_back(f.op);
+  const Json info = job_.machine_info_raw();
   Json caps;
   if (info.contains("ops")) {
     caps = capabilities_json(info, nullptr);
-  } else {
+  } else {  // an edmplc before issue 21
     try {
-      const std::vector<std::string> known =
-          probe_ops(settings_.host, settings_.port, wanted, std::chrono::seconds(3));
+      const std::vector<std::string> known = probe_ops(
+          settings_.host, settings_.port, operator_function_ops(), std::chrono::seconds(3));
       caps = capabilities_json(info, &known);
     } catch (const std::exception& e) {
       caps = capabilities_json(info, nullptr);
       caps["error"] = e.what();
     }
   }
+  if (std::string why; !job_.refresh_offsets(why)) throw bridge::ClientError(why);
   const bridge::Reply vars = client_.request("var.list");
   if (!vars) throw bridge::ClientError("var.list: " + vars.message, vars.code);
   std::vector<WebSeries> series = choose_series(vars.body);
+  const Json manual_info = caps.value("manual", Json(nullptr));
+  const bool has_manual_status = caps.value("manual_status", false);
+  const bool has_offsets = caps.value("work_coordinates", false);
   {
     std::lock_guard lock(mutex_);
     caps_ = std::move(caps);
@@ -121,6 +128,7 @@ void WebHub::start() {
   if (const bridge::Reply r = client_.subscribe({"status", "alarm", "progress"}, kFrameHz); !r) {
     throw bridge::ClientError("subscribe: " + r.message, r.code);
   }
+  manual_.start(manual_info, has_manual_status, has_offsets);
   if (!series.empty()) {
     std::vector<std::string> names;
     for (const WebSeries& s : series) names.push_back(s.var);
@@ -134,6 +142,7 @@ void WebHub::start() {
 void WebHub::stop() {
   if (stopped_) return;
   stopped_ = true;
+  manual_.stop();  // a held jog is stopped
   for (Worker& w : workers_) {
     {
       std::lock_guard lock(w.mutex);
@@ -217,6 +226,8 @@ std::string WebHub::welcome(bridge::Role role) const {
                   {"alarms", alarms_json_locked()},
                   {"history", Json(history_)},
                   {"status", last_status_},
+                  {"manual", manual_.manual_json()},
+                  {"offsets", manual_.offsets_json()},
                   {"bridge", bridge_up_}};
   return w.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
@@ -265,7 +276,10 @@ void WebHub::on_event(const Json& ev) {
   if (kind == "status") {
     bridge::StatusMessage s;
     std::string error;
-    if (bridge::from_json(ev, s, error)) job_.on_status(s);
+    if (bridge::from_json(ev, s, error)) {
+      job_.on_status(s);
+      manual_.on_status_time(s.t_s);
+    }
     Json st = ev;
     st.erase("event");
     st.erase("seq");
@@ -366,6 +380,15 @@ void WebHub::on_timer() {
     }
     if (bridge_changed_) {
       bridge_changed_ = false;
+      any = true;
+    }
+    WebManual::Changes changes = manual_.take_changes();
+    if (!changes.manual.is_null()) {
+      frame["manual"] = std::move(changes.manual);
+      any = true;
+    }
+    if (!changes.offsets.is_null()) {
+      frame["offsets"] = std::move(changes.offsets);
       any = true;
     }
     frame["bridge"] = bridge_up_;

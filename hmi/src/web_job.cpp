@@ -6,6 +6,8 @@
 
 #include "edm/bridge/machine_info.hpp"
 #include "edm/hmi/job_runner.hpp"
+#include "edm/hmi/mdi.hpp"
+#include "edm/hmi/resume.hpp"
 
 namespace edm::hmi {
 
@@ -35,6 +37,27 @@ Json no_machine_info() { return {{"ok", false}, {"message", "no machine.info yet
 
 std::string reply_error(const bridge::Reply& r) {
   return (r.code ? std::string(bridge::to_string(*r.code)) + ": " : std::string()) + r.message;
+}
+
+Json refused(std::string_view code, const std::string& message) {
+  return {{"ok", false}, {"code", code}, {"message", message}};
+}
+
+Json refused(const bridge::Reply& r, const std::string& what) {
+  return refused(r.code ? std::string(bridge::to_string(*r.code)) : "transport",
+                 what + ": " + reply_error(r));
+}
+
+/// The frames of a program as runs: [first block, frame, ox, oy, oz] each time the frame (or the
+/// G92 offset) changes — a few entries, whatever the program's length.
+Json frame_runs(const std::vector<BlockFrame>& frames) {
+  Json runs = Json::array();
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (i > 0 && frames[i] == frames[i - 1]) continue;
+    const BlockFrame& f = frames[i];
+    runs.push_back(Json::array({i, f.frame, f.offset_mm.x, f.offset_mm.y, f.offset_mm.z}));
+  }
+  return runs;
 }
 
 Json errors_json(const std::vector<GcodeError>& errors) {
@@ -110,8 +133,48 @@ bool WebJob::refresh_machine(std::string& error) {
   std::lock_guard lock(mutex_);
   tables_ = std::move(tables);
   machine_name_ = std::move(name);
+  machine_raw_ = info.body;
+  machine_raw_.erase("id");
+  machine_raw_.erase("ok");
   have_tables_ = true;
   return true;
+}
+
+Json WebJob::machine_info_raw() const {
+  std::lock_guard lock(mutex_);
+  return machine_raw_;
+}
+
+bool WebJob::refresh_offsets(std::string& error) {
+  const bridge::Reply r = client_.request("offset.get");
+  if (!r) {
+    if (r.code == bridge::ErrorCode::kUnknownOp) {  // an edmplc before issue 21: machine = work
+      std::lock_guard lock(mutex_);
+      offsets_ = WorkOffsets{};
+      offsets_generation_.reset();
+      offsets_json_ = nullptr;
+      return true;
+    }
+    error = "offset.get: " + reply_error(r);
+    return false;
+  }
+  WorkOffsets offsets;
+  if (!offsets_from_json(r.body, offsets, error)) {
+    error = "offset.get: " + error;
+    return false;
+  }
+  const std::uint64_t generation = r.body.value("generation", std::uint64_t{0});
+  std::lock_guard lock(mutex_);
+  offsets_ = offsets;
+  offsets_generation_ = generation;
+  offsets_json_ = to_json(offsets);
+  offsets_json_["generation"] = generation;
+  return true;
+}
+
+Json WebJob::offsets_json() const {
+  std::lock_guard lock(mutex_);
+  return offsets_json_;
 }
 
 Json WebJob::machine_info() const {
@@ -127,20 +190,52 @@ std::optional<Vec3> WebJob::position_locked() const {
 }
 
 std::optional<GcodeResult> WebJob::interpret(const std::string& text, const std::string& name,
-                                             GcodeOptions& options) const {
+                                             GcodeOptions& options,
+                                             std::optional<std::uint64_t>& generation) const {
   machining::MachineTables tables;
   {
     std::lock_guard lock(mutex_);
     if (!have_tables_) return std::nullopt;
     tables = tables_;
     options.start_mm = position_locked().value_or(Vec3{});
+    options.offsets = offsets_;
+    generation = offsets_generation_;
   }
   return interpret_gcode(text, name, tables, options);
 }
 
+bridge::Reply WebJob::upload_blocks(const std::vector<machining::MotionBlock>& blocks,
+                                    const std::string& slot,
+                                    std::optional<std::uint64_t> generation) const {
+  bridge::UploadOptions o;
+  o.slot = slot;
+  o.offsets_generation = generation;
+  return client_.upload_program(blocks, o);
+}
+
+void WebJob::load_locked(std::string part, std::string text,
+                         std::vector<machining::MotionBlock> blocks,
+                         const std::vector<BlockFrame>& frames, const Vec3& start,
+                         std::uint64_t generation) {
+  part_ = std::move(part);
+  text_ = std::move(text);
+  generation_ = generation;
+  toolpath_ = toolpath_points(blocks, start, kMaxToolpathPoints);
+  blocks_ = std::move(blocks);
+  frames_ = frames;
+  frame_runs_ = frame_runs(frames_);
+  resumed_from_.reset();
+  started_ = false;
+  report_done_ = false;
+  report_ = JobReport{};
+}
+
 Json WebJob::check(const std::string& text, const std::string& name) {
+  std::string error;
+  if (!refresh_offsets(error)) return refused("transport", error);
   GcodeOptions options;
-  const std::optional<GcodeResult> result = interpret(text, name, options);
+  std::optional<std::uint64_t> generation;
+  const std::optional<GcodeResult> result = interpret(text, name, options, generation);
   if (!result) return no_machine_info();
   const GcodeResult& g = *result;
   return {{"ok", g.ok()},
@@ -152,8 +247,11 @@ Json WebJob::check(const std::string& text, const std::string& name) {
 }
 
 Json WebJob::upload(const std::string& text, const std::string& name) {
+  std::string error;
+  if (!refresh_offsets(error)) return refused("transport", error);
   GcodeOptions options;
-  std::optional<GcodeResult> result = interpret(text, name, options);
+  std::optional<std::uint64_t> offsets_generation;
+  std::optional<GcodeResult> result = interpret(text, name, options, offsets_generation);
   if (!result) return no_machine_info();
   GcodeResult& g = *result;
   if (!g.ok()) {
@@ -162,7 +260,7 @@ Json WebJob::upload(const std::string& text, const std::string& name) {
             {"message", std::to_string(g.errors.size()) + " error(s) in the program"},
             {"errors", errors_json(g.errors)}};
   }
-  const bridge::Reply up = client_.upload_program(g.blocks);
+  const bridge::Reply up = upload_blocks(g.blocks, "", offsets_generation);
   if (!up) {
     Json errors = Json::array();
     if (up.details.is_object() && up.details.contains("issues") &&
@@ -179,24 +277,20 @@ Json WebJob::upload(const std::string& text, const std::string& name) {
             {"errors", errors}};
   }
   std::lock_guard lock(mutex_);
-  part_ = name;
-  text_ = text;
-  generation_ = up.body.value("generation", std::uint64_t{0});
-  toolpath_ = toolpath_points(g.blocks, options.start_mm, kMaxToolpathPoints);
-  blocks_ = std::move(g.blocks);
-  started_ = false;
-  report_done_ = false;
-  report_ = JobReport{};
+  load_locked(name, text, std::move(g.blocks), g.frames, options.start_mm,
+              up.body.value("generation", std::uint64_t{0}));
   return {{"ok", true}, {"generation", generation_}, {"blocks", blocks_.size()}};
 }
 
-bridge::Reply WebJob::start() {
+bridge::Reply WebJob::start(bool dry_run) {
   std::optional<double> electrode;
   {
     std::lock_guard lock(mutex_);
     if (last_status_) electrode = figures_from_status(*last_status_).electrode_mm;
   }
-  bridge::Reply r = client_.request("cycle.start");
+  // Only a dry run says so: an edmplc before issue 21 knows no "dry_run".
+  bridge::Reply r =
+      client_.request("cycle.start", dry_run ? Json{{"dry_run", true}} : Json::object());
   if (r) {
     std::lock_guard lock(mutex_);
     started_ = true;
@@ -204,10 +298,104 @@ bridge::Reply WebJob::start() {
     report_ = JobReport{};
     report_.part = part_;
     report_.machine = machine_name_;
-    report_.targets = program_targets(blocks_);
+    report_.targets = frames_.size() == blocks_.size() ? program_targets(blocks_, frames_)
+                                                       : program_targets(blocks_);
     report_.electrode_at_start_mm = electrode;
   }
   return r;
+}
+
+Json WebJob::start_from(std::int32_t line, std::optional<double> depth_done_mm, bool dry_run) {
+  std::string error;
+  if (!refresh_offsets(error)) return refused("transport", error);
+  std::string part, text;
+  std::optional<bridge::LastJob> last;
+  {
+    std::lock_guard lock(mutex_);
+    part = part_;
+    text = text_;
+    if (last_status_) last = last_status_->job_last;
+  }
+  if (text.empty()) return refused("invalid_state", "no program loaded: upload one first");
+  GcodeOptions options;
+  std::optional<std::uint64_t> offsets_generation;
+  const std::optional<GcodeResult> g = interpret(text, part, options, offsets_generation);
+  if (!g) return no_machine_info();
+  if (!g->ok()) {
+    Json r = refused("bad_program", std::to_string(g->errors.size()) + " error(s) in the program");
+    r["errors"] = errors_json(g->errors);
+    return r;
+  }
+  machining::MachineTables tables;
+  {
+    std::lock_guard lock(mutex_);
+    tables = tables_;
+  }
+  // The depth the hole on that line already has: the operator's figure, else the runtime's record
+  // of the last job when it ended on that very line (as `edmhmi run --from`), else none.
+  ResumePlan plan = plan_resume(*g, tables, line, 0.0);
+  std::string depth_from = "none";
+  if (plan.ok() && plan.drill) {
+    double depth = 0.0;
+    if (depth_done_mm) {
+      depth = *depth_done_mm;
+      depth_from = "operator";
+    } else if (last && last->line == plan.line && last->depth_mm) {
+      depth = std::max(0.0, *last->depth_mm);
+      depth_from = "last job (" + last->outcome + ")";
+    }
+    if (depth > 0.0) plan = plan_resume(*g, tables, line, depth);
+  } else if (plan.ok() && depth_done_mm && *depth_done_mm > 0.0) {
+    plan = plan_resume(*g, tables, line, *depth_done_mm);  // refused: no drilling on that line
+  }
+  if (!plan.ok())
+    return refused("bad_request", "from line " + std::to_string(line) + ": " + plan.error);
+  const bridge::Reply up = upload_blocks(plan.blocks, "", offsets_generation);
+  if (!up) return refused(up, "program refused");
+  {
+    std::lock_guard lock(mutex_);
+    load_locked(part, text, plan.blocks, plan.frames, options.start_mm,
+                up.body.value("generation", std::uint64_t{0}));
+    resumed_from_ = plan.line;
+  }
+  const bridge::Reply r = start(dry_run);
+  if (!r) return refused(r, "resumed program committed; cycle.start");
+  return {{"ok", true},
+          {"line", plan.line},
+          {"first_block", plan.first + 1},
+          {"prologue", plan.prologue},
+          {"blocks", plan.blocks.size()},
+          {"depth_done_mm", plan.depth_done_mm},
+          {"depth_from", depth_from},
+          {"clearance_z_mm", plan.clearance_z_mm}};
+}
+
+Json WebJob::mdi(const std::string& line) {
+  std::string error;
+  if (!refresh_offsets(error)) return refused("transport", error);
+  machining::MachineTables tables;
+  WorkOffsets offsets;
+  std::optional<std::uint64_t> generation;
+  Vec3 position;
+  {
+    std::lock_guard lock(mutex_);
+    if (!have_tables_) return no_machine_info();
+    tables = tables_;
+    offsets = offsets_;
+    generation = offsets_generation_;
+    position = position_locked().value_or(Vec3{});
+  }
+  const GcodeResult g = interpret_mdi(line, tables, offsets, position);
+  if (!g.ok()) {
+    Json r = refused("bad_program", g.messages().empty() ? "bad line" : g.messages().front());
+    r["errors"] = errors_json(g.errors);
+    return r;
+  }
+  const bridge::Reply up = upload_blocks(g.blocks, "mdi", generation);
+  if (!up) return refused(up, "MDI refused");
+  const bridge::Reply r = client_.request("cycle.start", Json{{"slot", "mdi"}});
+  if (!r) return refused(r, "MDI committed; cycle.start");
+  return {{"ok", true}, {"blocks", g.blocks.size()}};
 }
 
 void WebJob::on_status(const bridge::StatusMessage& s) {
@@ -245,6 +433,8 @@ Json WebJob::snapshot() const {
           {"blocks", blocks_.size()},
           {"started", started_},
           {"toolpath", toolpath_},
+          {"frames", frame_runs_},
+          {"resumed_from", resumed_from_ ? Json(*resumed_from_) : Json(nullptr)},
           {"report", report}};
 }
 

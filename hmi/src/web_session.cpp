@@ -1,5 +1,6 @@
 #include "edm/hmi/web_session.hpp"
 
+#include <atomic>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/ssl.hpp>
@@ -21,20 +22,26 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 /// Commands a viewer may send: none of them changes the machine or the job.
-const std::set<std::string, std::less<>> kViewerCommands{"check", "stats", "var.list", "var.read",
-                                                         "job"};
+const std::set<std::string, std::less<>> kViewerCommands{
+    "check", "stats", "var.list", "var.read", "job", "offset.get", "manual.status"};
 /// Machine commands relayed as they are.
 const std::set<std::string, std::less<>> kMachineOps{"cycle.hold", "cycle.resume", "cycle.stop",
                                                      "estop", "reset"};
+/// Manual commands relayed with the fields edmplc checks (values, ranges, the machine's state).
+const std::set<std::string, std::less<>> kManualOps{"home", "jog", "jog.stop"};
+/// Quick commands on the machine lane; the rest (interpretation, uploads) on the program lane.
+const std::set<std::string, std::less<>> kMachineLane{
+    "start", "feed.override", "home", "jog", "jog.stop", "jog.hold", "touch", "offset.set"};
 
-Json reply_json(const bridge::Reply& r) {
-  Json j = {{"ok", r.ok}, {"body", r.body}};
-  if (!r.ok) {
-    j["code"] = r.code ? std::string(bridge::to_string(*r.code)) : "transport";
-    j["message"] = r.message;
-    if (!r.details.is_null()) j["details"] = r.details;
-  }
-  return j;
+Json reply_json(const bridge::Reply& r) { return page_reply(r); }
+
+Json bad_request(const std::string& message) {
+  return {{"ok", false}, {"code", "bad_request"}, {"message", message}};
+}
+
+std::uint64_t next_session_id() {
+  static std::atomic<std::uint64_t> next{1};
+  return next++;
 }
 
 /// `Stream`: beast::tcp_stream (WS) or beast::ssl_stream<beast::tcp_stream> (WSS), after the HTTP
@@ -48,7 +55,10 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   WsSession(Stream stream, WebHub& hub)
       : ws_(std::move(stream)), hub_(hub), login_timer_(ws_.get_executor()) {}
 
-  ~WsSession() override { hub_.detach(this); }
+  ~WsSession() override {
+    hub_.manual().drop(id_);
+    hub_.detach(this);
+  }
 
   void run(beast::http::request<beast::http::string_body> req) {
     // Beast's server defaults (pings, 300 s idle), but a close handshake the peer does not answer
@@ -99,7 +109,10 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   }
 
   void on_read(beast::error_code ec) {
-    if (ec) return;  // closed, timed out or too large: the session ends
+    if (ec) {  // closed, timed out or too large: the session ends, and a jog it held stops now
+      hub_.manual().drop(id_);
+      return;
+    }
     const std::string text = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
     const Json msg = Json::parse(text, nullptr, /*allow_exceptions=*/false);
@@ -109,6 +122,8 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
       return on_login(msg);  // reading resumes once the token is checked
     } else if (msg["t"] == "cmd") {
       on_command(msg);
+    } else if (msg["t"] == "held") {  // the jog button is still down (no reply)
+      if (*role_ == bridge::Role::kOperator) hub_.manual().held(id_);
     } else {
       send_json({{"t", "error"}, {"message", "unknown message type"}});
     }
@@ -158,25 +173,37 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
       hub_.acknowledge_alarms(msg.value("seq", std::uint64_t{0}));
       return send_json({{"t", "reply"}, {"id", id}, {"ok", true}});
     }
+    if (op == "jog.release") {  // at once, never behind a queue
+      hub_.manual().release(id_);
+      return send_json({{"t", "reply"}, {"id", id}, {"ok", true}});
+    }
+    if (op == "manual.status" || op == "offset.get") {  // what the hub follows anyway
+      const Json body =
+          op == "manual.status" ? hub_.manual().manual_json() : hub_.manual().offsets_json();
+      return send_json({{"t", "reply"}, {"id", id}, {"ok", !body.is_null()}, {"body", body}});
+    }
     if (in_flight_ >= kMaxInFlight) return refuse("busy", "too many commands in progress");
     ++in_flight_;
-    const WebHub::Lane lane = kMachineOps.contains(op) || op == "start" || op == "feed.override"
+    const WebHub::Lane lane = kMachineOps.contains(op) || kMachineLane.contains(op)
                                   ? WebHub::Lane::kMachine
                                   : WebHub::Lane::kProgram;
-    const bool queued = hub_.post_work(lane, [weak = weak_from_this(), msg, id, op, &hub = hub_] {
-      Json out = run_command(hub, op, msg);
-      out["t"] = "reply";
-      out["id"] = id;
-      out["op"] = op;
-      const bool job_changed = (op == "upload" || op == "start") && out.value("ok", false);
-      asio::post(hub.io(), [weak, out = std::move(out), job_changed, &hub] {
-        if (job_changed) hub.broadcast_job();
-        if (const auto self = weak.lock()) {
-          --self->in_flight_;
-          self->send_json(out);
-        }
-      });
-    });
+    const std::uint64_t owner = id_;
+    const bool queued =
+        hub_.post_work(lane, [weak = weak_from_this(), msg, id, op, owner, &hub = hub_] {
+          Json out = run_command(hub, op, msg, owner);
+          out["t"] = "reply";
+          out["id"] = id;
+          out["op"] = op;
+          const bool job_changed =
+              (op == "upload" || op == "start" || op == "start_from") && out.value("ok", false);
+          asio::post(hub.io(), [weak, out = std::move(out), job_changed, &hub] {
+            if (job_changed) hub.broadcast_job();
+            if (const auto self = weak.lock()) {
+              --self->in_flight_;
+              self->send_json(out);
+            }
+          });
+        });
     if (!queued) {
       --in_flight_;
       refuse("busy", "server busy");
@@ -184,7 +211,8 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   }
 
   /// On the worker thread: the blocking part of a command.
-  static Json run_command(WebHub& hub, const std::string& op, const Json& msg) {
+  static Json run_command(WebHub& hub, const std::string& op, const Json& msg,
+                          std::uint64_t owner) {
     const std::string name = msg.value("name", std::string("program.nc"));
     if (op == "check" || op == "upload") {
       if (!msg.contains("text") || !msg["text"].is_string()) {
@@ -193,7 +221,58 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
       const std::string& text = msg["text"].get_ref<const std::string&>();
       return op == "check" ? hub.job().check(text, name) : hub.job().upload(text, name);
     }
-    if (op == "start") return reply_json(hub.job().start());
+    if (op == "start") return reply_json(hub.job().start(msg.value("dry_run", false) == true));
+    if (op == "start_from") {
+      if (!msg.contains("line") || !msg["line"].is_number_integer()) {
+        return bad_request("'line' must be a G-code line number");
+      }
+      std::optional<double> depth;
+      if (msg.contains("depth_done") && !msg["depth_done"].is_null()) {
+        if (!msg["depth_done"].is_number()) return bad_request("'depth_done' must be mm");
+        depth = msg["depth_done"].get<double>();
+      }
+      return hub.job().start_from(msg["line"].get<std::int32_t>(), depth,
+                                  msg.value("dry_run", false) == true);
+    }
+    if (op == "mdi") {
+      if (!msg.contains("line") || !msg["line"].is_string()) return bad_request("'line' missing");
+      const std::string& line = msg["line"].get_ref<const std::string&>();
+      if (line.size() > 1024 || line.find_first_of("\r\n") != std::string::npos) {
+        return bad_request("an MDI command is one line of at most 1024 bytes");
+      }
+      return hub.job().mdi(line);
+    }
+    if (kManualOps.contains(op)) {
+      Json params = Json::object();
+      for (const char* k : {"axes", "axis", "distance"}) {
+        if (msg.contains(k)) params[k] = msg[k];
+      }
+      if (op == "jog.stop") hub.manual().release(owner);
+      return reply_json(hub.client().request(op, params));
+    }
+    if (op == "jog.hold") {  // continuous: the hub refreshes it while "held" comes
+      if (!msg.contains("axis") || !msg["axis"].is_string() || !msg.contains("velocity") ||
+          !msg["velocity"].is_number()) {
+        return bad_request("jog.hold needs 'axis' and 'velocity' (mm/s)");
+      }
+      return hub.manual().hold(owner, msg["axis"].get<std::string>(),
+                               msg["velocity"].get<double>());
+    }
+    if (op == "touch") {
+      if (!msg.contains("target") || !msg["target"].is_string()) {
+        return bad_request("'target' missing");
+      }
+      std::string set;
+      if (msg.contains("set") && msg["set"].is_string()) set = msg["set"].get<std::string>();
+      return hub.manual().touch(msg["target"].get<std::string>(), set);
+    }
+    if (op == "offset.set") {
+      Json params = Json::object();
+      for (const char* k : {"frame", "x", "y", "z"}) {
+        if (msg.contains(k)) params[k] = msg[k];
+      }
+      return hub.manual().offset_set(params);
+    }
     if (op == "job") return {{"ok", true}, {"body", hub.job().snapshot()}};
     if (kMachineOps.contains(op)) return reply_json(hub.client().request(op));
     if (op == "feed.override") {  // edmplc checks the value (0..150) and the role
@@ -267,6 +346,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   std::uint64_t dropped_{0};
   int in_flight_{0};
   bool closing_{false};
+  const std::uint64_t id_{next_session_id()};  // the owner of a jog this browser holds
 };
 
 }  // namespace

@@ -1,6 +1,11 @@
 // Starts what the browser tests need: edmplc (drill-sim.yaml with an operator and a viewer token,
-// virtual clock paced to 10x, free ports), `edmhmi serve`, and Debian's Chromium through
-// playwright-core (no browser download). Every wait is on a condition with a timeout.
+// virtual clock paced to 10x, free ports, nothing retained), `edmhmi serve`, and Debian's
+// Chromium through playwright-core (no browser download). Every wait is on a condition with a
+// timeout.
+//
+// The jog dead-man (job.manual.deadman) counts machine time: on the clock paced 10x its default
+// 500 ms is 50 ms of wall time, finer than a browser's timers. The tests set DEADMAN_MS = 3 s of
+// machine time (300 ms of wall time), the figure the dead-man tests measure against.
 import { spawn } from 'node:child_process';
 import { mkdtempSync, readFileSync, writeFileSync, chmodSync, mkdirSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -16,6 +21,9 @@ export const OUT = process.env.EDM_WEB_ARTIFACTS || join(ROOT, 'out/web');
 // playwright-core is a dev dependency of web/ (pinned in web/package.json, installed by npm ci).
 const { chromium } = createRequire(join(ROOT, 'web/package.json'))('playwright-core');
 export const CHROMIUM = process.env.EDM_CHROMIUM || '/usr/bin/chromium';
+
+export const SPEED = 10;
+export const DEADMAN_MS = 3000;
 
 export function freePort() {
   return new Promise((res, rej) => {
@@ -41,23 +49,29 @@ function waitForOutput(child, re, what, timeoutMs = 20000) {
   });
 }
 
-export async function startStack({ speed = '10' } = {}) {
+export async function startStack({ speed = String(SPEED) } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'edm-web-'));
   const op = join(dir, 'operator.token');
   const vw = join(dir, 'viewer.token');
   const tokens = { operator: randomBytes(16).toString('hex'), viewer: randomBytes(16).toString('hex') };
   writeFileSync(op, `${tokens.operator}\n`); chmodSync(op, 0o600);
   writeFileSync(vw, `${tokens.viewer}\n`); chmodSync(vw, 0o600);
-  const base = readFileSync(join(ROOT, 'config/machines/drill-sim.yaml'), 'utf8');
+  // EDM_WEB_MACHINE_CONFIG: another drill-sim-like config (e.g. one that matches an older edmplc).
+  const base = readFileSync(process.env.EDM_WEB_MACHINE_CONFIG
+    || join(ROOT, 'config/machines/drill-sim.yaml'), 'utf8');
   const config = join(dir, 'drill-sim-tokens.yaml');
   const withTokens = base.replace(/^bridge:.*$/m,
     `bridge:\n  token_file: ${op}\n  viewer_token_file: ${vw}`);
   if (withTokens === base) throw new Error('drill-sim.yaml has no bridge: section');
-  writeFileSync(config, withTokens);
+  const withDeadman = withTokens.replace(/(type: EdmJob, params: \{)/,
+    `$1manual: {deadman: ${DEADMAN_MS}ms}, `);
+  if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob with params');
+  writeFileSync(config, withDeadman);
   const bridgePort = await freePort();
   const procs = [];
   const plc = spawn(join(BUILD, 'bin/edmplc'), ['--config', config, '--clock', 'virtual',
-    '--speed', speed, '--bridge-port', String(bridgePort)], { stdio: ['ignore', 'pipe', 'pipe'] });
+    '--speed', speed, '--bridge-port', String(bridgePort), '--state-dir', join(dir, 'state')],
+  { stdio: ['ignore', 'pipe', 'pipe'] });
   procs.push(plc);
   const stack = { dir, tokens, procs, plc, bridgePort };
   try {

@@ -4,7 +4,9 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { startStack, stopStack, launchBrowser, login, artifacts, ROOT } from './harness.mjs';
+import {
+  startStack, stopStack, launchBrowser, login, artifacts, ROOT, SPEED, DEADMAN_MS,
+} from './harness.mjs';
 
 const T = 30000;
 let stack; let browser; let page; let out;
@@ -14,6 +16,42 @@ const metrics = {};
 const state = () => page.locator('#state');
 async function confirm() {
   await page.locator('#confirm-yes').click();
+}
+
+/** The machine position (machine coordinates) of the last status the page got. */
+function position(p = page) {
+  return p.evaluate(() => {
+    const v = window.edm.status?.vars || {};
+    return { x: v['io.x_mm'], y: v['io.y_mm'], z: v['io.z_mm'], t: performance.now() };
+  });
+}
+
+/** Waits for the next manual.status result after `seq` and returns it. */
+async function nextResult(seq, timeout = T) {
+  await page.waitForFunction((s) => {
+    const r = window.edm.manual?.result;
+    return r && r.seq > s && window.edm.manual.busy === false;
+  }, seq, { timeout, polling: 50 });
+  return page.evaluate(() => window.edm.manual.result);
+}
+const lastSeq = () => page.evaluate(() => window.edm.manual?.result?.seq ?? 0);
+
+/**
+ * Polls the position every 20 ms until X has not changed by 1 µm for `quietMs`; returns when it
+ * last changed (performance.now() of the page) and where it stopped.
+ */
+async function waitStill(p, quietMs = 400, timeout = T) {
+  return p.evaluate(([quiet, limit]) => new Promise((resolve, reject) => {
+    const x = () => window.edm.status?.vars?.['io.x_mm'];
+    let last = x(); let changed = performance.now();
+    const t0 = performance.now();
+    const timer = setInterval(() => {
+      const now = performance.now(); const v = x();
+      if (Math.abs(v - last) > 0.001) { last = v; changed = now; }
+      if (now - changed > quiet) { clearInterval(timer); resolve({ stopped_at: changed, x: v }); }
+      if (now - t0 > limit) { clearInterval(timer); reject(new Error(`X still moving after ${limit} ms`)); }
+    }, 20);
+  }), [quietMs, timeout]);
 }
 
 before(async () => {
@@ -43,8 +81,138 @@ test('the operator logs in and sees the machine', async () => {
   metrics.login_to_ready_ms = Date.now() - t0;
   assert.equal(await page.locator('#machine-name').textContent(), 'drill-sim');
   assert.ok(await page.locator('#btn-estop').isVisible());
-  // Issue 21's functions are not in this edmplc: the panel says so.
-  await page.locator('#opfun [data-fn="jog"] .na').waitFor({ timeout: T });
+  // Issue 21's functions are in this edmplc: the panel has their controls, none says "not supported".
+  for (const id of ['#home-all', '#jog-X-plus', '#touch-go', '#off-set-G54', '#mdi-go', '#from-go',
+    '#override-set', '#dry-run']) {
+    assert.ok(await page.locator(id).isVisible(), `${id} not shown`);
+  }
+  assert.equal(await page.locator('#opfun .na').count(), 0);
+  await page.locator('#ref-Z').filter({ hasText: 'ref' }).waitFor({ timeout: T });
+});
+
+test('home Z: the axis goes to its reference switch and is referenced', async () => {
+  const seq = await lastSeq();
+  await page.locator('#home-Z').click();
+  await confirm();
+  const r = await nextResult(seq);
+  assert.equal(r.op, 'home');
+  assert.ok(r.ok, `home failed: ${r.error}`);
+  await page.locator('#manual-result').filter({ hasText: 'home ok' }).waitFor({ timeout: T });
+  const p = await position();
+  metrics.home_z_mm = p.z;
+  assert.ok(Math.abs(p.z - 15) < 0.01, `Z ${p.z} after homing, the switch is at 15`);
+  assert.equal(await page.locator('#ref-Z').textContent(), 'ref');
+});
+
+test('jog X by 1 mm: the machine X changes by 1.000', async () => {
+  const before = await position();
+  const seq = await lastSeq();
+  await page.locator('#opfun .jog-step[data-step="1"]').click();
+  await page.locator('#jog-X-plus').click();
+  const r = await nextResult(seq);
+  assert.ok(r.ok, `jog failed: ${r.error}`);
+  await page.waitForTimeout(200);  // the next status events
+  const after = await position();
+  metrics.jog_x_1mm_moved_mm = after.x - before.x;
+  assert.ok(Math.abs(after.x - before.x - 1) < 0.0005, `X moved ${after.x - before.x} mm`);
+  assert.equal(await page.locator('#dro-x').textContent(), after.x.toFixed(3));
+});
+
+test('touch z and set G54 Z: the offset table and the work readout follow', async () => {
+  const seq = await lastSeq();
+  const gen = Number(await page.locator('#offsets').getAttribute('data-generation'));
+  await page.locator('#touch-target').selectOption('z');
+  await page.locator('#touch-set').selectOption('G54');
+  await page.locator('#touch-go').click();
+  await confirm();
+  const r = await nextResult(seq, 60000);
+  assert.ok(r.ok, `touch failed: ${r.error}`);
+  metrics.touch_z_surface_mm = r.z;
+  assert.ok(Math.abs(r.z) < 0.01, `the surface of drill-sim's work is at Z 0, touched at ${r.z}`);
+  await page.locator('#touch-set-result').filter({ hasText: 'G54 set' }).waitFor({ timeout: T });
+  await page.waitForFunction((g) => Number(document.getElementById('offsets').dataset.generation) > g,
+    gen, { timeout: T });
+  const g54z = Number(await page.locator('#off-G54-Z').inputValue());
+  assert.ok(Math.abs(g54z - r.z) < 0.00006, `G54 Z ${g54z}, touched ${r.z}`);
+  // work = machine − G54
+  await page.waitForTimeout(200);
+  const p = await position();
+  const work = Number(await page.locator('#wrk-z').textContent());
+  assert.ok(Math.abs(work - (p.z - r.z)) < 0.0015, `work Z ${work}, machine ${p.z}, G54 ${r.z}`);
+  await page.screenshot({ path: join(out, 'touch-set-g54.png') });
+});
+
+test('a work offset typed in the table is set', async () => {
+  await page.locator('#off-G55-X').fill('12.5');
+  await page.locator('#off-set-G55').click();
+  await page.locator('#offsets-result').filter({ hasText: 'G55 set' }).waitFor({ timeout: T });
+  await page.waitForFunction(() => window.edm.offsets?.frames?.G55?.x === 12.5, null, { timeout: T });
+});
+
+test('MDI: one line runs in work coordinates', async () => {
+  await page.locator('#mdi-line').fill('G00 Z2');
+  await page.locator('#mdi-go').click();
+  await confirm();
+  await page.locator('#mdi-result').filter({ hasText: 'started' }).waitFor({ timeout: T });
+  await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
+  await page.waitForFunction(() => Math.abs(Number(document.getElementById('wrk-z').textContent) - 2) < 0.002,
+    null, { timeout: T, polling: 50 });
+});
+
+test('a continuous jog stops at once when its page is closed (dead man)', async () => {
+  const p2 = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  await login(p2, stack.url, stack.tokens.operator);
+  await p2.locator('#state').filter({ hasText: 'READY' }).waitFor({ timeout: T });
+  await p2.locator('#opfun .jog-step[data-step="cont"]').click();
+  await p2.locator('#jog-speed').selectOption({ index: 1 });  // a quarter of jog_v_max
+  const v = Number(await p2.locator('#jog-speed').inputValue());
+  const start = await position();
+  await p2.locator('#jog-X-plus').hover();
+  await p2.mouse.down();
+  await page.waitForFunction((x0) => window.edm.status.vars['io.x_mm'] > x0 + 0.5, start.x,
+    { timeout: T, polling: 20 });
+  await page.waitForFunction(() => window.edm.manual?.jog?.held === true, null, { timeout: T });
+  const atClose = await position();
+  await p2.close();  // no mouse-up: the socket closes with the button held
+  const still = await waitStill(page);
+  const stopMs = still.stopped_at - atClose.t;
+  metrics.jog_close_stop_ms = stopMs;
+  metrics.jog_close_travel_mm = still.x - atClose.x;
+  // The status the page sees is up to 40 ms old; the axis stops well inside the dead-man.
+  assert.ok(stopMs < DEADMAN_MS / SPEED, `stopped ${stopMs} ms after the page closed`);
+  assert.ok(still.x - atClose.x < v * SPEED * DEADMAN_MS / SPEED / 1000,
+    `moved ${still.x - atClose.x} mm after the page closed`);
+  await page.waitForFunction(() => window.edm.manual?.jog?.held === false, null, { timeout: T });
+});
+
+test('a continuous jog stops when the browser stops saying "held" (a sleeping tablet)', async () => {
+  const start = await position();
+  // A hand-made socket: holds a jog, says "held" for a second, then goes silent but stays open.
+  const r = await page.evaluate(([token, v]) => new Promise((resolve) => {
+    const ws = new WebSocket(new URL('ws', location.href).href.replace('http', 'ws'));
+    let timer = null; let lastHeld = 0; let heldMs = 0;
+    ws.onopen = () => ws.send(JSON.stringify({ t: 'login', token }));
+    ws.onmessage = (e) => {
+      const m = JSON.parse(e.data);
+      if (m.t === 'welcome') ws.send(JSON.stringify({ t: 'cmd', id: 1, op: 'jog.hold', axis: 'X', velocity: -v }));
+      if (m.t === 'reply' && m.id === 1) {
+        if (!m.ok) { resolve({ error: m.message }); return; }
+        heldMs = m.body.held_ms;
+        timer = setInterval(() => { ws.send(JSON.stringify({ t: 'held' })); lastHeld = performance.now(); }, heldMs);
+        setTimeout(() => { clearInterval(timer); window.edmSilentSocket = ws; resolve({ lastHeld, heldMs, refreshMs: m.body.refresh_ms }); }, 1000);
+      }
+    };
+  }), [stack.tokens.operator, 0.25 * 5]);
+  assert.equal(r.error, undefined);
+  const still = await waitStill(page);
+  const stopMs = still.stopped_at - r.lastHeld;
+  metrics.jog_silent_stop_ms = stopMs;
+  metrics.jog_silent_held_ms = r.heldMs;
+  metrics.jog_silent_refresh_ms = r.refreshMs;
+  assert.ok(start.x - still.x > 0.5, `X moved only ${start.x - still.x} mm while held`);
+  assert.ok(stopMs < DEADMAN_MS / SPEED, `stopped ${stopMs} ms after the last "held"`);
+  await page.locator('#manual-result').filter({ hasText: "no 'held'" }).waitFor({ timeout: T });
+  await page.evaluate(() => window.edmSilentSocket.close());
 });
 
 test('the operator sets the feed override; edmplc refuses a value above 150 %', async () => {
@@ -105,21 +273,35 @@ test('a viewer sees no control buttons and cannot act', async () => {
   const v = await browser.newPage({ viewport: { width: 1024, height: 768 } });
   await login(v, stack.url, stack.tokens.viewer);
   await v.locator('#role').filter({ hasText: 'viewer' }).waitFor({ timeout: T });
-  for (const id of ['#btn-estop', '#btn-start', '#btn-stop', '#btn-upload', '#opfun', '#btn-ack']) {
+  for (const id of ['#btn-estop', '#btn-start', '#btn-stop', '#btn-upload', '#opfun', '#btn-ack',
+    '#offsets-panel', '#mdi-row', '#from-row', '#jog-X-plus', '#home-all', '#dry-run']) {
     assert.equal(await v.locator(id).isVisible(), false, `${id} visible to a viewer`);
   }
-  // Even a hand-made command is refused by the server.
-  const reply = await v.evaluate((token) => new Promise((resolve) => {
+  // The work readout is for everyone.
+  assert.match(await v.locator('#wrk-head').textContent(), /work G5\d/);
+  // Even hand-made commands are refused by the server, before anything reaches edmplc.
+  const cmds = [{ op: 'estop' }, { op: 'home', axes: 'Z' }, { op: 'jog', axis: 'X', distance: 1 },
+    { op: 'jog.hold', axis: 'X', velocity: 1 }, { op: 'jog.stop' }, { op: 'touch', target: 'z' },
+    { op: 'offset.set', frame: 'G54', z: 1 }, { op: 'mdi', line: 'G00 Z5' },
+    { op: 'start_from', line: 5 }, { op: 'start', dry_run: true }];
+  const replies = await v.evaluate(([token, list]) => new Promise((resolve) => {
     const ws = new WebSocket(new URL('ws', location.href).href.replace('http', 'ws'));
+    const got = [];
     ws.onopen = () => ws.send(JSON.stringify({ t: 'login', token }));
     ws.onmessage = (e) => {
       const m = JSON.parse(e.data);
-      if (m.t === 'welcome') ws.send(JSON.stringify({ t: 'cmd', id: 1, op: 'estop' }));
-      if (m.t === 'reply') { ws.close(); resolve(m); }
+      if (m.t === 'welcome') {
+        list.forEach((c, i) => ws.send(JSON.stringify({ t: 'cmd', id: i + 1, ...c })));
+        ws.send(JSON.stringify({ t: 'held' }));  // ignored for a viewer
+      }
+      if (m.t === 'reply') got.push(m);
+      if (got.length === list.length) { ws.close(); resolve(got); }
     };
-  }), stack.tokens.viewer);
-  assert.equal(reply.ok, false);
-  assert.equal(reply.code, 'forbidden');
+  }), [stack.tokens.viewer, cmds]);
+  for (const reply of replies) {
+    assert.equal(reply.ok, false, JSON.stringify(reply));
+    assert.equal(reply.code, 'forbidden', JSON.stringify(reply));
+  }
   await v.screenshot({ path: join(out, 'viewer-1024x768.png') });
   await v.setViewportSize({ width: 800, height: 1280 });  // a tablet held upright
   await v.screenshot({ path: join(out, 'viewer-tablet-800x1280.png'), fullPage: true });
@@ -157,6 +339,19 @@ test('hold, resume, finish and read the job report', async () => {
   assert.match(report, /blocks\s+15 of 15/);
   await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
   await page.screenshot({ path: join(out, 'finished.png') });
+});
+
+test('run from a line, as a dry run: re-approach, then the rest of the program', async () => {
+  const line = demo.split('\n').findIndex((l) => l.startsWith('E0')) + 1;
+  await page.locator('#dry-run').check();
+  await page.locator('#from-line').fill(String(line));
+  await page.locator('#from-go').click();
+  await confirm();
+  await page.locator('#from-result').filter({ hasText: `started at line ${line}` }).waitFor({ timeout: T });
+  await page.locator('#job-report').filter({ hasText: 'outcome' }).waitFor({ timeout: 60000 });
+  assert.match(await page.locator('#job-report').textContent(), /outcome\s+finished/);
+  await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
+  await page.locator('#dry-run').uncheck();
 });
 
 test('stale data is flagged when the machine stops answering', async () => {

@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <utility>
 
 #include "edm/hmi/web_capabilities.hpp"
 #include "edm/hmi/web_job.hpp"
+#include "edm/hmi/web_manual.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::hmi::test {
@@ -64,14 +66,69 @@ TEST(WebStatic, content_types_and_caching) {
 }
 
 TEST(WebCapabilities, a_capability_list_in_machine_info_wins_over_the_probe) {
-  const bridge::Json info = {{"name", "m"}, {"ops", {"jog", "home"}}};
+  const bridge::Json info = {{"name", "m"},
+                             {"ops", {"jog", "home"}},
+                             {"manual", {{"available", true}, {"home", true}, {"touch", true}}}};
   const std::vector<std::string> probed{"touch"};
   const bridge::Json caps = capabilities_json(info, &probed);
   EXPECT_EQ(caps["source"], "machine.info");
   EXPECT_TRUE(caps["jog"].get<bool>());
   EXPECT_TRUE(caps["reference"].get<bool>());
   EXPECT_FALSE(caps["touch"].get<bool>());
+  EXPECT_EQ(caps["why"]["touch"], "not supported by this edmplc");
   EXPECT_FALSE(caps["work_coordinates"].get<bool>());
+  EXPECT_FALSE(caps["mdi"].get<bool>());
+}
+
+TEST(WebCapabilities, an_op_the_machine_has_not_wired_is_not_offered_and_says_why) {
+  const bridge::Json info = {
+      {"ops", {"home", "jog", "jog.stop", "touch", "manual.status", "offset.get", "offset.set"}},
+      {"manual", {{"available", true}, {"home", false}, {"touch", true}, {"deadman_ms", 500}}}};
+  const bridge::Json caps = capabilities_json(info, nullptr);
+  EXPECT_FALSE(caps["reference"].get<bool>());
+  EXPECT_EQ(caps["why"]["reference"], "this machine has no reference switches wired");
+  for (const char* k : {"jog", "touch", "offsets", "mdi", "run_from", "dry_run", "work_coordinates",
+                        "manual_status"}) {
+    EXPECT_TRUE(caps[k].get<bool>()) << k;
+  }
+  EXPECT_EQ(caps["manual"]["deadman_ms"], 500);
+}
+
+TEST(WebCapabilities, without_a_job_sequencer_mdi_and_jog_are_not_offered) {
+  const bridge::Json info = {{"ops", {"jog", "offset.get", "offset.set"}},
+                             {"manual", {{"available", false}}}};
+  const bridge::Json caps = capabilities_json(info, nullptr);
+  EXPECT_FALSE(caps["jog"].get<bool>());
+  EXPECT_FALSE(caps["mdi"].get<bool>());
+  EXPECT_TRUE(caps["offsets"].get<bool>());
+}
+
+TEST(WebCapabilities, the_probe_asks_each_op_once) {
+  const std::vector<std::string> ops = operator_function_ops();
+  EXPECT_EQ(std::count(ops.begin(), ops.end(), "offset.get"), 1);
+  EXPECT_EQ(ops.size(), 6u);  // home jog touch offset.set offset.get feed.override
+}
+
+TEST(WebJogTiming, on_a_real_clock_a_silent_browser_is_stopped_within_the_dead_man) {
+  const JogTiming t = jog_timing(500.0, 1.0);
+  EXPECT_DOUBLE_EQ(t.deadman_ms, 500.0);
+  EXPECT_NEAR(t.refresh_ms, 166.7, 0.1);
+  EXPECT_DOUBLE_EQ(t.hold_window_ms, 250.0);
+  EXPECT_LT(t.hold_window_ms + t.refresh_ms, t.deadman_ms);
+  EXPECT_LE(3 * t.held_ms, t.hold_window_ms + 1e-9);  // three "held" per window
+}
+
+TEST(WebJogTiming, a_faster_machine_clock_shortens_the_refresh_not_the_browsers_floor) {
+  const JogTiming t = jog_timing(3000.0, 10.0);  // the browser tests: 3 s of machine time at 10x
+  EXPECT_DOUBLE_EQ(t.deadman_ms, 300.0);
+  EXPECT_DOUBLE_EQ(t.refresh_ms, 100.0);
+  EXPECT_DOUBLE_EQ(t.hold_window_ms, 150.0);
+  EXPECT_LT(t.hold_window_ms + t.refresh_ms, t.deadman_ms);
+  const JogTiming fast = jog_timing(500.0, 10.0);
+  EXPECT_DOUBLE_EQ(fast.hold_window_ms, kMinHoldWindowMs);
+  EXPECT_NEAR(fast.refresh_ms, 16.7, 0.1);
+  const JogTiming bad = jog_timing(-1.0, 0.0);  // nonsense in: the defaults
+  EXPECT_DOUBLE_EQ(bad.deadman_ms, 500.0);
 }
 
 TEST(WebCapabilities, without_a_list_or_probe_nothing_is_offered) {

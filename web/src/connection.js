@@ -71,6 +71,11 @@ export class Connection {
     }
   }
 
+  /** Sends a message that wants no reply (the held jog's "held"); dropped when offline. */
+  send(message) {
+    if (this.ws && this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(message));
+  }
+
   /** Sends a command; resolves with the server's reply ({ok, body|code, message, …}). */
   cmd(op, params = {}) {
     if (!this.ws || this.ws.readyState !== WebSocket.OPEN) {

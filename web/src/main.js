@@ -5,7 +5,8 @@ import { Connection } from './connection.js';
 import { Charts } from './charts.js';
 import { Editor } from './editor.js';
 import { Toolpath } from './toolpath.js';
-import { renderAlarms, renderStats, VarPanel, renderOperatorFunctions } from './panels.js';
+import { renderAlarms, renderStats, VarPanel } from './panels.js';
+import { OperatorPanel, activeFrame } from './manual.js';
 
 const $ = (id) => document.getElementById(id);
 const STALE_MS = 1000;
@@ -19,7 +20,7 @@ const ui = {
   job: null,
   firstRender: null,
 };
-window.edm = ui; // read by the end-to-end tests (first render time, state)
+window.edm = ui; // read by the end-to-end tests (first render time, state, manual, offsets)
 
 const charts = new Charts();
 const editor = new Editor($('editor'));
@@ -51,7 +52,11 @@ const conn = new Connection({
     editor.readOnly = m.role !== 'operator';
     charts.setup(m.series || []);
     if (m.history) charts.push(m.history, true);
-    renderOperatorFunctions(m.caps, conn, m.role === 'operator');
+    ui.caps = m.caps || {};
+    ops.render(ui.caps, m.role === 'operator');
+    ui.offsets = m.offsets; ui.manual = m.manual;
+    ops.showOffsets(m.offsets);
+    ops.showManual(m.manual);
     ui.alarms = m.alarms || [];
     renderAlarms(ui.alarms, m.role === 'operator');
     vars.isOperator = m.role === 'operator';
@@ -64,7 +69,10 @@ const conn = new Connection({
     }
   },
   frame: (f) => {
+    if (f.offsets) { ui.offsets = f.offsets; ops.showOffsets(f.offsets); }
+    if (f.manual) { ui.manual = f.manual; ops.showManual(f.manual); }
     if (f.status) showStatus(f.status, true);
+    else if (f.offsets) showPosition(ui.status);
     if (f.rows) charts.push(f.rows);
     if (f.alarms) {
       ui.alarms = ui.alarms.concat(f.alarms).slice(-200);
@@ -78,6 +86,8 @@ const conn = new Connection({
   job: (j) => showJob(j, false),
 });
 const vars = new VarPanel(conn, confirmDialog);
+const ops = new OperatorPanel(conn, confirmDialog);
+ops.onFrame = () => showPosition(ui.status);
 
 function statusVar(s, suffix) {
   const v = s.vars || {};
@@ -91,8 +101,8 @@ function showStatus(s, fresh) {
   if (fresh) ui.lastStatusAt = performance.now();
   $('state').textContent = s.state;
   $('state').dataset.state = s.state;
-  const x = statusVar(s, 'io.x_mm'); const y = statusVar(s, 'io.y_mm'); const z = statusVar(s, 'io.z_mm');
-  $('dro-x').textContent = fmt(x); $('dro-y').textContent = fmt(y); $('dro-z').textContent = fmt(z);
+  ops.setState(s.state);
+  const [x, y, z] = showPosition(s);
   $('val-depth').textContent = `${fmt(statusVar(s, 'io.depth_mm'))} mm`;
   $('val-electrode').textContent = `${fmt(statusVar(s, 'io.electrode_mm'), 2)} mm`;
   const job = s.job || {};
@@ -105,11 +115,28 @@ function showStatus(s, fresh) {
   if (x !== undefined) toolpath.setPosition([x ?? 0, y ?? 0, z ?? 0]);
   updateButtons();
   if (job.outcome === 'finished' || job.outcome === 'aborted') {
-    if (ui.job && ui.job.started && !ui.job.report && !ui.reportAsked) {
+    // Only the loaded program's end (an MDI line runs under a generation of its own).
+    if (ui.job && ui.job.started && !ui.job.report && !ui.reportAsked && job.generation === ui.job.generation) {
       ui.reportAsked = true;
       conn.cmd('job').then((r) => { ui.reportAsked = false; if (r.ok) showJob(r.body, false); });
     }
   }
+}
+
+/** Machine coordinates from the status, work = machine − the active frame's offset. */
+function showPosition(s) {
+  if (!s) return [];
+  const m = [statusVar(s, 'io.x_mm'), statusVar(s, 'io.y_mm'), statusVar(s, 'io.z_mm')];
+  const f = ui.caps?.work_coordinates ? activeFrame(s, ui.job, ops.offsets, ops.frame) : null;
+  ['x', 'y', 'z'].forEach((a, i) => {
+    $(`dro-${a}`).textContent = fmt(m[i]);
+    const w = $(`wrk-${a}`);
+    w.textContent = f && typeof m[i] === 'number' ? fmt(m[i] - f.offset[i]) : '—';
+    w.classList.toggle('na', !f);
+  });
+  $('wrk-head').textContent = f ? `work ${f.name}` : 'work';
+  $('coord-note').textContent = ui.caps?.work_coordinates ? '' : 'work coordinates: not supported by this edmplc';
+  return m;
 }
 
 function showJob(j, initial) {
@@ -140,14 +167,18 @@ setInterval(() => {
   document.body.classList.toggle('is-stale', stale);
 }, 200);
 
-async function machine(op, question) {
+async function machine(op, question, params = {}) {
   if (question && !(await confirmDialog(question))) return;
-  const r = await conn.cmd(op);
+  const r = await conn.cmd(op, params);
   if (!r.ok) flash(`${op}: ${r.code}: ${r.message}`);
 }
 function flash(text) { $('check-result').textContent = text; }
 
-$('btn-start').onclick = () => machine('start', `Start ${ui.job?.part ?? 'the program'} on ${$('machine-name').textContent}? The axes will move and the generator will fire.`);
+$('btn-start').onclick = () => {
+  const dry = ui.caps?.dry_run && $('dry-run').checked;
+  const what = dry ? 'The axes will move; the generator stays off (dry run: drilling and orbit blocks are skipped).' : 'The axes will move and the generator will fire.';
+  machine('start', `Start ${ui.job?.part ?? 'the program'}${dry ? ' as a dry run' : ''} on ${$('machine-name').textContent}? ${what}`, dry ? { dry_run: true } : {});
+};
 $('btn-hold').onclick = () => machine('cycle.hold');
 $('btn-resume').onclick = () => machine('cycle.resume', 'Resume the job?');
 $('btn-stop').onclick = () => machine('cycle.stop', 'Stop the job? It cannot be resumed from here.');

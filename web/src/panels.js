@@ -1,5 +1,5 @@
-// The side panels: alarms with acknowledge, task statistics, variable watch and force, and the
-// operator functions of issue 21 (shown only when the machine offers their ops).
+// The side panels: alarms with acknowledge, task statistics, variable watch and force. The
+// operator functions of issue 21 are in manual.js.
 const $ = (id) => document.getElementById(id);
 const fmt = (v, d = 3) => (typeof v === 'number' && Number.isFinite(v) ? v.toFixed(d) : '—');
 
@@ -104,60 +104,4 @@ export class VarPanel {
       if (row) row.textContent = typeof value === 'number' ? String(+value.toPrecision(7)) : String(value);
     }
   }
-}
-
-const OPFUN = [
-  ['reference', 'Reference (home) axes'],
-  ['jog', 'Jog: continuous with dead-man, incremental'],
-  ['touch', 'Touch-off: Z surface, X/Y edges, centre'],
-  ['offsets', 'Work offsets G54–G59'],
-  ['run_from', 'Run from block N'],
-  ['override', 'Feed override 0–150 %'],
-  ['mdi', 'MDI'],
-];
-
-/** The feed override's control (op feed.override, 0–150 %), for an operator. */
-function overrideControl(conn) {
-  const span = document.createElement('span');
-  span.className = 'ok';
-  const input = document.createElement('input');
-  input.type = 'number';
-  input.min = '0';
-  input.max = '150';
-  input.step = '5';
-  input.value = '100';
-  input.id = 'override-pct';
-  const set = document.createElement('button');
-  set.id = 'override-set';
-  set.textContent = 'Set %';
-  const out = document.createElement('span');
-  out.id = 'override-result';
-  set.onclick = async () => {
-    const r = await conn.cmd('feed.override', { percent: Number(input.value) });
-    out.textContent = r.ok ? ` ${r.body.percent} %` : ` refused: ${r.message || r.code}`;
-  };
-  span.append(input, set, out);
-  return span;
-}
-
-/** Issue 21's panels: each shows "not supported by this edmplc" until the machine has its op. */
-export function renderOperatorFunctions(caps, conn = null, isOperator = false) {
-  const body = $('opfun-body');
-  body.replaceChildren(...OPFUN.map(([key, label]) => {
-    const div = document.createElement('div');
-    div.className = 'opfun';
-    div.dataset.fn = key;
-    const ok = caps && caps[key];
-    div.innerHTML = `<b>${label}</b> `;
-    if (ok && key === 'override' && conn && isOperator) {
-      div.append(overrideControl(conn));
-      return div;
-    }
-    const note = document.createElement('span');
-    note.className = ok ? 'ok' : 'na';
-    note.textContent = ok ? 'available (controls arrive with issue 21)' : 'not supported by this edmplc';
-    div.append(note);
-    return div;
-  }));
-  $('coord-note').textContent = caps && caps.work_coordinates ? '' : 'work coordinates: not supported by this edmplc';
 }

@@ -6,8 +6,11 @@
 //   frame timer (server I/O thread, 25 Hz) ──▶ one batched "frame" to every attached browser
 //   browser commands ──▶ worker threads (blocking bridge requests) ──▶ reply posted to the I/O
 //   thread. Three lanes, so nothing slow stands before an E-stop: machine commands (E-stop,
-//   hold, stop, …), program work (check, upload, variables, statistics) and log-ins (a wrong
-//   token is answered late by edmplc's hello throttle).
+//   hold, stop, jog, home, touch, …), program work (check, upload, MDI, run from a line,
+//   variables, statistics) and log-ins (a wrong token is answered late by edmplc's hello
+//   throttle).
+//   the manual functions (WebManual, its own thread): a held jog refreshed, manual.status and
+//   offset.get followed; their changes go out with the next frame.
 //
 // Telemetry: the bridge's trace stream (every cycle of the motion task) is thinned to one row per
 // 20 ms of machine time and at most kMaxRowsPerFrame rows a frame, so a browser receives at most
@@ -32,6 +35,7 @@
 #include "edm/bridge/client.hpp"
 #include "edm/hmi/connection.hpp"
 #include "edm/hmi/web_job.hpp"
+#include "edm/hmi/web_manual.hpp"
 
 namespace edm::hmi {
 
@@ -85,7 +89,7 @@ class WebHub {
   bridge::Role authenticate(const std::string& token);
 
   /// The "welcome" message of a logged-in browser: role, machine, capabilities, series, the job,
-  /// the alarm list and the last status.
+  /// the alarm list, the last status, manual.status and the work offsets.
   [[nodiscard]] std::string welcome(bridge::Role role) const;
   /// Marks the alarms up to `seq` acknowledged and sends the list to everyone (I/O thread).
   void acknowledge_alarms(std::uint64_t seq);
@@ -94,6 +98,7 @@ class WebHub {
 
   bridge::Client& client() { return client_; }
   WebJob& job() { return job_; }
+  WebManual& manual() { return manual_; }
 
   struct Counters {
     std::uint64_t frames{0}, browsers{0}, frames_dropped{0}, slow_disconnects{0};
@@ -121,6 +126,7 @@ class WebHub {
   bridge::Client& client_;
   ConnectionSettings settings_;
   WebJob job_;
+  WebManual manual_;
   boost::asio::steady_timer timer_;
   std::vector<std::weak_ptr<WebSink>> sinks_;  // I/O thread only
 
