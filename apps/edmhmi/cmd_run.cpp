@@ -71,6 +71,7 @@ std::optional<edm::hmi::ResumePlan> plan_from(const RunArgs& args, const edm::hm
   edm::hmi::ResumePlan plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, 0.0);
   if (plan.ok() && plan.drill) {
     double depth = 0.0;
+    std::optional<edm::hmi::DrillResume> state;
     std::string why;
     if (args.depth_done) {
       depth = *args.depth_done;
@@ -86,10 +87,15 @@ std::optional<edm::hmi::ResumePlan> plan_from(const RunArgs& args, const edm::hm
       depth = std::max(0.0, *machine.last_job->depth_mm);
       why = "the runtime's record of the last job (" + machine.last_job->outcome + " on line " +
             std::to_string(plan.line) + ")";
+      if (machine.last_job->touch_z_mm && machine.last_job->wear_mm) {
+        state = edm::hmi::DrillResume{*machine.last_job->touch_z_mm, *machine.last_job->wear_mm};
+        why += ", its touch at Z " + std::to_string(state->touch_z_mm) + " and wear " +
+               std::to_string(state->wear_mm) + " mm";
+      }
     }
     std::fprintf(stderr, "edmhmi: line %d drills on from %.4f mm deep (%s)\n", plan.line, depth,
                  why.c_str());
-    plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, depth);
+    plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, depth, state);
   } else if (plan.ok() && args.depth_done && *args.depth_done > 0.0) {
     plan = edm::hmi::plan_resume(g, machine.tables, args.from_line, *args.depth_done);
   }

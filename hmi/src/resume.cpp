@@ -77,7 +77,8 @@ std::vector<Vec3> block_starts(const GcodeResult& program) {
 }
 
 ResumePlan plan_resume(const GcodeResult& program, const machining::MachineTables& tables,
-                       std::int32_t line, double depth_done_mm) {
+                       std::int32_t line, double depth_done_mm,
+                       const std::optional<DrillResume>& drill_state) {
   if (!program.ok()) return refuse("the program has errors; fix them first (edmhmi check)");
   const std::vector<MotionBlock>& blocks = program.blocks;
   if (line < 1) return refuse("line " + std::to_string(line) + ": lines are numbered from 1");
@@ -163,7 +164,32 @@ ResumePlan plan_resume(const GcodeResult& program, const machining::MachineTable
   if (drill) {
     p.drill = p.prologue + (*drill - first);
     p.depth_done_mm = depth_done_mm;
-    resume_drill(p.blocks[*p.drill], starts[*drill], depth_done_mm, tables);
+    Vec3 drill_start = starts[*drill];
+    const bool state = drill_state && depth_done_mm > 0.0 &&
+                       std::isfinite(drill_state->touch_z_mm) &&
+                       std::isfinite(drill_state->wear_mm) && drill_state->wear_mm > 0.0;
+    if (state) {
+      // Where the front stopped, from the interrupted drill's own figures (the spark-gap offset
+      // left out: it only puts this a few µm higher), plus the clearance: lowered there with the
+      // generator off (a feed move never discharges), the drill's first sparks are at the bottom.
+      const double z_near =
+          drill_state->touch_z_mm - depth_done_mm - drill_state->wear_mm + kResumeClearanceMm;
+      if (z_near < drill_start.z) {
+        MotionBlock down{};
+        down.kind = MotionKind::kLinear;
+        down.target = {drill_start.x, drill_start.y, z_near};
+        down.feed_mm_s = 1.0;
+        down.condition = p.blocks[*p.drill].condition;
+        p.blocks.insert(p.blocks.begin() + static_cast<std::ptrdiff_t>(*p.drill), down);
+        p.frames.insert(p.frames.begin() + static_cast<std::ptrdiff_t>(*p.drill), frame);
+        ++*p.drill;
+        drill_start.z = z_near;
+      }
+      MotionBlock& d = p.blocks[*p.drill];
+      d.resume_touch_z_mm = drill_state->touch_z_mm;
+      d.resume_wear_mm = drill_state->wear_mm;
+    }
+    resume_drill(p.blocks[*p.drill], drill_start, depth_done_mm, tables);
   }
   return p;
 }

@@ -147,6 +147,10 @@ void DeepHoleDrill::begin_cycle() noexcept {
   target_depth_mm_ = d > 0.0 ? d : params_.depth_default_mm;
   const double done_mm = depth_done_mm.get();
   depth_done_mm_ = std::isfinite(done_mm) && done_mm > 0.0 ? done_mm : 0.0;
+  const double rz = resume_touch_z_mm.get(), rw = resume_wear_mm.get();
+  resume_ = depth_done_mm_ > 0.0 && std::isfinite(rz) && std::isfinite(rw) && rw > 0.0;
+  resume_touch_z_mm_ = resume_ ? rz : 0.0;
+  resume_wear_mm_ = resume_ ? rw : 0.0;
   spark_cycles_ = 0;
   dark_cycles_ = 0;
   safe_retract_ = false;
@@ -255,7 +259,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     td_stepped = true;
     spark_cycles_ = pulses.td_count.get() > 0 ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
-      touch_z_mm.set(z);
+      touch_z_mm.set(resume_ ? resume_touch_z_mm_ : z);
       reset_wear.set(true);  // the wear estimate starts at the touch
       set_state(State::kDrill);
     } else {
@@ -270,6 +274,12 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     }
     status = rt::worst(status, step(gap_, ctx));
     const bool retracting = handle_short(ctx, z, status);
+    // Resumed: the hole is already drilled down to depth_done_mm, so no wear is counted (the
+    // compensator held at 0) until the front is back where the interrupted drill stopped.
+    const bool above_done = resume_ && (touch_z_mm.get() - z) - resume_wear_mm_ -
+                                               params_.spark_gap_offset_um * 1e-3 <
+                                           depth_done_mm_;
+    if (above_done) reset_wear.set(true);
     if (!retracting) {
       // The servo's command into the wear compensator: the gap child's Vz, or the external
       // servo's clamped to the gap child's limits; ramped back in after a retract (v_scale
@@ -297,8 +307,8 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     // first sparks strike and drills one working gap above the bottom: the hole is deeper than
     // the front's travel by the working gap and shallower by the first-spark gap,
     //   depth = (touch_z − z) − wear_mm − spark_gap_offset_um·1e-3   (first-spark − working gap).
-    const double wear_now = comp ? wear_.wear_mm.get() : 0.0;
-    const double depth = depth_done_mm_ + (touch_z_mm.get() - z) - wear_now -
+    const double wear_now = (comp ? wear_.wear_mm.get() : 0.0) + resume_wear_mm_;
+    const double depth = (resume_ ? 0.0 : depth_done_mm_) + (touch_z_mm.get() - z) - wear_now -
                          params_.spark_gap_offset_um * 1e-3;
     depth_reached_mm.set(depth);
     wear_mm.set(wear_now);

@@ -74,6 +74,8 @@ void EdmJob::bind_self() {
   drill_.start.connect(drill_start);
   drill_.depth_mm.connect(drill_depth_mm);
   drill_.depth_done_mm.connect(drill_depth_done_mm);
+  drill_.resume_touch_z_mm.connect(drill_resume_touch_z_mm);
+  drill_.resume_wear_mm.connect(drill_resume_wear_mm);
   manual_.enable.connect(manual_enable);
   manual_.x_mm.follow(x_mm);
   manual_.y_mm.follow(y_mm);
@@ -297,6 +299,8 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     figures_.begin_drill_block();
     drill_depth_mm.set(b.depth_mm > 0.0 ? b.depth_mm : -b.target.z);
     drill_depth_done_mm.set(b.depth_done_mm);
+    drill_resume_touch_z_mm.set(b.resume_touch_z_mm);
+    drill_resume_wear_mm.set(b.resume_wear_mm);
     drill_start.set(true);
     step_ = Step::kBusy;
     return false;

@@ -379,7 +379,7 @@ void Parser::parse_bridge(const Value& v, BridgeSpec& out) {
 
 void Parser::parse_retain(const Value& v, RetainSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"file", "min_interval", "variables", "job_depth"});
+  auto m = r_.map(v, {"file", "min_interval", "variables", "job_depth", "job_touch_z", "job_wear"});
   if (!m) {
     return;
   }
@@ -395,10 +395,14 @@ void Parser::parse_retain(const Value& v, RetainSpec& out) {
   if (const Field* f = m->find("variables")) {
     out.variables = parse_variable_names(f->value);
   }
-  if (const Field* f = m->find("job_depth")) {
+  for (auto [key, dest] : {std::pair<const char*, std::optional<NameRef>*>{"job_depth", &out.job_depth},
+                           {"job_touch_z", &out.job_touch_z},
+                           {"job_wear", &out.job_wear}}) {
+    const Field* f = m->find(key);
+    if (f == nullptr) continue;
     if (auto s = r_.string(f->value)) {
       if (yaml_util::is_dotted_name(*s, 2, 5)) {
-        out.job_depth = NameRef{*s, f->value.loc};
+        *dest = NameRef{*s, f->value.loc};
       } else {
         r_.error(f->value,
                  yaml_util::quote(*s) + " is not a variable name (program.block.pin or io.pin)");

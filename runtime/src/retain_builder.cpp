@@ -35,19 +35,23 @@ class RetainBuilder {
                         }});
       }
     }
-    std::function<double()> read_depth;
-    if (rs.job_depth) {
-      if (auto t = retainable(*rs.job_depth)) {
+    // The job record's measured quantities: each an LREAL variable of the config.
+    auto reader = [&](const std::optional<NameRef>& n, const char* key) {
+      std::function<double()> read;
+      if (!n) return read;
+      if (auto t = retainable(*n)) {
         if (t->second != RetainType::kReal) {
-          diag_.error(rs.job_depth->loc, "retain.job_depth: '" + rs.job_depth->name +
-                                             "' is not LREAL (a depth in mm)");
+          diag_.error(n->loc, std::string("retain.") + key + ": '" + n->name +
+                                  "' is not LREAL (a length in mm)");
         } else {
-          read_depth = [&reg, var = t->first] {
-            return read_retained(reg, *var, RetainType::kReal).r;
-          };
+          read = [&reg, var = t->first] { return read_retained(reg, *var, RetainType::kReal).r; };
         }
       }
-    }
+      return read;
+    };
+    retain_job::Readers readers{reader(rs.job_depth, "job_depth"),
+                                reader(rs.job_touch_z, "job_touch_z"),
+                                reader(rs.job_wear, "job_wear")};
     if (!diag_.empty()) {
       return;
     }
@@ -88,7 +92,7 @@ class RetainBuilder {
     // While a part-program runner exists, the job record is retained beside the variables.
     const bool job_record = rt_.job_.has_runner();
     if (job_record) {
-      auto job_vars = retain_job::variables(rt_.job_, rt_.interrupted_job_, read_depth);
+      auto job_vars = retain_job::variables(rt_.job_, rt_.interrupted_job_, std::move(readers));
       vars.insert(vars.end(), std::make_move_iterator(job_vars.begin()),
                   std::make_move_iterator(job_vars.end()));
     }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <tuple>
 #include <utility>
 
 namespace edm::rt::retain_job {
@@ -14,12 +15,14 @@ constexpr const char* kBlock = "job.block";
 constexpr const char* kBlocks = "job.blocks";
 constexpr const char* kLine = "job.line";
 constexpr const char* kDepth = "job.depth_mm";
+constexpr const char* kTouchZ = "job.touch_z_mm";
+constexpr const char* kWear = "job.wear_mm";
 
 }  // namespace
 
 std::vector<RetainStore::Variable> variables(const JobStore& job,
                                              const std::optional<InterruptedJob>& kept,
-                                             std::function<double()> depth) {
+                                             Readers readers) {
   // Until a job begins here, the interrupted record stays on disk.
   auto keep = [&job, &kept] { return kept.has_value() && job.progress().jobs_started == 0; };
   std::vector<RetainStore::Variable> out;
@@ -43,9 +46,14 @@ std::vector<RetainStore::Variable> variables(const JobStore& job,
   out.push_back({kLine, RetainType::kInt, [&job, &kept, keep] {
                    return RetainValue::make_int(keep() ? kept->line : job.progress().line);
                  }});
-  if (depth) {
-    out.push_back({kDepth, RetainType::kReal, [&kept, keep, depth = std::move(depth)] {
-                     return RetainValue::make_real(keep() ? kept->depth_mm.value_or(0.0) : depth());
+  using Kept = std::optional<double> InterruptedJob::*;
+  for (auto [name, read, field] : {std::tuple<const char*, std::function<double()>*, Kept>{
+                                       kDepth, &readers.depth, &InterruptedJob::depth_mm},
+                                   {kTouchZ, &readers.touch_z, &InterruptedJob::touch_z_mm},
+                                   {kWear, &readers.wear, &InterruptedJob::wear_mm}}) {
+    if (!*read) continue;
+    out.push_back({name, RetainType::kReal, [&kept, keep, f = std::move(*read), field] {
+                     return RetainValue::make_real(keep() ? ((*kept).*field).value_or(0.0) : f());
                    }});
   }
   return out;
@@ -65,6 +73,8 @@ std::optional<InterruptedJob> take(RetainMap& values) {
   const auto blocks = pop(kBlocks);
   const auto line = pop(kLine);
   const auto depth = pop(kDepth);
+  const auto touch_z = pop(kTouchZ);
+  const auto wear = pop(kWear);
   if (!running || running->type != RetainType::kBool || !running->b) {
     return std::nullopt;
   }
@@ -76,9 +86,13 @@ std::optional<InterruptedJob> take(RetainMap& values) {
   j.block_index = as_int(block);
   j.block_count = as_int(blocks);
   j.line = as_int(line);
-  if (depth && depth->type == RetainType::kReal && std::isfinite(depth->r)) {
-    j.depth_mm = depth->r;
-  }
+  auto real = [](const std::optional<RetainValue>& v) -> std::optional<double> {
+    if (v && v->type == RetainType::kReal && std::isfinite(v->r)) return v->r;
+    return std::nullopt;
+  };
+  j.depth_mm = real(depth);
+  j.touch_z_mm = real(touch_z);
+  j.wear_mm = real(wear);
   return j;
 }
 

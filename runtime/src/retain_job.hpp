@@ -20,13 +20,19 @@
 
 namespace edm::rt::retain_job {
 
-/// The record's variables, reading `job` live (`depth` reads `retain.job_depth`; empty: no
-/// depth entry). While no job has begun in this runtime, they keep reporting `kept` (the
+/// The record's measured quantities (each empty: no such entry): `retain.job_depth`,
+/// `retain.job_touch_z`, `retain.job_wear`.
+struct Readers {
+  std::function<double()> depth, touch_z, wear;
+};
+
+/// The record's variables, reading `job` live and the readers (entries `job.depth_mm`,
+/// `job.touch_z_mm`, `job.wear_mm`). While no job has begun in this runtime, they keep reporting `kept` (the
 /// interrupted job found at start), so a second unclean stop before the next job still names
 /// it. `job.running` is urgent: its change is written without waiting for min_interval.
 /// `job` and `kept` must outlive the store.
 [[nodiscard]] std::vector<RetainStore::Variable> variables(
-    const JobStore& job, const std::optional<InterruptedJob>& kept, std::function<double()> depth);
+    const JobStore& job, const std::optional<InterruptedJob>& kept, Readers readers);
 
 /// Removes the `job.*` entries from `values` (so they are not restored as variables) and returns
 /// the job they describe when `job.running` was true; nullopt otherwise (no record, a finished or

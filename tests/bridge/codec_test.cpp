@@ -110,8 +110,8 @@ TEST(Codec, program_checksum_covers_order_and_values) {
 }
 
 TEST(Codec, one_block_record_matches_python_struct_pack) {
-  // python3 -c "import struct,zlib; print('%08x' % zlib.crc32(struct.pack('<Bii6didi5dB',
-  //   4, 12, 3, 1.5, -2.0, -10.0, 0.0, 0.0, 0.0, 0, 0.25, 1, 10.6, 0.0, 0.0, 0.0, 0.0, 0)))"
+  // python3 -c "import struct,zlib; print('%08x' % zlib.crc32(struct.pack('<Bii6didi7dB',
+  //   4, 12, 3, 1.5, -2.0, -10.0, 0.0, 0.0, 0.0, 0, 0.25, 1, 10.6, 0, 0, 0, 0, 0.0, 0.0, 0)))"
   MotionBlock b;
   b.kind = MotionKind::kDrill;
   b.line = 12;
@@ -120,7 +120,7 @@ TEST(Codec, one_block_record_matches_python_struct_pack) {
   b.feed_mm_s = 0.25;
   b.condition = 1;
   b.z_travel_mm = 10.6;
-  EXPECT_EQ(format_checksum(program_checksum(std::span(&b, 1))), "9a597876");
+  EXPECT_EQ(format_checksum(program_checksum(std::span(&b, 1))), "0ef656b5");
 }
 
 TEST(Codec, checksum_text_round_trips_and_rejects_junk) {

@@ -79,11 +79,12 @@ def block_record(b):
     c = b.get("centre", [0.0, 0.0, 0.0])
     kinds = ["rapid", "linear", "arc_cw", "arc_ccw", "drill", "orbit_finish", "dwell",
              "condition", "rotation", "flushing", "end"]
-    return struct.pack("<Bii6didi5dB", kinds.index(b["kind"]), b.get("line", 0), b.get("col", 0),
+    return struct.pack("<Bii6didi7dB", kinds.index(b["kind"]), b.get("line", 0), b.get("col", 0),
                        *map(float, t), *map(float, c), b.get("turns", 0),
                        float(b.get("feed_mm_s", 0.0)), b.get("condition", 0),
                        float(b.get("z_travel_mm", 0.0)), float(b.get("depth_mm", 0.0)),
-                       float(b.get("depth_done_mm", 0.0)), float(b.get("final_radius_mm", 0.0)),
+                       float(b.get("depth_done_mm", 0.0)), float(b.get("resume_touch_z_mm", 0.0)),
+                       float(b.get("resume_wear_mm", 0.0)), float(b.get("final_radius_mm", 0.0)),
                        float(b.get("dwell_s", 0.0)), 1 if b.get("on", False) else 0)
 
 

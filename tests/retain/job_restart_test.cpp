@@ -186,6 +186,39 @@ TEST_F(JobRestart, FinishedJobThenKillRestartsWithoutTheAlarm) {
   EXPECT_NEAR(*restored, electrode, 1e-9);
 }
 
+// Issue 21 item 6: after kill -9 in the middle of drilling, the restart comes up in FAULT (alarm
+// 182), the operator resets and runs the part from the drilling block's line: the re-approach
+// (rapid up, over, down to the block's start, E1 re-armed) and the drill, counting from the depth
+// the interrupted job had reached, finish the hole to its programmed depth. The simulated work
+// keeps its half-drilled hole across the restart (retained, like a real workpiece).
+TEST_F(JobRestart, KillMidDrillingThenRunFromTheBlockFinishesTheHole) {
+  auto& plc = start_plc();
+  ASSERT_EQ(edmhmi({"run", "--detach", kBlindHole}, "run"), 0) << log("run");
+  ASSERT_TRUE(wait_for_record(true, 6.0, 90s)) << log("plc");
+  plc.kill();
+  const RetainMap at_kill = retained();
+  const double depth_at_kill = at_kill.at("job.depth_mm").r;
+  const double hole_at_kill = at_kill.at("io.hole_depth_mm").r;
+  // The controller's estimate and the simulated hole were written together: they agree.
+  EXPECT_NEAR(depth_at_kill, hole_at_kill, 0.03);
+  EXPECT_LT(hole_at_kill, 19.0);
+
+  auto& again = start_plc();
+  ASSERT_EQ(edmhmi({"reset"}, "reset"), 0) << log("reset");
+  // blind-hole.nc: N70 G01 Z-20.0 (the drilling block) is on source line 10.
+  ASSERT_EQ(edmhmi({"run", "--quiet", "--from", "10", kBlindHole}, "resume"), 0)
+      << log("resume") << log("plc");
+  const std::string out = log("resume");
+  EXPECT_NE(out.find("finished"), std::string::npos) << out;
+  again.signal(SIGTERM);
+  ASSERT_TRUE(again.wait(60s).has_value());
+  const double hole = retained().at("io.hole_depth_mm").r;
+  std::printf("killed at %.4f mm (estimate %.4f mm); resumed from line 10: hole %.4f mm "
+              "(program 20 mm, error %+.1f um)\n",
+              hole_at_kill, depth_at_kill, hole, (hole - 20.0) * 1e3);
+  EXPECT_NEAR(hole, 20.0, 0.05);
+}
+
 TEST_F(JobRestart, WithoutAStateDirectoryNothingIsRetained) {
   edm::apps::SpawnOptions o;
   o.out = edm::apps::Stream::kPipe;

@@ -90,6 +90,8 @@ Json to_json(const MotionBlock& b) {
   put_unless_default(j, "z_travel_mm", b.z_travel_mm, d.z_travel_mm);
   put_unless_default(j, "depth_mm", b.depth_mm, d.depth_mm);
   put_unless_default(j, "depth_done_mm", b.depth_done_mm, d.depth_done_mm);
+  put_unless_default(j, "resume_touch_z_mm", b.resume_touch_z_mm, d.resume_touch_z_mm);
+  put_unless_default(j, "resume_wear_mm", b.resume_wear_mm, d.resume_wear_mm);
   put_unless_default(j, "final_radius_mm", b.final_radius_mm, d.final_radius_mm);
   put_unless_default(j, "dwell_s", b.dwell_s, d.dwell_s);
   put_unless_default(j, "on", b.on, d.on);
@@ -129,6 +131,10 @@ bool from_json(const Json& j, MotionBlock& out, std::string& error) {
       ok = finite_number(v, b.depth_mm) && b.depth_mm >= 0.0;
     } else if (key == "depth_done_mm") {
       ok = finite_number(v, b.depth_done_mm) && b.depth_done_mm >= 0.0;
+    } else if (key == "resume_touch_z_mm") {
+      ok = finite_number(v, b.resume_touch_z_mm);
+    } else if (key == "resume_wear_mm") {
+      ok = finite_number(v, b.resume_wear_mm) && b.resume_wear_mm >= 0.0;
     } else if (key == "final_radius_mm") {
       ok = finite_number(v, b.final_radius_mm);
     } else if (key == "dwell_s") {
@@ -176,6 +182,8 @@ void Crc32::update(const MotionBlock& b) noexcept {
   put_le(p, b.z_travel_mm);
   put_le(p, b.depth_mm);
   put_le(p, b.depth_done_mm);
+  put_le(p, b.resume_touch_z_mm);
+  put_le(p, b.resume_wear_mm);
   put_le(p, b.final_radius_mm);
   put_le(p, b.dwell_s);
   *p++ = b.on ? 1 : 0;
@@ -381,8 +389,11 @@ Json to_json(const StatusMessage& s) {
     Json last = {{"outcome", s.job_last->outcome},
                  {"block", s.job_last->block},
                  {"line", s.job_last->line}};
-    if (s.job_last->depth_mm && std::isfinite(*s.job_last->depth_mm)) {
-      last["depth_mm"] = *s.job_last->depth_mm;
+    for (auto [key, v] : {std::pair<const char*, const std::optional<double>*>{
+                              "depth_mm", &s.job_last->depth_mm},
+                          {"touch_z_mm", &s.job_last->touch_z_mm},
+                          {"wear_mm", &s.job_last->wear_mm}}) {
+      if (*v && std::isfinite(**v)) last[key] = **v;
     }
     job["last"] = std::move(last);
   }
@@ -409,8 +420,10 @@ bool from_json(const Json& j, StatusMessage& out, std::string& error) {
       l.outcome = it->at("outcome").get<std::string>();
       l.block = it->at("block").get<std::uint64_t>();
       l.line = it->at("line").get<std::int32_t>();
-      if (auto d = it->find("depth_mm"); d != it->end() && d->is_number()) {
-        l.depth_mm = d->get<double>();
+      for (auto [key, v] : {std::pair<const char*, std::optional<double>*>{"depth_mm", &l.depth_mm},
+                            {"touch_z_mm", &l.touch_z_mm},
+                            {"wear_mm", &l.wear_mm}}) {
+        if (auto d = it->find(key); d != it->end() && d->is_number()) *v = d->get<double>();
       }
       s.job_last = std::move(l);
     }

@@ -498,14 +498,16 @@ std::optional<LastJob> Server::Impl::last_job() {
   const rt::JobProgress p = rt.job().progress();
   const auto& interrupted = rt.interrupted_job();
   if (interrupted && p.jobs_started == 0) {
-    return LastJob{"interrupted", static_cast<std::uint64_t>(interrupted->block_index),
-                   static_cast<std::int32_t>(interrupted->line), interrupted->depth_mm};
+    return LastJob{"interrupted",           static_cast<std::uint64_t>(interrupted->block_index),
+                   static_cast<std::int32_t>(interrupted->line), interrupted->depth_mm,
+                   interrupted->touch_z_mm, interrupted->wear_mm};
   }
   if (p.outcome != rt::JobOutcome::kAborted || p.slot != rt::JobSlot::kMain) return std::nullopt;
-  LastJob l{"aborted", p.block_index, p.line, std::nullopt};
-  if (const auto& d = rt.config().retain.job_depth) {
-    l.depth_mm = rt.variables().read(d->name);
-  }
+  LastJob l{"aborted", p.block_index, p.line, std::nullopt, std::nullopt, std::nullopt};
+  const rt::RetainSpec& rs = rt.config().retain;
+  if (rs.job_depth) l.depth_mm = rt.variables().read(rs.job_depth->name);
+  if (rs.job_touch_z) l.touch_z_mm = rt.variables().read(rs.job_touch_z->name);
+  if (rs.job_wear) l.wear_mm = rt.variables().read(rs.job_wear->name);
   return l;
 }
 

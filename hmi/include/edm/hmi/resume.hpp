@@ -24,6 +24,16 @@
 
 namespace edm::hmi {
 
+/// The interrupted drill's own state (status job.last: touch_z_mm, wear_mm): with it the resumed
+/// drill counts the depth on from its original touch point and wear, and the prologue lowers the
+/// electrode, generator off, to kResumeClearanceMm above where the front stopped — inside the
+/// hole, first sparks may strike the wall far above the bottom.
+struct DrillResume {
+  double touch_z_mm{0.0};  // machine Z where the interrupted drill first touched
+  double wear_mm{0.0};     // the wear it had compensated since (> 0)
+};
+inline constexpr double kResumeClearanceMm = 0.2;
+
 struct ResumePlan {
   std::vector<machining::MotionBlock> blocks;  // prologue + the program from `first` on
   std::vector<BlockFrame> frames;              // one per block
@@ -50,6 +60,7 @@ std::vector<machining::Vec3> block_starts(const GcodeResult& program);
 /// Errors: a program with errors, line < 1, a line past the last block or at the program end, a
 /// G160 orbit on that line (it cannot be resumed part-way), a depth out of range.
 ResumePlan plan_resume(const GcodeResult& program, const machining::MachineTables& tables,
-                       std::int32_t line, double depth_done_mm = 0.0);
+                       std::int32_t line, double depth_done_mm = 0.0,
+                       const std::optional<DrillResume>& drill_state = std::nullopt);
 
 }  // namespace edm::hmi

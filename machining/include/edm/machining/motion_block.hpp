@@ -59,6 +59,11 @@ struct MotionBlock {
                                 // machine Z 0 (depth = −target.z)
   double depth_done_mm{0.0};    // kDrill: depth the hole already has when the block starts (run
                                 // from a block after an interruption); 0 = a new hole
+  double resume_touch_z_mm{0.0};  // kDrill with depth_done_mm > 0: the machine Z where the
+                                  // interrupted drill first touched (its depth origin) ...
+  double resume_wear_mm{0.0};     // ... and the wear it had compensated since: the depth goes on
+                                  // counting from them (0, 0: from the resumed drill's first
+                                  // sparks, plus depth_done_mm)
   double final_radius_mm{0.0};  // kOrbitFinish: final hole radius (mm, absolute, > 0)
   double dwell_s{0.0};          // kDwell
   bool on{false};               // kRotation / kFlushing

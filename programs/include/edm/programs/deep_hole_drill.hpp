@@ -22,7 +22,11 @@
 //                 depth_reached_mm = depth_done_mm + (touch_z_mm − z_mm)
 //                                    − (enable_wear_comp ? wear.wear_mm : 0)
 //                                    − spark_gap_offset_um·1e-3
-//                 (depth_done_mm: the depth a resumed hole already had, 0 for a new one)
+//                 (depth_done_mm: the depth a resumed hole already had, 0 for a new one);
+//                 resumed with the interrupted drill's state (resume_wear_mm > 0): touch_z_mm
+//                 is resume_touch_z_mm and the wear is resume_wear_mm + this cycle's, so
+//                 depth_reached_mm = (touch_z_mm − z_mm) − wear − spark_gap_offset_um·1e-3 as if
+//                 never interrupted (wear_mm, the output, includes resume_wear_mm)
 //                 (the front touches at the first-spark gap and drills one working gap above
 //                 the bottom; spark_gap_offset_um is their difference, docs/blocks.md)
 //                 (output wear_mm: that estimated electrode wear of this cycle)
@@ -141,6 +145,11 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   // strike at its bottom, so the depth counts from there. Read at the start of a cycle; ≤ 0 or
   // not finite: a new hole.
   rt::Input<double> depth_done_mm{pins_, "depth_done_mm", "mm"};
+  // A resumed hole whose interrupted drill's state is known (resume_wear_mm > 0 with
+  // depth_done_mm > 0): the depth counts on from that drill's touch point and wear, not from the
+  // new first sparks (inside a hole they may strike the wall well above the bottom).
+  rt::Input<double> resume_touch_z_mm{pins_, "resume_touch_z_mm", "mm"};
+  rt::Input<double> resume_wear_mm{pins_, "resume_wear_mm", "mm"};
   rt::Input<double> wear_ratio{pins_,
                                "wear_ratio"};  // ≤ 0 (unwired): the wear child's wear_ratio_default
   rt::Input<double> area_ratio{pins_, "area_ratio"};  // ≤ 0 (unwired): the wear child's areas
@@ -206,6 +215,9 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   double breakthrough_z_mm_{0.0};  // z where the breakthrough was detected
   double target_depth_mm_{0.0};
   double depth_done_mm_{0.0};  // depth_done_mm at the start of the cycle
+  bool resume_{false};         // counting on from an interrupted drill's touch and wear
+  double resume_touch_z_mm_{0.0};
+  double resume_wear_mm_{0.0};
   double retract_to_z_mm_{0.0};
   bool safe_retract_{false};  // the running retract was started by the safe state
   double last_z_sp_mm_{0.0};

@@ -124,6 +124,8 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<bool> feed_hold{pins_, "feed_hold"};
   rt::Output<double> drill_depth_mm{pins_, "drill_depth_mm", "mm"};
   rt::Output<double> drill_depth_done_mm{pins_, "drill_depth_done_mm", "mm"};
+  rt::Output<double> drill_resume_touch_z_mm{pins_, "drill_resume_touch_z_mm", "mm"};
+  rt::Output<double> drill_resume_wear_mm{pins_, "drill_resume_wear_mm", "mm"};
   rt::Output<bool> manual_enable{pins_, "manual_enable"};
   rt::Output<bool> dry_run{pins_, "dry_run"};
   rt::Output<double> wear_ratio{pins_, "wear_ratio"};

@@ -167,6 +167,11 @@ struct RetainSpec {
   /// the runtime retains while a part program runs (docs/runtime.md, "Restart after an unclean
   /// stop"); absent: the record has no depth.
   std::optional<NameRef> job_depth;
+  /// Two more LREAL variables of the record, for resuming a drilling block where it stopped
+  /// (issue 21): the Z where the drill first touched (its depth origin) and the electrode wear it
+  /// had compensated since (drill-sim: cnc.job.drill.touch_z_mm, cnc.job.drill.wear_mm).
+  std::optional<NameRef> job_touch_z;
+  std::optional<NameRef> job_wear;
   SourceLoc loc;
   SourceLoc file_loc;  // of the `file:` value, for problems with the path itself
 };

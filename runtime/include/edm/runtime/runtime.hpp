@@ -52,6 +52,8 @@ struct InterruptedJob {
   std::int64_t block_count{0};     // blocks in the program
   std::int64_t line{0};            // its G-code line
   std::optional<double> depth_mm;  // `retain.job_depth` at the last retain write, if configured
+  std::optional<double> touch_z_mm;  // `retain.job_touch_z`: the drill's depth origin (machine Z)
+  std::optional<double> wear_mm;     // `retain.job_wear`: the wear it had compensated since
 };
 
 struct RunOptions {

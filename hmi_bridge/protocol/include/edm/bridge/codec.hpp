@@ -34,13 +34,13 @@ bool from_json(const Json& j, machining::MotionBlock& out, std::string& error);
 
 // ---- program checksum ---------------------------------------------------------------------
 // CRC-32 (IEEE 802.3, the zlib/PNG polynomial; Python: zlib.crc32) over each block's canonical
-// 114-byte little-endian record, in program order:
+// 130-byte little-endian record, in program order:
 //   u8 kind, i32 line, i32 col, f64 target.x/y/z, f64 centre.x/y/z, i32 turns, f64 feed_mm_s,
-//   i32 condition, f64 z_travel_mm, f64 depth_mm, f64 depth_done_mm, f64 final_radius_mm,
-//   f64 dwell_s, u8 on
-// (Python: struct.pack('<Bii6didi5dB', ...)). It covers the decoded values, so it catches a
+//   i32 condition, f64 z_travel_mm, f64 depth_mm, f64 depth_done_mm, f64 resume_touch_z_mm,
+//   f64 resume_wear_mm, f64 final_radius_mm, f64 dwell_s, u8 on
+// (Python: struct.pack('<Bii6didi7dB', ...)). It covers the decoded values, so it catches a
 // lost, repeated or reordered chunk and any number the JSON round trip changed.
-inline constexpr std::size_t kBlockRecordBytes = 114;
+inline constexpr std::size_t kBlockRecordBytes = 130;
 
 // Incremental: update() in any number of pieces gives the CRC of their concatenation.
 class Crc32 {
@@ -101,6 +101,8 @@ struct LastJob {
   std::uint64_t block{0};
   std::int32_t line{0};
   std::optional<double> depth_mm;  // retain.job_depth's variable then (the controller's estimate)
+  std::optional<double> touch_z_mm;  // retain.job_touch_z's: the drill's depth origin (machine Z)
+  std::optional<double> wear_mm;     // retain.job_wear's: the wear compensated since the touch
 };
 
 struct StatusMessage {
