@@ -88,6 +88,32 @@ std::string_view to_string(ManualError e) noexcept {
   return "";
 }
 
+std::string_view error_code(ManualError e) noexcept {
+  switch (e) {
+    case ManualError::kNone:
+      return "";
+    case ManualError::kStopped:
+      return "stopped";
+    case ManualError::kDeadman:
+      return "deadman";
+    case ManualError::kNoContact:
+      return "no_contact";
+    case ManualError::kAlreadyInContact:
+      return "in_contact";
+    case ManualError::kSoftLimit:
+      return "soft_limit";
+    case ManualError::kNoSwitch:
+      return "no_switch";
+    case ManualError::kInterrupted:
+      return "interrupted";
+    case ManualError::kNotAvailable:
+      return "not_available";
+    case ManualError::kBadRequest:
+      return "bad_request";
+  }
+  return "";
+}
+
 void ManualControl::attach(const ManualInfo& info, std::uint8_t referenced_at_start) noexcept {
   info_.store(info);
   reference_required_.store(info.reference_required, std::memory_order_release);

@@ -384,7 +384,9 @@ Json to_json(const StatusMessage& s) {
               {"generation", s.job_generation},
               {"block", s.job_block},
               {"blocks", s.job_blocks},
-              {"line", s.job_line}};
+              {"line", s.job_line},
+              {"jobs_started", s.job_jobs_started},
+              {"slot", s.job_slot}};
   if (s.job_last) {
     Json last = {{"outcome", s.job_last->outcome},
                  {"block", s.job_last->block},
@@ -415,6 +417,8 @@ bool from_json(const Json& j, StatusMessage& out, std::string& error) {
     s.job_block = job.at("block").get<std::uint64_t>();
     s.job_blocks = job.at("blocks").get<std::uint64_t>();
     s.job_line = job.at("line").get<std::int32_t>();
+    s.job_jobs_started = job.value("jobs_started", std::uint64_t{0});  // absent: older runtime
+    s.job_slot = job.value("slot", std::string("main"));
     if (auto it = job.find("last"); it != job.end() && it->is_object()) {
       LastJob l;
       l.outcome = it->at("outcome").get<std::string>();

@@ -150,6 +150,7 @@ Body op_manual_status(Session& s) {
              {"op", std::string(rt::to_string(r.op))},
              {"ok", r.ok},
              {"error", std::string(rt::to_string(r.error))},
+             {"code", std::string(rt::error_code(r.error))},
              {"x", r.x},
              {"y", r.y},
              {"z", r.z},

@@ -490,6 +490,8 @@ StatusMessage Server::Impl::status_message() {
   m.job_block = p.block_index;
   m.job_blocks = p.block_count;
   m.job_line = p.line;
+  m.job_jobs_started = p.jobs_started;
+  m.job_slot = p.slot == rt::JobSlot::kMdi ? "mdi" : "main";
   m.job_last = last_job();
   return m;
 }

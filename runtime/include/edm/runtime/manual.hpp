@@ -52,6 +52,9 @@ std::string_view to_string(ManualOp op) noexcept;
 std::string_view to_string(TouchTarget t) noexcept;
 std::string_view to_string(ManualMode m) noexcept;
 std::string_view to_string(ManualError e) noexcept;
+/// A stable machine-readable name: "", "stopped", "deadman", "no_contact", "in_contact",
+/// "soft_limit", "no_switch", "interrupted", "not_available", "bad_request".
+std::string_view error_code(ManualError e) noexcept;
 /// "z", "x+", "x-", "y+", "y-", "center" → target; false when unknown.
 bool touch_target_from_string(std::string_view s, TouchTarget& out) noexcept;
 

@@ -115,6 +115,8 @@ struct StatusMessage {
   std::uint64_t job_block{0};  // index of the block being executed
   std::uint64_t job_blocks{0};
   std::int32_t job_line{0};                          // its G-code line
+  std::uint64_t job_jobs_started{0};                 // jobs begun since start (any slot)
+  std::string job_slot{"main"};                      // the current or last job's: main, mdi
   std::optional<LastJob> job_last;                   // job.last: a job that may be resumed
   std::vector<std::pair<std::string, double>> vars;  // the configured key variables
   std::uint64_t dropped{0};  // events this session has lost to a full queue (events only)
