@@ -80,6 +80,9 @@ TEST_F(DeadMan, AJogWhoseHmiIsKilledStopsWithinTheDeadManTime) {
 
   jog.signal(SIGKILL);
   const auto killed = Clock::now();
+  // The machine's own time at the kill (its clock is paced to wall time, but a loaded machine may
+  // lag it: the dead-man is judged on the machine's clock).
+  const double killed_t_s = client_.request("status").body["t_s"].get<double>();
   ASSERT_TRUE(jog.wait(5s).has_value());
   // The runtime ends the jog on its own: busy false, result dead-man.
   ASSERT_TRUE(poll_until([&] { return !manual()["busy"].get<bool>(); }, 10s, 10ms));
@@ -90,11 +93,14 @@ TEST_F(DeadMan, AJogWhoseHmiIsKilledStopsWithinTheDeadManTime) {
   const double xa = x();
   std::this_thread::sleep_for(300ms);  // an interval of wall (= machine) time to observe
   EXPECT_NEAR(x(), xa, 0.001);
-  std::printf("edmhmi killed while jogging X at 2 mm/s: the jog ended %.0f ms later (dead-man "
-              "%.0f ms)\n",
-              after_s * 1e3, deadman_s * 1e3);
-  // The dead-man, one refresh period of edmhmi at most, the deceleration and the poll.
-  EXPECT_LE(after_s, deadman_s + deadman_s / 3.0 + 0.3);
+  const double ended_after_s = st["result"]["t_s"].get<double>() - killed_t_s;
+  std::printf("edmhmi killed while jogging X at 2 mm/s: the jog ended %.0f ms of machine time "
+              "later (%.0f ms of wall time; dead-man %.0f ms)\n",
+              ended_after_s * 1e3, after_s * 1e3, deadman_s * 1e3);
+  // The dead-man, one refresh period of edmhmi at most (deadman/3), the deceleration and the
+  // settling in position, on the machine's clock.
+  EXPECT_LE(ended_after_s, deadman_s + deadman_s / 3.0 + 0.2);
+  EXPECT_LT(after_s, 10.0) << "never left moving";
 }
 
 }  // namespace
