@@ -48,6 +48,21 @@ Json refused(const bridge::Reply& r, const std::string& what) {
                  what + ": " + reply_error(r));
 }
 
+/// A refused upload, with the commit's issues located at their lines (program.commit's details).
+Json commit_refused(const bridge::Reply& up) {
+  Json errors = Json::array();
+  if (up.details.is_object() && up.details.contains("issues") && up.details["issues"].is_array()) {
+    for (const Json& i : up.details["issues"]) {
+      errors.push_back({{"line", i.value("line", 0)},
+                        {"col", i.value("col", 0)},
+                        {"message", i.value("message", std::string())}});
+    }
+  }
+  Json r = refused(up, "program refused");
+  r["errors"] = std::move(errors);
+  return r;
+}
+
 /// The frames of a program as runs: [first block, frame, ox, oy, oz] each time the frame (or the
 /// G92 offset) changes — a few entries, whatever the program's length.
 Json frame_runs(const std::vector<BlockFrame>& frames) {
@@ -261,21 +276,7 @@ Json WebJob::upload(const std::string& text, const std::string& name) {
             {"errors", errors_json(g.errors)}};
   }
   const bridge::Reply up = upload_blocks(g.blocks, "", offsets_generation);
-  if (!up) {
-    Json errors = Json::array();
-    if (up.details.is_object() && up.details.contains("issues") &&
-        up.details["issues"].is_array()) {
-      for (const Json& i : up.details["issues"]) {
-        errors.push_back({{"line", i.value("line", 0)},
-                          {"col", i.value("col", 0)},
-                          {"message", i.value("message", std::string())}});
-      }
-    }
-    return {{"ok", false},
-            {"code", up.code ? std::string(bridge::to_string(*up.code)) : "transport"},
-            {"message", "program refused: " + reply_error(up)},
-            {"errors", errors}};
-  }
+  if (!up) return commit_refused(up);
   std::lock_guard lock(mutex_);
   load_locked(name, text, std::move(g.blocks), g.frames, options.start_mm,
               up.body.value("generation", std::uint64_t{0}));
@@ -337,21 +338,26 @@ Json WebJob::start_from(std::int32_t line, std::optional<double> depth_done_mm, 
   std::string depth_from = "none";
   if (plan.ok() && plan.drill) {
     double depth = 0.0;
+    std::optional<DrillResume> state;  // the interrupted drill's touch Z and wear: it counts on
     if (depth_done_mm) {
       depth = *depth_done_mm;
       depth_from = "operator";
     } else if (last && last->line == plan.line && last->depth_mm) {
       depth = std::max(0.0, *last->depth_mm);
       depth_from = "last job (" + last->outcome + ")";
+      if (last->touch_z_mm && last->wear_mm) {
+        state = DrillResume{*last->touch_z_mm, *last->wear_mm};
+        depth_from += ", its touch Z and wear";
+      }
     }
-    if (depth > 0.0) plan = plan_resume(*g, tables, line, depth);
+    if (depth > 0.0) plan = plan_resume(*g, tables, line, depth, state);
   } else if (plan.ok() && depth_done_mm && *depth_done_mm > 0.0) {
     plan = plan_resume(*g, tables, line, *depth_done_mm);  // refused: no drilling on that line
   }
   if (!plan.ok())
     return refused("bad_request", "from line " + std::to_string(line) + ": " + plan.error);
   const bridge::Reply up = upload_blocks(plan.blocks, "", offsets_generation);
-  if (!up) return refused(up, "program refused");
+  if (!up) return commit_refused(up);
   {
     std::lock_guard lock(mutex_);
     load_locked(part, text, plan.blocks, plan.frames, options.start_mm,

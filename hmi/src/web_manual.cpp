@@ -154,6 +154,12 @@ void WebManual::release(std::uint64_t owner) {
   cv_.notify_all();
 }
 
+void WebManual::release_any() {
+  std::lock_guard lock(mutex_);
+  if (pending_hold_) pending_released_ = true;
+  hold_.reset();
+}
+
 Json WebManual::touch(const std::string& target, const std::string& set_frame) {
   if (!set_frame.empty() && !frame_index(set_frame)) {
     return refused("bad_request", "'set' must be one of G54 … G59");

@@ -212,7 +212,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
 
   /// On the worker thread: the blocking part of a command.
   static Json run_command(WebHub& hub, const std::string& op, const Json& msg,
-                          std::uint64_t owner) {
+                          std::uint64_t owner) {  // owner: this browser, for a held jog
     const std::string name = msg.value("name", std::string("program.nc"));
     if (op == "check" || op == "upload") {
       if (!msg.contains("text") || !msg["text"].is_string()) {
@@ -247,7 +247,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
       for (const char* k : {"axes", "axis", "distance"}) {
         if (msg.contains(k)) params[k] = msg[k];
       }
-      if (op == "jog.stop") hub.manual().release(owner);
+      if (op == "jog.stop") hub.manual().release_any();
       return reply_json(hub.client().request(op, params));
     }
     if (op == "jog.hold") {  // continuous: the hub refreshes it while "held" comes

@@ -18,6 +18,19 @@ async function confirm() {
   await page.locator('#confirm-yes').click();
 }
 
+/** Waits for the state; on a timeout says what the machine did instead (job, last alarms). */
+async function waitState(re, timeout = T) {
+  try {
+    await state().filter({ hasText: re }).waitFor({ timeout });
+  } catch (e) {
+    const seen = await page.evaluate(() => JSON.stringify({
+      state: window.edm.status?.state, job: window.edm.status?.job,
+      alarms: (window.edm.alarms || []).slice(-3).map((a) => `${a.code} ${a.name} ${a.source}: ${a.text}`),
+    }));
+    throw new Error(`state ${re} not reached: ${seen}`, { cause: e });
+  }
+}
+
 /** The machine position (machine coordinates) of the last status the page got. */
 function position(p = page) {
   return p.evaluate(() => {
@@ -306,14 +319,14 @@ test('a viewer sees no control buttons and cannot act', async () => {
   await v.setViewportSize({ width: 800, height: 1280 });  // a tablet held upright
   await v.screenshot({ path: join(out, 'viewer-tablet-800x1280.png'), fullPage: true });
   await v.close();
-  assert.match(await state().textContent(), /RUNNING|HOLD/);
+  await waitState(/RUNNING|HOLD/, 1000);
 });
 
 test('a reload in the middle of the job leaves it running', async () => {
   const before = await page.evaluate(() => window.edm.status.job);
   await page.reload();
   await page.locator('#app').waitFor({ state: 'visible', timeout: T });
-  await state().filter({ hasText: 'RUNNING' }).waitFor({ timeout: T });
+  await waitState('RUNNING');
   const after = await page.evaluate(() => window.edm.status.job);
   // The charts keep their recent past across the reload (the server's history).
   assert.ok(Number(await page.locator('#chart-z').getAttribute('data-points')) > 20);
@@ -328,8 +341,9 @@ test('hold, resume, finish and read the job report', async () => {
     return last && JSON.parse(last).depth_est > 4;
   }, null, { timeout: 60000, polling: 100 });
   await page.screenshot({ path: join(out, 'drilling.png') });  // README's picture
+  await waitState('RUNNING');
   await page.locator('#btn-hold').click();
-  await state().filter({ hasText: 'HOLD' }).waitFor({ timeout: T });
+  await waitState('HOLD');
   await page.locator('#btn-resume').click();
   await confirm();
   await state().filter({ hasText: 'RUNNING' }).waitFor({ timeout: T });
@@ -347,11 +361,73 @@ test('run from a line, as a dry run: re-approach, then the rest of the program',
   await page.locator('#from-line').fill(String(line));
   await page.locator('#from-go').click();
   await confirm();
-  await page.locator('#from-result').filter({ hasText: `started at line ${line}` }).waitFor({ timeout: T });
+  await page.locator('#from-result').filter({ hasText: /started|refused/ }).waitFor({ timeout: T });
+  assert.match(await page.locator('#from-result').textContent(), new RegExp(`started at line ${line}`));
   await page.locator('#job-report').filter({ hasText: 'outcome' }).waitFor({ timeout: 60000 });
   assert.match(await page.locator('#job-report').textContent(), /outcome\s+finished/);
   await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
   await page.locator('#dry-run').uncheck();
+});
+
+// TODO until the runtime keeps job.last and the axes still once a stopped job is READY: seen
+// here, a resume sent right after READY faults in 0.1 s (alarm 110 in cnc.job.pz, the axis
+// moving down), and 3 s after the stop job.last says depth 12.000 mm for a 3.5 mm hole.
+test('stop mid-drill, then run from the drilling line: the hole is finished from its depth', {
+  todo: 'runtime: job.last and the axes after cycle.stop (see the comment above)',
+}, async () => {
+  // A second hole: G54 moved 10 mm in X, the electrode over the new place (MDI), and Z touched
+  // off again there — the first hole wore the electrode ~10 mm shorter.
+  await page.locator('#off-G54-X').fill('10');
+  await page.locator('#off-set-G54').click();
+  await page.locator('#offsets-result').filter({ hasText: 'G54 set' }).waitFor({ timeout: T });
+  await page.locator('#mdi-line').fill('G00 X5 Y5');
+  await page.locator('#mdi-go').click();
+  await confirm();
+  await page.locator('#mdi-result').filter({ hasText: /started|refused/ }).waitFor({ timeout: T });
+  await page.waitForFunction(() => Math.abs(window.edm.status.vars['io.x_mm'] - 15) < 0.002
+    && window.edm.status.state === 'READY', null, { timeout: T, polling: 50 });
+  const seq = await lastSeq();
+  await page.locator('#touch-target').selectOption('z');
+  await page.locator('#touch-set').selectOption('G54');
+  await page.locator('#touch-go').click();
+  await confirm();
+  const touched = await nextResult(seq, 60000);
+  assert.ok(touched.ok, `touch failed: ${touched.error}`);
+  metrics.touch_z_worn_electrode_mm = touched.z;
+  await page.locator('#touch-set-result').filter({ hasText: 'G54 set' }).waitFor({ timeout: T });
+  await page.waitForFunction((z) => Math.abs(window.edm.offsets.frames.G54.z - z) < 1e-6,
+    touched.z, { timeout: T });
+  await page.locator('#program').fill(demo);
+  await page.locator('#btn-upload').click();
+  await page.locator('#check-result').filter({ hasText: /uploaded: 15 blocks/ }).waitFor({ timeout: T });
+  await page.locator('#btn-start').click();
+  await confirm();
+  await state().filter({ hasText: 'RUNNING' }).waitFor({ timeout: T });
+  await page.waitForFunction(() => (window.edm.status?.vars?.['io.depth_mm'] ?? 0) > 3, null,
+    { timeout: 60000, polling: 50 });
+  await page.locator('#btn-stop').click();
+  await confirm();
+  await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
+  const last = await page.evaluate(() => window.edm.status.job.last);
+  const drillLine = demo.split('\n').findIndex((l) => l.startsWith('G01 Z-12')) + 1;
+  assert.equal(last?.line, drillLine, JSON.stringify(last));
+  metrics.stopped_at_depth_mm = last.depth_mm;
+  metrics.stopped_job_last = last;
+  await page.locator('#from-line').fill(String(drillLine));
+  await page.locator('#from-depth').fill('');
+  await page.locator('#from-go').click();
+  await confirm();
+  await page.locator('#from-result').filter({ hasText: /started|refused/ }).waitFor({ timeout: T });
+  const started = await page.locator('#from-result').textContent();
+  assert.match(started, new RegExp(`started at line ${drillLine}.*last job \\(aborted\\)`));
+  await page.locator('#job-report').filter({ hasText: 'outcome' }).waitFor({ timeout: 120000 });
+  const report = await page.locator('#job-report').textContent();
+  assert.match(report, /outcome\s+finished/);
+  await state().filter({ hasText: 'READY' }).waitFor({ timeout: T });
+  const depth = await page.evaluate(() => window.edm.status.vars['io.depth_mm']);
+  metrics.resumed_hole_depth_mm = depth;
+  assert.ok(Math.abs(depth - 12) < 0.1, `the resumed hole is ${depth} mm deep, the program 12`);
+  writeFileSync(join(out, 'resumed-report.txt'), report);
 });
 
 test('stale data is flagged when the machine stops answering', async () => {

@@ -87,6 +87,7 @@ export class OperatorPanel {
     section('jog', 'Jog', (d) => this.buildJog(d));
     section('touch', 'Touch-off', (d) => this.buildTouch(d));
     section('override', 'Feed override', (d) => this.buildOverride(d));
+    this.markStep();
     this.buildOffsets(isOperator);
     for (const id of ['from-row', 'mdi-row']) {
       const row = $(id);
@@ -152,7 +153,6 @@ export class OperatorPanel {
       }
     }
     div.append(steps, grid);
-    this.markStep();
   }
 
   markStep() {
@@ -238,7 +238,7 @@ export class OperatorPanel {
       return;
     }
     const head = t.insertRow();
-    for (const h of ['show', 'frame', 'X', 'Y', 'Z', '']) head.append(el('th', { textContent: h }));
+    for (const h of ['', '', 'X', 'Y', 'Z', '']) head.append(el('th', { textContent: h }));
     for (const f of FRAMES) {
       const tr = t.insertRow();
       tr.dataset.frame = f;
@@ -247,7 +247,7 @@ export class OperatorPanel {
       tr.insertCell().append(radio);
       tr.insertCell().textContent = f;
       const inputs = AXES.map((a) => {
-        const i = el('input', { type: 'number', step: '0.0001', size: 8, className: 'off' });
+        const i = el('input', { type: 'number', step: '0.0001', className: 'off' });
         i.dataset.axis = a.toLowerCase();
         i.id = `off-${f}-${a}`;
         tr.insertCell().append(i);
@@ -333,6 +333,7 @@ export class OperatorPanel {
   }
 
   async startFrom() {
+    $('from-result').textContent = '';
     const line = Number($('from-line').value);
     if (!Number.isInteger(line) || line < 1) { $('from-result').textContent = 'give a line number'; return; }
     const depthText = $('from-depth').value.trim();
@@ -340,16 +341,19 @@ export class OperatorPanel {
     if (!(await this.confirm(`Start the loaded program from line ${line}${dry ? ' as a dry run' : ''}? The electrode rapids up to the clearance, over and down to that block, then the program runs on.`))) return;
     const params = { line, dry_run: dry };
     if (depthText !== '') params.depth_done = Number(depthText);
+    $('from-result').textContent = 'interpreting…';
     const r = await this.conn.cmd('start_from', params);
     $('from-result').textContent = r.ok
       ? `started at line ${r.line} (block ${r.first_block}, ${r.prologue} re-approach blocks, depth done ${fmt(r.depth_done_mm, 3)} mm: ${r.depth_from})`
-      : `refused: ${r.message || r.code}`;
+      : `refused: ${r.message || r.code}${(r.errors || []).map((e) => ` · line ${e.line}: ${e.message}`).join('')}`;
   }
 
   async mdi() {
+    $('mdi-result').textContent = '';
     const line = $('mdi-line').value.trim();
     if (!line) return;
     if (!(await this.confirm(`Run the MDI line "${line}"? The axes may move.`))) return;
+    $('mdi-result').textContent = 'interpreting…';
     const r = await this.conn.cmd('mdi', { line });
     $('mdi-result').textContent = r.ok ? `started (${r.blocks} blocks)` : `refused: ${r.message || r.code}`;
   }

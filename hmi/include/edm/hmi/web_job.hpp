@@ -64,7 +64,8 @@ class WebJob {
   /// is, with the current offsets, resumed at source line `line` (a safe re-approach first),
   /// committed in place of the loaded program, and started. The drilling block on that line goes
   /// on from `depth_done_mm`, else from the runtime's record of the last job when it ended on
-  /// that line (status job.last), else from 0. {"ok", "line", "first_block", "prologue",
+  /// that line (status job.last: its depth, and its touch Z and wear so the drill counts on from
+  /// them, as `edmhmi run --from`), else from 0. {"ok", "line", "first_block", "prologue",
   /// "depth_done_mm", "depth_from", "clearance_z_mm", "blocks"} or {"ok": false, "code",
   /// "message", "errors"?}.
   bridge::Json start_from(std::int32_t line, std::optional<double> depth_done_mm, bool dry_run);

@@ -80,6 +80,9 @@ class WebManual {
   /// The browser let go (or its socket closed: drop): jog.stop at once, from the follower.
   void release(std::uint64_t owner);
   void drop(std::uint64_t owner) { release(owner); }
+  /// jog.stop from any operator ends the hold, whoever holds it (the runtime stops the jog, and
+  /// a refresh must not start it again).
+  void release_any();
 
   /// touch {target}; with `set_frame` ("G54".."G59", or empty) the result goes into that frame.
   /// Blocking; the page's reply.
