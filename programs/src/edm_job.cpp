@@ -168,6 +168,12 @@ void EdmJob::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
 
 void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   if (job_ != nullptr) job_->rt_finish(outcome);
+  if (outcome == rt::JobOutcome::kAborted) {
+    // An operator stop is no safe state: the children must still end their cycles (a drill left
+    // running would creep down dark, counting wear it never made).
+    drill_.abort();
+    finish_.abort();
+  }
   drill_returning_ = false;
   if (outcome == rt::JobOutcome::kFinished) jobs_finished.set(jobs_finished.get() + 1);
   state_value_ = State::kIdle;

@@ -17,6 +17,7 @@
 
 #include "edm/hmi/gcode.hpp"
 #include "edm/hmi/mdi.hpp"
+#include "edm/hmi/resume.hpp"
 #include "operator_rig.hpp"
 
 namespace edm::test {
@@ -174,6 +175,59 @@ TEST(DryRun, RunsTheMovesWithTheGeneratorOffAndNeverEntersTheWork) {
   EXPECT_NEAR(m.truth().machine_y_mm, kHoleY, 0.005);
   // The next start is a normal one again (the option is consumed).
   EXPECT_FALSE(job.current_options().dry_run && job.active());
+}
+
+}  // namespace
+}  // namespace edm::test
+namespace edm::test {
+namespace {
+
+// An operator stop in the middle of drilling: the drill retracts at once (never creeps on down
+// with the generator off) and keeps its depth count; a run from the drilling line then finishes
+// the hole from the drill's own touch point and wear (what `edmhmi run --from` and the page send).
+TEST(StopAndResume, StopMidDrillRetractsThenRunFromTheLineFinishesTheHole) {
+  OperatorRig m("start_gap_um: 5000", "");
+  hmi::GcodeOptions go;
+  go.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
+  const hmi::GcodeResult part = hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), go);
+  ASSERT_TRUE(part.ok()) << part.messages().front();
+  auto& job = m.runtime->job();
+  ASSERT_EQ(job.load(part.blocks), rt::LoadResult::kOk);
+  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  for (int k = 0; k < 120'000 && m.read("cnc.job.drill.depth_reached_mm") < 3.0; ++k) {
+    m.run_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GE(m.read("cnc.job.drill.depth_reached_mm"), 3.0);
+  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStop), rt::CommandResult::kOk);
+  const double z_stop = m.truth().machine_z_mm;
+  double z_min = z_stop;
+  for (int k = 0; k < 5000; ++k) {
+    m.run_for(std::chrono::milliseconds(1));
+    z_min = std::min(z_min, m.truth().machine_z_mm);
+    ASSERT_EQ(m.read("io.gen_on"), 0.0);
+  }
+  EXPECT_GT(z_min, z_stop - 0.005) << "Z went on down after the stop";
+  EXPECT_GT(m.truth().machine_z_mm, 0.0) << "retracted out of the hole";
+  EXPECT_EQ(m.read("cnc.job.drill.state"), 0.0);
+  EXPECT_EQ(job.progress().outcome, rt::JobOutcome::kAborted);
+  const double depth = m.read("cnc.job.drill.depth_reached_mm");
+  const double touch_z = m.read("cnc.job.drill.touch_z_mm");
+  const double wear = m.read("cnc.job.drill.wear_mm");
+  EXPECT_NEAR(depth, m.truth().hole_depth_mm, 0.03) << "the count kept at the stop";
+
+  // Run from the drilling line (N70 is source line 8 of kPart).
+  hmi::GcodeOptions again;
+  again.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
+  const hmi::GcodeResult g = hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), again);
+  const hmi::ResumePlan plan =
+      hmi::plan_resume(g, m.runtime->tables(), 8, depth, hmi::DrillResume{touch_z, wear});
+  ASSERT_TRUE(plan.ok()) << plan.error;
+  ASSERT_TRUE(plan.drill.has_value());
+  ASSERT_TRUE(m.run_program(plan.blocks, rt::JobSlot::kMain));
+  const double err_um = (m.truth().hole_depth_mm - kDepth) * 1e3;
+  std::printf("stopped at %.4f mm, resumed from line 8: hole %.4f mm (error %+.1f um)\n", depth,
+              m.truth().hole_depth_mm, err_um);
+  EXPECT_NEAR(err_um, 0.0, 30.0);
 }
 
 }  // namespace

@@ -125,6 +125,10 @@ struct DeepHoleDrillParams {
 
 class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::CompositeBlock> {
  public:
+  /// The job was stopped by the operator (not a safe state): as the safe state does, the
+  /// generator goes off and an approach or drilling cycle retracts (to the touch height plus
+  /// clearance_mm) and ends in IDLE, done false — never left creeping down dark. RT-safe.
+  void abort() noexcept { safe_state_self(rt::SafeStateRequest{}); }
   enum class State : std::int64_t {
     kIdle = 0,
     kApproach = 1,

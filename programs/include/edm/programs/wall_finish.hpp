@@ -95,6 +95,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   enum class State : std::int64_t { kIdle = 0, kPolarity = 1, kOrbit = 2, kBack = 3, kDone = 4 };
 
   WallFinish();
+  /// The job was stopped by the operator: the orbit stops as in the safe state (IDLE, done
+  /// false). RT-safe.
+  void abort() noexcept { safe_state_self(rt::SafeStateRequest{}); }
 
   // Pins, listed in declaration order.
   PulseInputs pulses{pins_};  // td_sum_ns, td_count, n_open, n_short
