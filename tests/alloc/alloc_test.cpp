@@ -228,6 +228,59 @@ INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachines, ::testing::Values("drill-sim", 
                                                                       : "FuzzyServo";
                          });
 
+// The operator's manual motion (issue 21) on drill-sim: a homing of Z (switch, back-off, latch,
+// encoder set), a distance jog, a continuous jog refreshed then stopped, and a touch-off of the
+// surface (touch mode, fast and slow approach) — every cycle of them counted. The requests are
+// made between cycles (the bridge's thread in use), not counted.
+TEST(Allocations, NoneInsideCyclesOfTheManualMotion) {
+  auto r = build_shipped("drill-sim");
+  auto run_until_idle = [&](std::uint64_t seq, int max_cycles) {
+    rt::VirtualClock clock;
+    static std::int64_t k = 0;
+    auto& task = *r->tasks()[0];
+    std::size_t total = 0;
+    for (int n = 0; n < max_cycles; ++n, ++k) {
+      const rt::TimePoint release{1ms * k};
+      clock.advance_to(release);
+      g_allocations = 0;
+      g_counting = true;
+      task.run_cycle(release, clock);
+      g_counting = false;
+      total += g_allocations.load();
+      const rt::ManualStatus st = r->manual().status();
+      if (st.seen_seq >= seq && !st.busy) break;
+    }
+    return total;
+  };
+  rt::ManualRequest home;
+  home.op = rt::ManualOp::kHome;
+  home.axes = 0x4;
+  EXPECT_EQ(run_until_idle(r->manual().request(home), 20'000), 0u);
+  EXPECT_TRUE(r->manual().status().result.ok);
+  rt::ManualRequest jog;
+  jog.op = rt::ManualOp::kJogDistance;
+  jog.axis = 2;
+  jog.value = -10.0;
+  EXPECT_EQ(run_until_idle(r->manual().request(jog), 20'000), 0u);
+  jog.value = -4.9;
+  EXPECT_EQ(run_until_idle(r->manual().request(jog), 20'000), 0u);
+  rt::ManualRequest touch;
+  touch.op = rt::ManualOp::kTouch;
+  touch.target = rt::TouchTarget::kZ;
+  EXPECT_EQ(run_until_idle(r->manual().request(touch), 60'000), 0u);
+  EXPECT_TRUE(r->manual().status().result.ok) << rt::to_string(r->manual().status().result.error);
+  rt::ManualRequest vel;
+  vel.op = rt::ManualOp::kJogVelocity;
+  vel.axis = 0;
+  vel.value = 2.0;
+  EXPECT_EQ(run_until_idle(r->manual().request(vel), 100), 0u);  // refreshed below, then stopped
+  EXPECT_EQ(run_until_idle(r->manual().request(vel), 100), 0u);
+  rt::ManualRequest stop;
+  stop.op = rt::ManualOp::kStop;
+  EXPECT_EQ(run_until_idle(r->manual().request(stop), 2'000), 0u);
+  EXPECT_EQ(r->manual().status().result.error, rt::ManualError::kStopped);
+}
+
 // Every seed-004 block in one program on the simulated drill: Td detector → P gap controller →
 // wear compensation → Z, interpolators and position loops for X/Y, orbit expander, polarity
 // switch and short retract (tests/data/alloc/seed_004.yaml).
