@@ -369,12 +369,9 @@ test('run from a line, as a dry run: re-approach, then the rest of the program',
   await page.locator('#dry-run').uncheck();
 });
 
-// TODO until the runtime keeps job.last and the axes still once a stopped job is READY: seen
-// here, a resume sent right after READY faults in 0.1 s (alarm 110 in cnc.job.pz, the axis
-// moving down), and 3 s after the stop job.last says depth 12.000 mm for a 3.5 mm hole.
-test('stop mid-drill, then run from the drilling line: the hole is finished from its depth', {
-  todo: 'runtime: job.last and the axes after cycle.stop (see the comment above)',
-}, async () => {
+// A stop ends the drill's cycle (it retracts, keeping its depth count: EdmJob's abort of its
+// children); job.last then carries the depth, touch Z and wear the resumed drill counts on from.
+test('stop mid-drill, then run from the drilling line: the hole is finished from its depth', async () => {
   // A second hole: G54 moved 10 mm in X, the electrode over the new place (MDI), and Z touched
   // off again there — the first hole wore the electrode ~10 mm shorter.
   await page.locator('#off-G54-X').fill('10');
