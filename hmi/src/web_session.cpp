@@ -53,9 +53,11 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
 
  public:
   WsSession(Stream stream, WebHub& hub)
-      : ws_(std::move(stream)), hub_(hub), login_timer_(ws_.get_executor()) {}
+      : ws_(std::move(stream)), hub_(hub), hub_alive_(hub.alive_token()),
+        login_timer_(ws_.get_executor()) {}
 
   ~WsSession() override {
+    if (hub_alive_.expired()) return;  // shutdown: the hub went first (edmhmi serve's order)
     hub_.manual().drop(id_);
     hub_.detach(this);
   }
@@ -337,6 +339,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
 
   websocket::stream<Stream> ws_;
   WebHub& hub_;
+  std::weak_ptr<const bool> hub_alive_;  // WebHub::alive_token()
   asio::steady_timer login_timer_;
   beast::flat_buffer buffer_;
   std::deque<std::shared_ptr<const std::string>> queue_;

@@ -107,7 +107,12 @@ class WebHub {
   void count_drop();
   void count_slow_disconnect();
 
+  /// Expires when the hub is destroyed: a session outliving it (destroyed with the io_context's
+  /// pending handlers after the hub, at shutdown) must not call back into it.
+  [[nodiscard]] std::weak_ptr<const bool> alive_token() const noexcept { return alive_; }
+
  private:
+  std::shared_ptr<const bool> alive_ = std::make_shared<const bool>(true);
   void on_event(const bridge::Json& ev);
   void on_trace(const bridge::Json& ev);
   void arm_timer();
