@@ -53,7 +53,9 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
 
  public:
   WsSession(Stream stream, WebHub& hub)
-      : ws_(std::move(stream)), hub_(hub), hub_alive_(hub.alive_token()),
+      : ws_(std::move(stream)),
+        hub_(hub),
+        hub_alive_(hub.alive_token()),
         login_timer_(ws_.get_executor()) {}
 
   ~WsSession() override {

@@ -276,9 +276,9 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     const bool retracting = handle_short(ctx, z, status);
     // Resumed: the hole is already drilled down to depth_done_mm, so no wear is counted (the
     // compensator held at 0) until the front is back where the interrupted drill stopped.
-    const bool above_done = resume_ && (touch_z_mm.get() - z) - resume_wear_mm_ -
-                                               params_.spark_gap_offset_um * 1e-3 <
-                                           depth_done_mm_;
+    const bool above_done =
+        resume_ && (touch_z_mm.get() - z) - resume_wear_mm_ - params_.spark_gap_offset_um * 1e-3 <
+                       depth_done_mm_;
     if (above_done) reset_wear.set(true);
     if (!retracting) {
       // The servo's command into the wear compensator: the gap child's Vz, or the external

@@ -43,18 +43,20 @@ void ManualMotionParams::visit(rt::ParamVisitor& v) {
   v.param("home_order", home_order,
           {.description = "the order in which the axes are referenced (X, Y, Z each at most once)",
            .load_time_only = true});
-  v.param("home_search_mm_s", home_search_mm_s,
-          {.unit = "mm/s", .description = "speed toward the reference switch",
-           .range = rt::kPositive});
+  v.param(
+      "home_search_mm_s", home_search_mm_s,
+      {.unit = "mm/s", .description = "speed toward the reference switch", .range = rt::kPositive});
   v.param("home_latch_mm_s", home_latch_mm_s,
           {.unit = "mm/s",
            .description = "slow speed onto the switch where the position is set",
            .range = rt::kPositive});
   v.param("home_back_off_mm", home_back_off_mm,
-          {.unit = "mm", .description = "back-off from the switch before the slow latch",
+          {.unit = "mm",
+           .description = "back-off from the switch before the slow latch",
            .range = rt::kPositive});
   v.param("home_search_max_mm", home_search_max_mm,
-          {.unit = "mm", .description = "longest search for the switch (else the homing fails)",
+          {.unit = "mm",
+           .description = "longest search for the switch (else the homing fails)",
            .range = rt::kPositive});
   v.param("home_x_mm", home_x_mm,
           {.unit = "mm", .description = "machine X of the X reference switch"});
@@ -63,14 +65,16 @@ void ManualMotionParams::visit(rt::ParamVisitor& v) {
   v.param("home_z_mm", home_z_mm,
           {.unit = "mm", .description = "machine Z of the Z reference switch"});
   v.param("touch_fast_mm_s", touch_fast_mm_s,
-          {.unit = "mm/s", .description = "first approach toward the work in touch mode",
+          {.unit = "mm/s",
+           .description = "first approach toward the work in touch mode",
            .range = rt::kPositive});
   v.param("touch_slow_mm_s", touch_slow_mm_s,
           {.unit = "mm/s",
            .description = "second approach: the touch is where it makes contact",
            .range = rt::kPositive});
   v.param("touch_max_mm", touch_max_mm,
-          {.unit = "mm", .description = "longest approach without contact (else no contact)",
+          {.unit = "mm",
+           .description = "longest approach without contact (else no contact)",
            .range = rt::kPositive});
   v.param("touch_back_off_mm", touch_back_off_mm,
           {.unit = "mm", .description = "back-off after each contact", .range = rt::kPositive});
@@ -92,8 +96,8 @@ std::vector<rt::ParamError> ManualMotionParams::validate() const {
   for (char c : home_order) {
     const int a = axis_of(c);
     if (a < 0 || seen[a]) {
-      errs.push_back({"home_order", "must list X, Y and Z, each at most once (got '" +
-                                        home_order + "')"});
+      errs.push_back(
+          {"home_order", "must list X, Y and Z, each at most once (got '" + home_order + "')"});
       break;
     }
     seen[a] = true;
@@ -281,8 +285,8 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
   if (step_ != Step::kIdle) {
     // Another request while busy: only a jog replaces a jog (a new speed or axis); anything
     // else is refused (the bridge refuses it first; this is the RT side's own guard).
-    if (!(step_ == Step::kJog && (r.op == ManualOp::kJogVelocity ||
-                                  r.op == ManualOp::kJogDistance))) {
+    if (!(step_ == Step::kJog &&
+          (r.op == ManualOp::kJogVelocity || r.op == ManualOp::kJogDistance))) {
       return;
     }
   }
@@ -330,9 +334,9 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
         if (v == 0.0) {
           if (!was_idle) {
             begin_move(a, a == axis_ ? prof_.pos : hold_[a], params_.jog_v_max_mm_s);
-            prof_.target = prof_.pos + std::copysign(prof_.vel * prof_.vel /
-                                                         (2.0 * params_.accel_mm_s2),
-                                                     prof_.vel);
+            prof_.target =
+                prof_.pos +
+                std::copysign(prof_.vel * prof_.vel / (2.0 * params_.accel_mm_s2), prof_.vel);
           } else {
             finish(true, ManualError::kNone, ctx);
             return;
@@ -400,8 +404,6 @@ void ManualMotion::next_home_axis(const rt::CycleContext& ctx) noexcept {
 }
 
 void ManualMotion::begin_touch_side() noexcept {
-  int a = 2;
-  side_ = -1;
   TouchTarget t = req_.target;
   if (t == TouchTarget::kCenter) {
     t = touch_index_ == 0   ? TouchTarget::kXPlus
@@ -409,30 +411,12 @@ void ManualMotion::begin_touch_side() noexcept {
         : touch_index_ == 2 ? TouchTarget::kYPlus
                             : TouchTarget::kYMinus;
   }
-  switch (t) {
-    case TouchTarget::kZ:
-      a = 2;
-      side_ = -1;
-      break;
-    case TouchTarget::kXPlus:
-      a = 0;
-      side_ = 1;
-      break;
-    case TouchTarget::kXMinus:
-      a = 0;
-      side_ = -1;
-      break;
-    case TouchTarget::kYPlus:
-      a = 1;
-      side_ = 1;
-      break;
-    case TouchTarget::kYMinus:
-      a = 1;
-      side_ = -1;
-      break;
-    case TouchTarget::kCenter:
-      break;
-  }
+  // The axis each one-sided touch moves and its direction toward the work (z, x+, x-, y+, y-).
+  static constexpr int kAxisOf[] = {2, 0, 0, 1, 1};
+  static constexpr int kSideOf[] = {-1, 1, -1, 1, -1};
+  const auto i = static_cast<std::size_t>(t);  // kCenter became one of the four sides above
+  const int a = kAxisOf[i];
+  side_ = kSideOf[i];
   const double from = a == axis_ ? prof_.pos : hold_[a];
   start_[a] = from;
   begin_move(a, from + side_ * params_.touch_max_mm, params_.touch_fast_mm_s);
@@ -523,8 +507,8 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
       break;
     case Step::kHomeOff:
       if (switch_on(axis_)) {
-        if (prof_.done) begin_move(axis_, prof_.pos - params_.home_search_max_mm,
-                                   params_.home_search_mm_s);
+        if (prof_.done)
+          begin_move(axis_, prof_.pos - params_.home_search_max_mm, params_.home_search_mm_s);
         step_profile(dt);
         if (std::abs(prof_.pos - travel_from_) > params_.home_search_max_mm) {
           finish(false, ManualError::kNoSwitch, ctx);

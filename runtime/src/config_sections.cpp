@@ -395,9 +395,10 @@ void Parser::parse_retain(const Value& v, RetainSpec& out) {
   if (const Field* f = m->find("variables")) {
     out.variables = parse_variable_names(f->value);
   }
-  for (auto [key, dest] : {std::pair<const char*, std::optional<NameRef>*>{"job_depth", &out.job_depth},
-                           {"job_touch_z", &out.job_touch_z},
-                           {"job_wear", &out.job_wear}}) {
+  for (auto [key, dest] :
+       {std::pair<const char*, std::optional<NameRef>*>{"job_depth", &out.job_depth},
+        {"job_touch_z", &out.job_touch_z},
+        {"job_wear", &out.job_wear}}) {
     const Field* f = m->find(key);
     if (f == nullptr) continue;
     if (auto s = r_.string(f->value)) {

@@ -11,7 +11,9 @@ std::string name(int frame, char axis) {
   return "offsets." + WorkOffsets::frame_name(frame) + "." + std::string(1, axis);
 }
 
-double axis_of(const WorkFrame& f, char axis) { return axis == 'x' ? f.x : axis == 'y' ? f.y : f.z; }
+double axis_of(const WorkFrame& f, char axis) {
+  return axis == 'x' ? f.x : axis == 'y' ? f.y : f.z;
+}
 
 }  // namespace
 
@@ -19,10 +21,10 @@ std::vector<RetainStore::Variable> variables(const WorkOffsets& offsets) {
   std::vector<RetainStore::Variable> out;
   for (int f = 0; f < WorkOffsets::kFrames; ++f) {
     for (char axis : {'x', 'y', 'z'}) {
-      out.push_back({name(f, axis), RetainType::kReal, [&offsets, f, axis] {
-                       return RetainValue::make_real(axis_of(offsets.get(f), axis));
-                     },
-                     /*urgent=*/true});
+      out.push_back(
+          {name(f, axis), RetainType::kReal,
+           [&offsets, f, axis] { return RetainValue::make_real(axis_of(offsets.get(f), axis)); },
+           /*urgent=*/true});
     }
   }
   return out;

@@ -130,9 +130,9 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
 
   // A command the axis could not stop from inside the range is cut to one it can.
   const double d = v > 0.0 ? lim.max_mm - x : x - lim.min_mm;
-  const double allowed = !std::isfinite(x)   ? 0.0
-                         : !referenced(a)   ? lim.v_max_mm_s
-                                            : stop_speed(d, lim.a_max_mm_s2, dt_s_);
+  const double allowed = !std::isfinite(x) ? 0.0
+                         : !referenced(a)  ? lim.v_max_mm_s
+                                           : stop_speed(d, lim.a_max_mm_s2, dt_s_);
   const bool refused = std::abs(v) > allowed + kEpsilon;
   if (refused) {
     v = v > 0.0 ? allowed : -allowed;

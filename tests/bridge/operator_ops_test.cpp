@@ -21,12 +21,12 @@ constexpr const char* kViewer = "viewer-secret-0123456789";
 class OperatorOps : public ::testing::Test {
  protected:
   void start(const std::string& manual_params = "") {
-    std::string text = edm::test::read_file(std::string(EDM_SOURCE_DIR) +
-                                            "/config/machines/drill-sim.yaml");
+    std::string text =
+        edm::test::read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
     if (!manual_params.empty()) {
-      edm::test::replace_once(text, "params: {drill: {spark_gap_offset_um: 30.3}}",
-                              "params: {drill: {spark_gap_offset_um: 30.3}, manual: {" +
-                                  manual_params + "}}");
+      edm::test::replace_once(
+          text, "params: {drill: {spark_gap_offset_um: 30.3}}",
+          "params: {drill: {spark_gap_offset_um: 30.3}, manual: {" + manual_params + "}}");
     }
     rt_ = edm::test::build_sim_machine(rt::parse_config_text(text, "drill-sim.yaml"));
     ServerOptions o;
@@ -97,12 +97,12 @@ class OperatorOps : public ::testing::Test {
 
 TEST_F(OperatorOps, ViewersMayWatchButNeverMove) {
   start();
-  for (const auto& [op, params] : std::vector<std::pair<const char*, Json>>{
-           {"home", Json::object()},
-           {"jog", {{"axis", "X"}, {"distance", 1.0}}},
-           {"jog.stop", Json::object()},
-           {"touch", {{"target", "z"}}},
-           {"offset.set", {{"frame", "G54"}, {"x", 1.0}}}}) {
+  for (const auto& [op, params] :
+       std::vector<std::pair<const char*, Json>>{{"home", Json::object()},
+                                                 {"jog", {{"axis", "X"}, {"distance", 1.0}}},
+                                                 {"jog.stop", Json::object()},
+                                                 {"touch", {{"target", "z"}}},
+                                                 {"offset.set", {{"frame", "G54"}, {"x", 1.0}}}}) {
     expect_error(viewer_.request(op, params), ErrorCode::kForbidden);
   }
   EXPECT_TRUE(viewer_.request("manual.status"));
@@ -160,10 +160,10 @@ TEST_F(OperatorOps, BadRequestsAreRefusedPrecisely) {
 TEST_F(OperatorOps, ManualMotionOnlyWhenReadyAndIdle) {
   start("deadman: 60s");  // the slow jog below must outlast the requests that test it
   ASSERT_TRUE(op_.request("estop"));
-  for (const auto& [op, params] : std::vector<std::pair<const char*, Json>>{
-           {"home", Json::object()},
-           {"jog", {{"axis", "X"}, {"distance", 1.0}}},
-           {"touch", {{"target", "z"}}}}) {
+  for (const auto& [op, params] :
+       std::vector<std::pair<const char*, Json>>{{"home", Json::object()},
+                                                 {"jog", {{"axis", "X"}, {"distance", 1.0}}},
+                                                 {"touch", {{"target", "z"}}}}) {
     expect_error(op_.request(op, params), ErrorCode::kInvalidState);
   }
   EXPECT_TRUE(op_.request("jog.stop")) << "a stop is always accepted";
@@ -223,8 +223,7 @@ TEST_F(OperatorOps, WorkOffsetsAreSetReadAndRefusedDuringAJob) {
   const std::vector<MotionBlock> long_prog{dwell, end};
   ASSERT_TRUE(op_.upload_program(long_prog, uo));
   ASSERT_TRUE(op_.request("cycle.start"));
-  expect_error(op_.request("offset.set", {{"frame", "G54"}, {"x", 1.0}}),
-               ErrorCode::kInvalidState);
+  expect_error(op_.request("offset.set", {{"frame", "G54"}, {"x", 1.0}}), ErrorCode::kInvalidState);
   expect_error(op_.request("jog", {{"axis", "X"}, {"distance", 1.0}}), ErrorCode::kInvalidState);
   ASSERT_TRUE(op_.request("cycle.stop"));
   EXPECT_EQ(rt_->work_offsets().get(0).x, 0.0);

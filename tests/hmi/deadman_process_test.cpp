@@ -94,9 +94,10 @@ TEST_F(DeadMan, AJogWhoseHmiIsKilledStopsWithinTheDeadManTime) {
   std::this_thread::sleep_for(300ms);  // an interval of wall (= machine) time to observe
   EXPECT_NEAR(x(), xa, 0.001);
   const double ended_after_s = st["result"]["t_s"].get<double>() - killed_t_s;
-  std::printf("edmhmi killed while jogging X at 2 mm/s: the jog ended %.0f ms of machine time "
-              "later (%.0f ms of wall time; dead-man %.0f ms)\n",
-              ended_after_s * 1e3, after_s * 1e3, deadman_s * 1e3);
+  std::printf(
+      "edmhmi killed while jogging X at 2 mm/s: the jog ended %.0f ms of machine time "
+      "later (%.0f ms of wall time; dead-man %.0f ms)\n",
+      ended_after_s * 1e3, after_s * 1e3, deadman_s * 1e3);
   // The dead-man, one refresh period of edmhmi at most (deadman/3), the deceleration and the
   // settling in position, on the machine's clock.
   EXPECT_LE(ended_after_s, deadman_s + deadman_s / 3.0 + 0.2);

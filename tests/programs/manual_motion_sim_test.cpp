@@ -29,8 +29,9 @@ const std::string kWork =
 
 TEST(ManualMotion, HomingFindsTheSwitchesAndSetsMachineCoordinates) {
   // Incremental encoders: at power-on they read the machine position less an unknown offset.
-  OperatorRig m(kWork + ", encoder_offset_x_mm: 23.4, encoder_offset_y_mm: -11.2, "
-                        "encoder_offset_z_mm: 3.3",
+  OperatorRig m(kWork +
+                    ", encoder_offset_x_mm: 23.4, encoder_offset_y_mm: -11.2, "
+                    "encoder_offset_z_mm: 3.3",
                 "referenced_at_start: false, reference_required: true");
   EXPECT_EQ(m.manual().referenced(), 0);
   EXPECT_FALSE(m.manual().may_run_programs());
@@ -206,7 +207,7 @@ TEST(ManualMotion, TouchEdgesFromOutsideAndTheBoreCentreFromInside) {
   EXPECT_NEAR(r.x, kOriginX, 0.003);
   // The Y− face (y = −6.789) from below it.
   ASSERT_TRUE(m.jog(2, 4.0).ok);
-  ASSERT_TRUE(m.jog(0, 10.0).ok);  // x back to 20
+  ASSERT_TRUE(m.jog(0, 10.0).ok);   // x back to 20
   ASSERT_TRUE(m.jog(1, -10.0).ok);  // y 10 → 0
   ASSERT_TRUE(m.jog(1, -9.0).ok);   // → −9
   ASSERT_TRUE(m.jog(2, -4.0).ok);
@@ -232,8 +233,8 @@ TEST(ManualMotion, TouchEdgesFromOutsideAndTheBoreCentreFromInside) {
   EXPECT_NEAR(r.x, bx, 0.003);
   EXPECT_NEAR(r.y, by, 0.003);
   EXPECT_NEAR(r.size, 6.0, 0.005);
-  std::printf("bore centre found at (%+.4f, %+.4f) mm of the truth, diameter %.4f mm\n",
-              r.x - bx, r.y - by, r.size);
+  std::printf("bore centre found at (%+.4f, %+.4f) mm of the truth, diameter %.4f mm\n", r.x - bx,
+              r.y - by, r.size);
   m.run_for(20ms);
   EXPECT_NEAR(m.truth().machine_x_mm, bx, 0.003);  // it ends at the centre
   EXPECT_NEAR(m.truth().machine_y_mm, by, 0.003);

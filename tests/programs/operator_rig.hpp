@@ -32,16 +32,15 @@ struct OperatorRig {
   /// `sim_params`: extra simulator parameters ("work_surface_z_mm: -7.3, …"); `manual`: the
   /// job's manual child's parameters ("referenced_at_start: false, …").
   OperatorRig(const std::string& sim_params, const std::string& manual, int seed = 1) {
-    std::string text =
-        read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
+    std::string text = read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
     replace_once(text, "params: {preset: drill, seed: 1, wall_sparks: true}",
                  "params: {preset: drill, seed: 1, wall_sparks: true" +
                      (sim_params.empty() ? std::string() : ", " + sim_params) + "}");
     replace_once(text, "params: {drill: {spark_gap_offset_um: 30.3}}",
                  "params: {drill: {spark_gap_offset_um: 30.3}" +
                      (manual.empty() ? std::string() : ", manual: {" + manual + "}") + "}");
-    runtime = build_sim_machine(rt::parse_config_text(text, "drill-sim-operator.yaml"),
-                                seeded(seed));
+    runtime =
+        build_sim_machine(rt::parse_config_text(text, "drill-sim-operator.yaml"), seeded(seed));
     runtime->machine().command(rt::MachineCommand::kPowerOn);
     std::vector<rt::Task*> tasks;
     for (const auto& t : runtime->tasks()) {
@@ -63,8 +62,7 @@ struct OperatorRig {
   double read(const char* name) { return runtime->variables().read(name).value_or(1e9); }
 
   /// Sends `r` and runs until the runtime has taken it and is no longer busy (at most `limit`).
-  rt::ManualResult request(rt::ManualRequest r,
-                           rt::Duration limit = std::chrono::seconds(120)) {
+  rt::ManualResult request(rt::ManualRequest r, rt::Duration limit = std::chrono::seconds(120)) {
     const std::uint64_t seq = manual().request(r);
     const rt::TimePoint end = now + limit;
     while (now < end) {
@@ -94,8 +92,7 @@ struct OperatorRig {
                    rt::Duration limit = std::chrono::seconds(600)) {
     const machining::Vec3 at{read("io.x_mm"), read("io.y_mm"), read("io.z_mm")};
     const auto issues = machining::check_program(blocks, runtime->tables(), at);
-    EXPECT_TRUE(issues.empty()) << "line " << issues.front().line << ": "
-                                << issues.front().message;
+    EXPECT_TRUE(issues.empty()) << "line " << issues.front().line << ": " << issues.front().message;
     if (!issues.empty()) return false;
     auto& job = runtime->job();
     const auto loaded =

@@ -213,9 +213,10 @@ TEST_F(JobRestart, KillMidDrillingThenRunFromTheBlockFinishesTheHole) {
   again.signal(SIGTERM);
   ASSERT_TRUE(again.wait(60s).has_value());
   const double hole = retained().at("io.hole_depth_mm").r;
-  std::printf("killed at %.4f mm (estimate %.4f mm); resumed from line 10: hole %.4f mm "
-              "(program 20 mm, error %+.1f um)\n",
-              hole_at_kill, depth_at_kill, hole, (hole - 20.0) * 1e3);
+  std::printf(
+      "killed at %.4f mm (estimate %.4f mm); resumed from line 10: hole %.4f mm "
+      "(program 20 mm, error %+.1f um)\n",
+      hole_at_kill, depth_at_kill, hole, (hole - 20.0) * 1e3);
   EXPECT_NEAR(hole, 20.0, 0.05);
 }
 

@@ -380,27 +380,23 @@ Json to_json(const StatusMessage& s) {
   for (const auto& [name, value] : s.vars) {
     vars[name] = std::isfinite(value) ? Json(value) : Json(nullptr);
   }
-  Json job = {{"outcome", s.job_outcome},
-              {"generation", s.job_generation},
-              {"block", s.job_block},
-              {"blocks", s.job_blocks},
-              {"line", s.job_line},
-              {"jobs_started", s.job_jobs_started},
+  Json job = {{"outcome", s.job_outcome}, {"generation", s.job_generation},
+              {"block", s.job_block},     {"blocks", s.job_blocks},
+              {"line", s.job_line},       {"jobs_started", s.job_jobs_started},
               {"slot", s.job_slot}};
   if (s.job_last) {
-    Json last = {{"outcome", s.job_last->outcome},
-                 {"block", s.job_last->block},
-                 {"line", s.job_last->line}};
-    for (auto [key, v] : {std::pair<const char*, const std::optional<double>*>{
-                              "depth_mm", &s.job_last->depth_mm},
-                          {"touch_z_mm", &s.job_last->touch_z_mm},
-                          {"wear_mm", &s.job_last->wear_mm}}) {
+    Json last = {
+        {"outcome", s.job_last->outcome}, {"block", s.job_last->block}, {"line", s.job_last->line}};
+    for (auto [key, v] :
+         {std::pair<const char*, const std::optional<double>*>{"depth_mm", &s.job_last->depth_mm},
+          {"touch_z_mm", &s.job_last->touch_z_mm},
+          {"wear_mm", &s.job_last->wear_mm}}) {
       if (*v && std::isfinite(**v)) last[key] = **v;
     }
     job["last"] = std::move(last);
   }
-  return {{"state", s.state}, {"cause", s.cause},          {"t_s", s.t_s},
-          {"cycle", s.cycle}, {"job", std::move(job)},     {"vars", std::move(vars)},
+  return {{"state", s.state},    {"cause", s.cause},      {"t_s", s.t_s},
+          {"cycle", s.cycle},    {"job", std::move(job)}, {"vars", std::move(vars)},
           {"dropped", s.dropped}};
 }
 

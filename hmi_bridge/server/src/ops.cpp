@@ -263,9 +263,8 @@ Body op_program_commit(Session& s, const Json& msg) {
   const std::size_t n = u.blocks.size();
   const rt::JobSlot slot = u.slot;
   const std::optional<std::uint64_t> offsets = u.offsets_generation;
-  const rt::LoadResult loaded = slot == rt::JobSlot::kMdi
-                                    ? rt.job().load_mdi(std::move(u.blocks))
-                                    : rt.job().load(std::move(u.blocks), got);
+  const rt::LoadResult loaded = slot == rt::JobSlot::kMdi ? rt.job().load_mdi(std::move(u.blocks))
+                                                          : rt.job().load(std::move(u.blocks), got);
   if (loaded != rt::LoadResult::kOk) {
     s.upload_.reset();
     return error(ErrorCode::kBusy, "a job became active; program not swapped");
@@ -274,8 +273,7 @@ Body op_program_commit(Session& s, const Json& msg) {
   srv.committed_offsets[static_cast<std::size_t>(slot)] = offsets;
   srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
   spdlog::info("bridge: session {} committed {} of {} blocks (crc32 {})", s.id(),
-               slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n,
-               format_checksum(got));
+               slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n, format_checksum(got));
   return Json{{"blocks", n},
               {"slot", slot == rt::JobSlot::kMdi ? "mdi" : "main"},
               {"checksum", format_checksum(got)},

@@ -99,8 +99,8 @@ Body op_jog(Session& s, const Json& msg) {
   } else {
     const double v = vel->get<double>();
     if (!std::isfinite(v) || std::abs(v) > info.jog_v_max_mm_s) {
-      return error(ErrorCode::kBadRequest, "'velocity' must be within ±" +
-                                               std::to_string(info.jog_v_max_mm_s) + " mm/s");
+      return error(ErrorCode::kBadRequest,
+                   "'velocity' must be within ±" + std::to_string(info.jog_v_max_mm_s) + " mm/s");
     }
     r.op = rt::ManualOp::kJogVelocity;
     r.value = v;
@@ -214,14 +214,15 @@ Body op_offset_set(Session& s, const Json& msg) {
 }  // namespace
 
 Json manual_info_json(const rt::ManualInfo& info) {
-  return Json{{"available", info.available},
-              {"home", info.home},
-              {"touch", info.touch},
-              {"reference_required", info.reference_required},
-              {"deadman_ms", info.deadman_ms},
-              {"jog_v_max_mm_s", info.jog_v_max_mm_s},
-              {"jog_distance_mm", Json::array({info.jog_distance_min_mm, info.jog_distance_max_mm})},
-              {"electrode_d_mm", info.electrode_d_mm}};
+  return Json{
+      {"available", info.available},
+      {"home", info.home},
+      {"touch", info.touch},
+      {"reference_required", info.reference_required},
+      {"deadman_ms", info.deadman_ms},
+      {"jog_v_max_mm_s", info.jog_v_max_mm_s},
+      {"jog_distance_mm", Json::array({info.jog_distance_min_mm, info.jog_distance_max_mm})},
+      {"electrode_d_mm", info.electrode_d_mm}};
 }
 
 std::optional<Body> read_upload_options(const Json& msg, rt::JobSlot& slot,

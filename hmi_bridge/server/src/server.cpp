@@ -500,9 +500,12 @@ std::optional<LastJob> Server::Impl::last_job() {
   const rt::JobProgress p = rt.job().progress();
   const auto& interrupted = rt.interrupted_job();
   if (interrupted && p.jobs_started == 0) {
-    return LastJob{"interrupted",           static_cast<std::uint64_t>(interrupted->block_index),
-                   static_cast<std::int32_t>(interrupted->line), interrupted->depth_mm,
-                   interrupted->touch_z_mm, interrupted->wear_mm};
+    return LastJob{"interrupted",
+                   static_cast<std::uint64_t>(interrupted->block_index),
+                   static_cast<std::int32_t>(interrupted->line),
+                   interrupted->depth_mm,
+                   interrupted->touch_z_mm,
+                   interrupted->wear_mm};
   }
   if (p.outcome != rt::JobOutcome::kAborted || p.slot != rt::JobSlot::kMain) return std::nullopt;
   LastJob l{"aborted", p.block_index, p.line, std::nullopt, std::nullopt, std::nullopt};

@@ -22,11 +22,11 @@
 // machine is commanded back to READY. A job does not begin while ManualControl says the machine
 // must be referenced first (manual.reference_required): the machine is commanded back to READY.
 // A dry run (StartOptions::dry_run) runs every move with the generator disarmed and skips the
-// drilling and orbit-finishing blocks (the electrode stays above the work). An operator stop (machine READY), FAULT or ESTOP while
-// running aborts the job (kAborted); the children's safe states stop the axes, switch the
-// generator off and back Z off. HOLD pauses interpolated moves and dwells at once, and a drilling
-// block and an orbit-finishing block at once too (the children's `hold`: generator off, axes
-// still, resumed where they were).
+// drilling and orbit-finishing blocks (the electrode stays above the work). An operator stop
+// (machine READY), FAULT or ESTOP while running aborts the job (kAborted); the children's safe
+// states stop the axes, switch the generator off and back Z off. HOLD pauses interpolated moves and
+// dwells at once, and a drilling block and an orbit-finishing block at once too (the children's
+// `hold`: generator off, axes still, resumed where they were).
 //
 // Blocks (machining::MotionKind):
 //   condition  E<n>: the condition's polarity, on/off time, servo reference, Tdr and wear ratio
@@ -39,10 +39,11 @@
 //   arc_cw / arc_ccw  arc interpolates in XY (centre, end, turns), Z held; then in position.
 //   drill      drill.depth_mm = the block's depth_mm (below the work frame's Z0), or −target.z
 //              for a block without one (machine Z0 is the work surface); drill.depth_done_mm =
-//              depth_done_mm (a resumed hole); the depth is measured from the first sparks, through = false, wear ratio and Tdr of the active condition; XY
-//              held by px/py; when the drill child is DONE (after its retract) a rapid takes the
-//              electrode back to where the block began, so a drilling block ends at its start
-//              point (the G-code interpreter's current point after it, docs/gcode.md).
+//              depth_done_mm (a resumed hole); the depth is measured from the first sparks, through
+//              = false, wear ratio and Tdr of the active condition; XY held by px/py; when the
+//              drill child is DONE (after its retract) a rapid takes the electrode back to where
+//              the block began, so a drilling block ends at its start point (the G-code
+//              interpreter's current point after it, docs/gcode.md).
 //   orbit_finish  finish.final_offset_mm = final_radius_mm − orbit_radius_offset_mm (the
 //              electrode radius plus the finishing side gap, calibrated: docs/blocks.md); Z held.
 //   end        finishes the job.

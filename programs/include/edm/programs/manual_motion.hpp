@@ -7,8 +7,9 @@
 // the same way. The runtime's safety supervisor watches every move like any other (soft limits
 // of referenced axes, v_max, following error); an E-stop or fault ends the operation.
 //
-// Motion: one axis moves at a time along a reference with a trapezoidal speed profile (accel_mm_s2);
-// the axis command is v_ref + kp·(ref − actual); the other axes hold where they were.
+// Motion: one axis moves at a time along a reference with a trapezoidal speed profile
+// (accel_mm_s2); the axis command is v_ref + kp·(ref − actual); the other axes hold where they
+// were.
 //
 // Jog
 //   distance  |d| in [0.001, 10] mm; on a referenced axis the target must lie inside the soft
@@ -61,18 +62,18 @@ struct ManualMotionParams {
   double kp_per_s{20.0};       // [1/s]
   rt::Duration deadman{std::chrono::milliseconds(500)};
   std::string home_order{"ZXY"};
-  double home_search_mm_s{5.0};    // [mm/s]
-  double home_latch_mm_s{0.2};     // [mm/s]
-  double home_back_off_mm{1.0};    // [mm]
+  double home_search_mm_s{5.0};      // [mm/s]
+  double home_latch_mm_s{0.2};       // [mm/s]
+  double home_back_off_mm{1.0};      // [mm]
   double home_search_max_mm{300.0};  // [mm]
-  double home_x_mm{90.0};          // [mm] the machine coordinate of each reference switch
+  double home_x_mm{90.0};            // [mm] the machine coordinate of each reference switch
   double home_y_mm{90.0};
   double home_z_mm{15.0};
-  double touch_fast_mm_s{1.0};     // [mm/s]
-  double touch_slow_mm_s{0.05};    // [mm/s]
-  double touch_max_mm{20.0};       // [mm]
-  double touch_back_off_mm{0.2};   // [mm]
-  double electrode_d_mm{1.0};      // [mm]
+  double touch_fast_mm_s{1.0};    // [mm/s]
+  double touch_slow_mm_s{0.05};   // [mm/s]
+  double touch_max_mm{20.0};      // [mm]
+  double touch_back_off_mm{0.2};  // [mm]
+  double electrode_d_mm{1.0};     // [mm]
   bool reference_required{false};
   bool referenced_at_start{true};  // absolute encoders: every axis is referenced at power-on
 
@@ -89,8 +90,8 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   rt::Input<bool> ref_x{pins_, "ref_x"};  // reference switches (wired: homing available)
   rt::Input<bool> ref_y{pins_, "ref_y"};
   rt::Input<bool> ref_z{pins_, "ref_z"};
-  rt::Input<bool> contact{pins_, "contact"};  // touch sensing (wired: touch available)
-  rt::Output<bool> active{pins_, "active"};   // moving the axes: the sequencer passes vx/vy/vz
+  rt::Input<bool> contact{pins_, "contact"};     // touch sensing (wired: touch available)
+  rt::Output<bool> active{pins_, "active"};      // moving the axes: the sequencer passes vx/vy/vz
   rt::Output<std::int64_t> mode{pins_, "mode"};  // rt::ManualMode
   rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
   rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
@@ -113,20 +114,20 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
  private:
   enum class Step : std::uint8_t {
     kIdle,
-    kJog,        // a distance or velocity jog
-    kHomeOff,    // leave the switch
+    kJog,      // a distance or velocity jog
+    kHomeOff,  // leave the switch
     kHomeSearch,
     kHomeBack,
     kHomeLatch,
     kHomeSettle,
-    kTouchArm,   // touch mode on, waiting for the first contact reading
+    kTouchArm,  // touch mode on, waiting for the first contact reading
     kTouchFast,
     kTouchBack,
     kTouchSlow,
     kTouchOff,
-    kReturn,     // back to the start point (no contact, centre-finding)
-    kCentre,     // to the centre of the two contacts
-    kInPosition, // the reference has arrived: waiting for the axes to settle on it
+    kReturn,      // back to the start point (no contact, centre-finding)
+    kCentre,      // to the centre of the two contacts
+    kInPosition,  // the reference has arrived: waiting for the axes to settle on it
   };
   /// One axis's reference: a trapezoidal move to `target` at `speed`.
   struct Profile {
@@ -160,10 +161,10 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
 
   Step step_{Step::kIdle};
   rt::ManualRequest req_{};
-  int axis_{0};            // the axis moving
+  int axis_{0};  // the axis moving
   Profile prof_{};
-  double hold_[3]{};       // where the other axes stay
-  double start_[3]{};      // where the operation began (touch: its side's start)
+  double hold_[3]{};   // where the other axes stay
+  double start_[3]{};  // where the operation began (touch: its side's start)
   double travel_from_{0.0};
   rt::TimePoint refreshed_{};
   int settle_cycles_{0};
@@ -174,8 +175,8 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   std::uint8_t home_todo_{0};  // axes left to reference
   std::size_t home_next_{0};   // index into home_order
   // Touch.
-  int side_{0};        // +1 / −1: the direction toward the work
-  int touch_index_{0}; // center: 0 x+, 1 x−, 2 y+, 3 y−
+  int side_{0};         // +1 / −1: the direction toward the work
+  int touch_index_{0};  // center: 0 x+, 1 x−, 2 y+, 3 y−
   double contact_[4]{};
   double found_{0.0};
 };

@@ -79,7 +79,8 @@ class JobStore {
   }
   /// Any thread: the options of the current (or last) job.
   [[nodiscard]] StartOptions current_options() const noexcept {
-    return {cur_slot_.load(std::memory_order_relaxed), cur_dry_run_.load(std::memory_order_acquire)};
+    return {cur_slot_.load(std::memory_order_relaxed),
+            cur_dry_run_.load(std::memory_order_acquire)};
   }
   /// Non-RT. Number of blocks in the loaded program (0 = none).
   [[nodiscard]] std::size_t loaded_blocks() const noexcept {

@@ -37,15 +37,15 @@ enum class TouchTarget : std::uint8_t { kZ, kXPlus, kXMinus, kYPlus, kYMinus, kC
 enum class ManualMode : std::uint8_t { kIdle, kHome, kJog, kTouch };
 enum class ManualError : std::uint8_t {
   kNone,
-  kStopped,          // jog.stop, or the operator's request replaced it
-  kDeadman,          // continuous jog: no refresh within the dead-man time
-  kNoContact,        // touch: no contact within the search distance
-  kAlreadyInContact, // touch: the contact reads true before moving
-  kSoftLimit,        // the move would leave the soft limits of a referenced axis
-  kNoSwitch,         // home: the switch did not trip within the search distance
-  kInterrupted,      // the machine left READY (E-stop, fault, a job started)
-  kNotAvailable,     // this machine cannot (no switch / no contact input wired)
-  kBadRequest,       // out of range (checked again on the RT side)
+  kStopped,           // jog.stop, or the operator's request replaced it
+  kDeadman,           // continuous jog: no refresh within the dead-man time
+  kNoContact,         // touch: no contact within the search distance
+  kAlreadyInContact,  // touch: the contact reads true before moving
+  kSoftLimit,         // the move would leave the soft limits of a referenced axis
+  kNoSwitch,          // home: the switch did not trip within the search distance
+  kInterrupted,       // the machine left READY (E-stop, fault, a job started)
+  kNotAvailable,      // this machine cannot (no switch / no contact input wired)
+  kBadRequest,        // out of range (checked again on the RT side)
 };
 
 std::string_view to_string(ManualOp op) noexcept;
@@ -90,9 +90,9 @@ struct ManualStatus {
 
 /// What the machine's manual-motion block offers (set once at configure time).
 struct ManualInfo {
-  bool available{false};         // a ManualMotion block runs on this machine
-  bool home{false};              // reference switches wired
-  bool touch{false};             // the contact input wired
+  bool available{false};           // a ManualMotion block runs on this machine
+  bool home{false};                // reference switches wired
+  bool touch{false};               // the contact input wired
   bool reference_required{false};  // programs refused until every axis is referenced
   double deadman_ms{500.0};
   double jog_v_max_mm_s{5.0};
