@@ -156,11 +156,19 @@ double sd(const std::vector<double>& v) {
   return v.size() > 1 ? std::sqrt(s / static_cast<double>(v.size() - 1)) : 0.0;
 }
 
-// The figures over seeds 1-20 (docs/benchmarks.md). Also a test: every seed must pass.
+// The figures over seeds 1-20 (docs/benchmarks.md). Also a test: every seed must pass. Under a
+// sanitizer (about 9x slower: 210 s for twenty seeds, near ctest's 300 s timeout on a loaded
+// machine) seeds 1-5: the sanitizers look for memory errors, not figures.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr int kLastSeed = 5;
+#else
+constexpr int kLastSeed = 20;
+#endif
+
 TEST(ShortFigures, TwentySeeds) {
   std::vector<double> lost, latency, err_plain, err_hit, tries;
   int violations = 0, alarms_exact = 0;
-  for (int seed = 1; seed <= 20; ++seed) {
+  for (int seed = 1; seed <= kLastSeed; ++seed) {
     const ContactOutcome plain = run(seed, "");
     const ContactOutcome hit = run(seed, kTransient);
     const ContactOutcome stuck = run(seed, kPersistent);
@@ -180,17 +188,18 @@ TEST(ShortFigures, TwentySeeds) {
   double max_latency = 0.0;
   for (double l : latency) max_latency = std::max(max_latency, l);
   std::printf(
-      "[shorts] seeds 1-20, 20 mm holes, contact at 8 mm (clear 20 um):\n"
+      "[shorts] seeds 1-%d, 20 mm holes, contact at 8 mm (clear 20 um):\n"
       "[shorts]   retract latency after the detection: max %.0f cycles\n"
       "[shorts]   time lost per retract: %.3f +- %.3f s (mean +- SD)\n"
       "[shorts]   depth error without contact %+.1f +- %.1f um, with %+.1f +- %.1f um\n"
-      "[shorts]   persistent contact: alarm 150 after exactly N = %lld retracts on %d/20 seeds\n"
+      "[shorts]   persistent contact: alarm 150 after exactly N = %lld retracts on %d/%d seeds\n"
       "[shorts]   cycles fed toward the work while reading short: %d\n",
-      max_latency, mean(lost), sd(lost), mean(err_plain), sd(err_plain), mean(err_hit), sd(err_hit),
+      kLastSeed, max_latency, mean(lost), sd(lost), mean(err_plain), sd(err_plain), mean(err_hit),
+      sd(err_hit),
       static_cast<long long>(programs::DeepHoleDrillParams{}.shorts.short_retracts_max),
-      alarms_exact, violations);
+      alarms_exact, kLastSeed, violations);
   EXPECT_EQ(violations, 0);
-  EXPECT_EQ(alarms_exact, 20);
+  EXPECT_EQ(alarms_exact, kLastSeed);
 }
 
 }  // namespace
