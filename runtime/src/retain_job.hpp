@@ -27,10 +27,10 @@ struct Readers {
 };
 
 /// The record's variables, reading `job` live and the readers (entries `job.depth_mm`,
-/// `job.touch_z_mm`, `job.wear_mm`). While no job has begun in this runtime, they keep reporting `kept` (the
-/// interrupted job found at start), so a second unclean stop before the next job still names
-/// it. `job.running` is urgent: its change is written without waiting for min_interval.
-/// `job` and `kept` must outlive the store.
+/// `job.touch_z_mm`, `job.wear_mm`). While no job has begun in this runtime, they keep reporting
+/// `kept` (the interrupted job found at start), so a second unclean stop before the next job still
+/// names it. `job.running` is urgent: its change is written without waiting for min_interval. `job`
+/// and `kept` must outlive the store.
 [[nodiscard]] std::vector<RetainStore::Variable> variables(
     const JobStore& job, const std::optional<InterruptedJob>& kept, Readers readers);
 

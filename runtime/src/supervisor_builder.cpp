@@ -33,8 +33,8 @@ void* typed_pin(const PinRef& p, PinDir dir, const NameRef& n, const char* role,
 std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
                                              const machining::MachineTables& tables,
                                              Machine& machine, const ManualControl* manual,
-                                             Duration io_period,
-                                             const IoPinResolver& resolve, DiagnosticSink& diag) {
+                                             Duration io_period, const IoPinResolver& resolve,
+                                             DiagnosticSink& diag) {
   if (!spec.present) {
     return nullptr;
   }

@@ -22,7 +22,7 @@ using IoPinResolver = std::function<PinRef(const NameRef&)>;
 std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
                                              const machining::MachineTables& tables,
                                              Machine& machine, const ManualControl* manual,
-                                             Duration io_period,
-                                             const IoPinResolver& resolve, DiagnosticSink& diag);
+                                             Duration io_period, const IoPinResolver& resolve,
+                                             DiagnosticSink& diag);
 
 }  // namespace edm::rt

@@ -46,27 +46,27 @@ bool motion_kind_from_string(std::string_view s, MotionKind& out) noexcept;
 
 struct MotionBlock {
   MotionKind kind{MotionKind::kEnd};
-  std::int32_t line{0};         // 1-based source line of the G-code block (0 = unknown)
-  std::int32_t col{0};          // 1-based column of the word that made the block (0 = unknown)
-  Vec3 target{};                // end point (rapid, linear, arc, drill)
-  Vec3 centre{};                // arc centre (absolute); orbit: hole centre (= current XY)
-  std::int32_t turns{0};        // arcs: extra full turns (G02/G03 P); 0 = the plain arc
-  double feed_mm_s{0.0};        // linear / arc / drill speed cap; 0 = machine default
-  std::int32_t condition{0};    // kCondition: E number (0 = disarm); other kinds: active E
-  double z_travel_mm{0.0};      // kDrill: Z travel to send after wear pre-compensation (> 0)
-  double depth_mm{0.0};         // kDrill: programmed depth below the work's Z0 (the active work
-                                // offset's surface); 0 = a machine-coordinate program whose Z0 is
-                                // machine Z 0 (depth = −target.z)
-  double depth_done_mm{0.0};    // kDrill: depth the hole already has when the block starts (run
-                                // from a block after an interruption); 0 = a new hole
+  std::int32_t line{0};           // 1-based source line of the G-code block (0 = unknown)
+  std::int32_t col{0};            // 1-based column of the word that made the block (0 = unknown)
+  Vec3 target{};                  // end point (rapid, linear, arc, drill)
+  Vec3 centre{};                  // arc centre (absolute); orbit: hole centre (= current XY)
+  std::int32_t turns{0};          // arcs: extra full turns (G02/G03 P); 0 = the plain arc
+  double feed_mm_s{0.0};          // linear / arc / drill speed cap; 0 = machine default
+  std::int32_t condition{0};      // kCondition: E number (0 = disarm); other kinds: active E
+  double z_travel_mm{0.0};        // kDrill: Z travel to send after wear pre-compensation (> 0)
+  double depth_mm{0.0};           // kDrill: programmed depth below the work's Z0 (the active work
+                                  // offset's surface); 0 = a machine-coordinate program whose Z0 is
+                                  // machine Z 0 (depth = −target.z)
+  double depth_done_mm{0.0};      // kDrill: depth the hole already has when the block starts (run
+                                  // from a block after an interruption); 0 = a new hole
   double resume_touch_z_mm{0.0};  // kDrill with depth_done_mm > 0: the machine Z where the
                                   // interrupted drill first touched (its depth origin) ...
   double resume_wear_mm{0.0};     // ... and the wear it had compensated since: the depth goes on
                                   // counting from them (0, 0: from the resumed drill's first
                                   // sparks, plus depth_done_mm)
-  double final_radius_mm{0.0};  // kOrbitFinish: final hole radius (mm, absolute, > 0)
-  double dwell_s{0.0};          // kDwell
-  bool on{false};               // kRotation / kFlushing
+  double final_radius_mm{0.0};    // kOrbitFinish: final hole radius (mm, absolute, > 0)
+  double dwell_s{0.0};            // kDwell
+  bool on{false};                 // kRotation / kFlushing
   friend bool operator==(const MotionBlock&, const MotionBlock&) = default;
 };
 

@@ -47,11 +47,11 @@ struct BuildOptions {
 /// The job the retain file showed running when the previous runtime stopped without a clean
 /// shutdown (kill -9, power loss). The seam for resuming it from its block (issue 21).
 struct InterruptedJob {
-  std::uint32_t program_id{0};     // the id it was committed under (bridge: CRC-32); 0 = none
-  std::int64_t block_index{0};     // the block being executed (0-based)
-  std::int64_t block_count{0};     // blocks in the program
-  std::int64_t line{0};            // its G-code line
-  std::optional<double> depth_mm;  // `retain.job_depth` at the last retain write, if configured
+  std::uint32_t program_id{0};       // the id it was committed under (bridge: CRC-32); 0 = none
+  std::int64_t block_index{0};       // the block being executed (0-based)
+  std::int64_t block_count{0};       // blocks in the program
+  std::int64_t line{0};              // its G-code line
+  std::optional<double> depth_mm;    // `retain.job_depth` at the last retain write, if configured
   std::optional<double> touch_z_mm;  // `retain.job_touch_z`: the drill's depth origin (machine Z)
   std::optional<double> wear_mm;     // `retain.job_wear`: the wear it had compensated since
 };

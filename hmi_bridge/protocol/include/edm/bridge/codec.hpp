@@ -100,7 +100,7 @@ struct LastJob {
   std::string outcome;  // interrupted, aborted
   std::uint64_t block{0};
   std::int32_t line{0};
-  std::optional<double> depth_mm;  // retain.job_depth's variable then (the controller's estimate)
+  std::optional<double> depth_mm;    // retain.job_depth's variable then (the controller's estimate)
   std::optional<double> touch_z_mm;  // retain.job_touch_z's: the drill's depth origin (machine Z)
   std::optional<double> wear_mm;     // retain.job_wear's: the wear compensated since the touch
 };
