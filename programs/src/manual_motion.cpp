@@ -135,12 +135,8 @@ void ManualMotion::bind() {
 void ManualMotion::activate() noexcept {
   step_ = Step::kIdle;
   status_ = {};
-  active.set(false);
+  stop_outputs();
   mode.set(0);
-  touch_mode.set(false);
-  vx_cmd_mm_s.set(0.0);
-  vy_cmd_mm_s.set(0.0);
-  vz_cmd_mm_s.set(0.0);
   pos_set_x.set(false);
   pos_set_y.set(false);
   pos_set_z.set(false);
@@ -156,23 +152,30 @@ void ManualMotion::activate() noexcept {
 }
 
 void ManualMotion::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
-  if (step_ != Step::kIdle) {
-    step_ = Step::kIdle;
-    status_.result.ok = false;
-    status_.result.error = ManualError::kInterrupted;
-    status_.result.seq = req_.seq;
-    status_.result.op = req_.op;
-    status_.result.target = req_.target;
-    status_.busy = false;
-    status_.mode = ManualMode::kIdle;
-  }
+  if (step_ != Step::kIdle) end_operation(false, ManualError::kInterrupted, 0.0);
+  stop_outputs();
+  mode.set(0);
+  if (manual_ != nullptr) manual_->rt_publish(status_);
+}
+
+void ManualMotion::stop_outputs() noexcept {
   active.set(false);
   touch_mode.set(false);
   vx_cmd_mm_s.set(0.0);
   vy_cmd_mm_s.set(0.0);
   vz_cmd_mm_s.set(0.0);
-  mode.set(0);
-  if (manual_ != nullptr) manual_->rt_publish(status_);
+}
+
+void ManualMotion::end_operation(bool ok, ManualError e, double t_s) noexcept {
+  step_ = Step::kIdle;
+  status_.result.seq = req_.seq;
+  status_.result.op = req_.op;
+  status_.result.target = req_.target;
+  status_.result.ok = ok;
+  status_.result.error = e;
+  status_.result.t_s = t_s;
+  status_.busy = false;
+  status_.mode = ManualMode::kIdle;
 }
 
 double ManualMotion::pos(int axis) const noexcept {
@@ -247,20 +250,8 @@ void ManualMotion::command_axes() noexcept {
 }
 
 void ManualMotion::finish(bool ok, ManualError e, const rt::CycleContext& ctx) noexcept {
-  step_ = Step::kIdle;
-  status_.result.seq = req_.seq;
-  status_.result.op = req_.op;
-  status_.result.target = req_.target;
-  status_.result.ok = ok;
-  status_.result.error = e;
-  status_.result.t_s = rt::to_seconds(ctx.release);
-  status_.busy = false;
-  status_.mode = ManualMode::kIdle;
-  active.set(false);
-  touch_mode.set(false);
-  vx_cmd_mm_s.set(0.0);
-  vy_cmd_mm_s.set(0.0);
-  vz_cmd_mm_s.set(0.0);
+  end_operation(ok, e, rt::to_seconds(ctx.release));
+  stop_outputs();
 }
 
 void ManualMotion::finish_settled(bool ok, ManualError e, const rt::CycleContext& ctx) noexcept {

@@ -60,6 +60,22 @@ const char* const kPart =
     "N110 M30\n"
     "%\n";
 
+/// kPart interpreted from where the electrode is (machine coordinates = work coordinates).
+hmi::GcodeResult part_here(OperatorRig& m) {
+  hmi::GcodeOptions go;
+  go.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
+  return hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), go);
+}
+
+/// Loads kPart from where the electrode is and starts it (a dry run or not).
+void start_part(OperatorRig& m, bool dry_run) {
+  const hmi::GcodeResult part = part_here(m);
+  ASSERT_TRUE(part.ok()) << part.messages().front();
+  ASSERT_EQ(m.runtime->job().load(part.blocks), rt::LoadResult::kOk);
+  m.runtime->job().set_start_options({rt::JobSlot::kMain, dry_run});
+  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+}
+
 class OperatorDay : public ::testing::TestWithParam<int> {};
 
 TEST_P(OperatorDay, ReferenceTouchOffSetG54AndDrillInWorkCoordinates) {
@@ -150,14 +166,8 @@ namespace {
 // orbit blocks are skipped, so the electrode never enters the work.
 TEST(DryRun, RunsTheMovesWithTheGeneratorOffAndNeverEntersTheWork) {
   OperatorRig m("start_gap_um: 5000", "");
-  hmi::GcodeOptions go;
-  go.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
-  const hmi::GcodeResult part = hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), go);
-  ASSERT_TRUE(part.ok()) << part.messages().front();
+  ASSERT_NO_FATAL_FAILURE(start_part(m, /*dry_run=*/true));
   auto& job = m.runtime->job();
-  ASSERT_EQ(job.load(part.blocks), rt::LoadResult::kOk);
-  job.set_start_options({rt::JobSlot::kMain, /*dry_run=*/true});
-  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   double lowest_z = 1e9;
   bool armed = false;
   for (int k = 0; k < 60'000 && (job.progress().jobs_started == 0 || job.active()); ++k) {
@@ -187,13 +197,8 @@ namespace {
 // the hole from the drill's own touch point and wear (what `edmhmi run --from` and the page send).
 TEST(StopAndResume, StopMidDrillRetractsThenRunFromTheLineFinishesTheHole) {
   OperatorRig m("start_gap_um: 5000", "");
-  hmi::GcodeOptions go;
-  go.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
-  const hmi::GcodeResult part = hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), go);
-  ASSERT_TRUE(part.ok()) << part.messages().front();
+  ASSERT_NO_FATAL_FAILURE(start_part(m, /*dry_run=*/false));
   auto& job = m.runtime->job();
-  ASSERT_EQ(job.load(part.blocks), rt::LoadResult::kOk);
-  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   for (int k = 0; k < 120'000 && m.read("cnc.job.drill.depth_reached_mm") < 3.0; ++k) {
     m.run_for(std::chrono::milliseconds(1));
   }
@@ -216,9 +221,7 @@ TEST(StopAndResume, StopMidDrillRetractsThenRunFromTheLineFinishesTheHole) {
   EXPECT_NEAR(depth, m.truth().hole_depth_mm, 0.03) << "the count kept at the stop";
 
   // Run from the drilling line (N70 is source line 8 of kPart).
-  hmi::GcodeOptions again;
-  again.start_mm = {m.read("io.x_mm"), m.read("io.y_mm"), m.read("io.z_mm")};
-  const hmi::GcodeResult g = hmi::interpret_gcode(kPart, "hole.nc", m.runtime->tables(), again);
+  const hmi::GcodeResult g = part_here(m);
   const hmi::ResumePlan plan =
       hmi::plan_resume(g, m.runtime->tables(), 8, depth, hmi::DrillResume{touch_z, wear});
   ASSERT_TRUE(plan.ok()) << plan.error;

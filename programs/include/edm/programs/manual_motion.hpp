@@ -138,6 +138,9 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
 
   void start(const rt::ManualRequest& r, const rt::CycleContext& ctx) noexcept;
   void finish(bool ok, rt::ManualError e, const rt::CycleContext& ctx) noexcept;
+  /// The result of the operation (request `req_`) and the idle state, published next.
+  void end_operation(bool ok, rt::ManualError e, double t_s) noexcept;
+  void stop_outputs() noexcept;  // not active, touch mode off, every axis command 0
   /// finish() once the axes stand on their references (kInPosition).
   void finish_settled(bool ok, rt::ManualError e, const rt::CycleContext& ctx) noexcept;
   void begin_move(int axis, double target, double speed) noexcept;
