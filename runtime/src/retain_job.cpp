@@ -47,14 +47,19 @@ std::vector<RetainStore::Variable> variables(const JobStore& job,
                    return RetainValue::make_int(keep() ? kept->line : job.progress().line);
                  }});
   using Kept = std::optional<double> InterruptedJob::*;
-  for (auto [name, read, field] : {std::tuple<const char*, std::function<double()>*, Kept>{
-                                       kDepth, &readers.depth, &InterruptedJob::depth_mm},
-                                   {kTouchZ, &readers.touch_z, &InterruptedJob::touch_z_mm},
-                                   {kWear, &readers.wear, &InterruptedJob::wear_mm}}) {
-    if (!*read) continue;
-    out.push_back({name, RetainType::kReal, [&kept, keep, f = std::move(*read), field] {
-                     return RetainValue::make_real(keep() ? ((*kept).*field).value_or(0.0) : f());
-                   }});
+  struct RealRecord {
+    const char* name;
+    std::function<double()>* read;
+    Kept field;
+  };
+  for (const RealRecord& r : {RealRecord{kDepth, &readers.depth, &InterruptedJob::depth_mm},
+                              RealRecord{kTouchZ, &readers.touch_z, &InterruptedJob::touch_z_mm},
+                              RealRecord{kWear, &readers.wear, &InterruptedJob::wear_mm}}) {
+    if (!*r.read) continue;
+    out.push_back(
+        {r.name, RetainType::kReal, [&kept, keep, f = std::move(*r.read), field = r.field] {
+           return RetainValue::make_real(keep() ? ((*kept).*field).value_or(0.0) : f());
+         }});
   }
   return out;
 }
