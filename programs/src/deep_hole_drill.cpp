@@ -31,6 +31,12 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
            .description = "frontal gap at the first sparks less the working gap: the hole is "
                           "this much shallower than the front's travel from the touch",
            .range = rt::closed(-1000.0, 1000.0)});
+  v.param("contact_offset_um", contact_offset_um,
+          {.unit = "um",
+           .description = "working gap less the touch-sensing distance: a hole measured by touch "
+                          "(contact_depth_mm) is this much deeper than the front's travel from "
+                          "the contact",
+           .range = rt::closed(-1000.0, 1000.0)});
   v.param("touch_cycles", touch_cycles,
           {.unit = "cycles",
            .description = "consecutive cycles with sparks that count as touching the work",
@@ -149,6 +155,14 @@ void DeepHoleDrill::begin_cycle() noexcept {
   depth_done_mm_ = std::isfinite(done_mm) && done_mm > 0.0 ? done_mm : 0.0;
   const double rz = resume_touch_z_mm.get(), rw = resume_wear_mm.get();
   resume_ = depth_done_mm_ > 0.0 && std::isfinite(rz) && std::isfinite(rw) && rw > 0.0;
+  const double cz = contact_z_mm.get(), cd = contact_depth_mm.get();
+  measured_ = std::isfinite(cz) && std::isfinite(cd) && cd > 0.0;
+  contact_z_mm_ = measured_ ? cz : 0.0;
+  contact_depth_mm_ = measured_ ? cd : 0.0;
+  if (measured_) {
+    resume_ = false;
+    depth_done_mm_ = 0.0;
+  }
   resume_touch_z_mm_ = resume_ ? rz : 0.0;
   resume_wear_mm_ = resume_ ? rw : 0.0;
   spark_cycles_ = 0;
@@ -259,7 +273,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     td_stepped = true;
     spark_cycles_ = pulses.td_count.get() > 0 ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
-      touch_z_mm.set(resume_ ? resume_touch_z_mm_ : z);
+      touch_z_mm.set(measured_ ? contact_z_mm_ : resume_ ? resume_touch_z_mm_ : z);
       reset_wear.set(true);  // the wear estimate starts at the touch
       set_state(State::kDrill);
     } else {
@@ -279,7 +293,10 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     const bool above_done =
         resume_ && (touch_z_mm.get() - z) - resume_wear_mm_ - params_.spark_gap_offset_um * 1e-3 <
                        depth_done_mm_;
-    if (above_done) reset_wear.set(true);
+    // Measured: likewise until the front is back one working gap above the measured bottom
+    // (it touched contact_offset_um lower than that).
+    const bool above_bottom = measured_ && (contact_z_mm_ - z) < -params_.contact_offset_um * 1e-3;
+    if (above_done || above_bottom) reset_wear.set(true);
     if (!retracting) {
       // The servo's command into the wear compensator: the gap child's Vz, or the external
       // servo's clamped to the gap child's limits; ramped back in after a retract (v_scale
@@ -308,8 +325,10 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     // the front's travel by the working gap and shallower by the first-spark gap,
     //   depth = (touch_z − z) − wear_mm − spark_gap_offset_um·1e-3   (first-spark − working gap).
     const double wear_now = (comp ? wear_.wear_mm.get() : 0.0) + resume_wear_mm_;
-    const double depth = (resume_ ? 0.0 : depth_done_mm_) + (touch_z_mm.get() - z) - wear_now -
-                         params_.spark_gap_offset_um * 1e-3;
+    const double depth = measured_ ? contact_depth_mm_ + (touch_z_mm.get() - z) - wear_now +
+                                         params_.contact_offset_um * 1e-3
+                                   : (resume_ ? 0.0 : depth_done_mm_) + (touch_z_mm.get() - z) -
+                                         wear_now - params_.spark_gap_offset_um * 1e-3;
     depth_reached_mm.set(depth);
     wear_mm.set(wear_now);
     dark_cycles_ = pulses.td_count.get() > 0 ? 0 : dark_cycles_ + 1;

@@ -14,6 +14,10 @@ using machining::MotionKind;
 
 // The loops must be able to follow a rapid with margin for the feed-forward's overshoot.
 constexpr double kLoopSpeedMargin = 1.5;
+// An axis stands still below this speed; a move is complete once every axis has for this many
+// cycles (and every loop is in its window).
+constexpr double kStillSpeedMmS = 0.2;
+constexpr std::int64_t kStillCycles = 5;
 }  // namespace
 
 void EdmJobParams::visit(rt::ParamVisitor& v) {
@@ -32,6 +36,26 @@ void EdmJobParams::visit(rt::ParamVisitor& v) {
           {.unit = "s",
            .description = "generator-off wait when a condition changes the polarity",
            .range = rt::kNonNegative});
+  v.param("probe_depth", probe_depth,
+          {.description = "measure a blind hole's depth by touch (bottom and surface) and drill "
+                          "the rest from the measurement"});
+  v.param("probe_margin_mm", probe_margin_mm,
+          {.unit = "mm",
+           .description = "the first drilling stops this much short of the depth (more than "
+                          "the wear estimate's error)",
+           .range = rt::open_closed(0.0, 5.0)});
+  v.param("probe_dx_mm", probe_dx_mm,
+          {.unit = "mm",
+           .description = "X of the surface touch relative to the hole (on the work)",
+           .range = rt::closed(-100.0, 100.0)});
+  v.param("probe_dy_mm", probe_dy_mm,
+          {.unit = "mm",
+           .description = "Y of the surface touch relative to the hole (on the work)",
+           .range = rt::closed(-100.0, 100.0)});
+  v.param("probe_clear_mm", probe_clear_mm,
+          {.unit = "mm",
+           .description = "a probe touch starts this far above the expected contact",
+           .range = rt::open_closed(0.0, 5.0)});
 }
 
 EdmJob::EdmJob()
@@ -76,6 +100,8 @@ void EdmJob::bind_self() {
   drill_.depth_done_mm.connect(drill_depth_done_mm);
   drill_.resume_touch_z_mm.connect(drill_resume_touch_z_mm);
   drill_.resume_wear_mm.connect(drill_resume_wear_mm);
+  drill_.contact_z_mm.connect(drill_contact_z_mm);
+  drill_.contact_depth_mm.connect(drill_contact_depth_mm);
   manual_.enable.connect(manual_enable);
   manual_.x_mm.follow(x_mm);
   manual_.y_mm.follow(y_mm);
@@ -136,6 +162,10 @@ void EdmJob::bind_self() {
 
 void EdmJob::activate_self() noexcept {
   state_value_ = State::kIdle;
+  still_cycles_ = 0;
+  last_x_ = x_mm.get();
+  last_y_ = y_mm.get();
+  last_z_ = z_mm.get();
   hold_valid_ = false;
   step_ = Step::kEnter;
   condition_ = nullptr;
@@ -146,6 +176,10 @@ void EdmJob::activate_self() noexcept {
   rotation_on.set(false);
   state.set(0);
   jobs_finished.set(0);
+  set_probe(0);
+  probe_moving_ = false;
+  probe_failures.set(0);
+  measured_depth_mm.set(0.0);
 }
 
 void EdmJob::stop_outputs() noexcept {
@@ -173,8 +207,11 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
     // running would creep down dark, counting wear it never made).
     drill_.abort();
     finish_.abort();
+    manual_.abort_job_touch();
   }
   drill_returning_ = false;
+  set_probe(0);
+  probe_moving_ = false;
   if (outcome == rt::JobOutcome::kFinished) jobs_finished.set(jobs_finished.get() + 1);
   state_value_ = State::kIdle;
   state.set(0);
@@ -199,7 +236,8 @@ void EdmJob::select_condition(int e) noexcept {
 }
 
 bool EdmJob::in_position() const noexcept {
-  return px_.in_position.get() && py_.in_position.get() && pz_.in_position.get();
+  return px_.in_position.get() && py_.in_position.get() && pz_.in_position.get() &&
+         still_cycles_ >= kStillCycles;
 }
 
 void EdmJob::set_reference(double x, double y, double z, double vx, double vy, double vz) noexcept {
@@ -292,37 +330,6 @@ bool EdmJob::run_arc(const MotionBlock& b, const rt::CycleContext& ctx, bool hol
   return step_ == Step::kBusy && arc_.done.get() && !arc_start.get() && in_position();
 }
 
-bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
-                       rt::BlockStatus& status) noexcept {
-  if (drill_returning_) return run_block(drill_return_, ctx, hold, status);
-  hold_position();
-  if (step_ == Step::kEnter) {
-    drill_return_ = MotionBlock{};
-    drill_return_.kind = MotionKind::kRapid;
-    drill_return_.line = b.line;
-    drill_return_.col = b.col;
-    drill_return_.target = {x_mm.get(), y_mm.get(), z_mm.get()};
-    figures_.begin_drill_block();
-    drill_depth_mm.set(b.depth_mm > 0.0 ? b.depth_mm : -b.target.z);
-    drill_depth_done_mm.set(b.depth_done_mm);
-    drill_resume_touch_z_mm.set(b.resume_touch_z_mm);
-    drill_resume_wear_mm.set(b.resume_wear_mm);
-    drill_start.set(true);
-    step_ = Step::kBusy;
-    return false;
-  }
-  drill_start.set(false);
-  feed_hold.set(hold);
-  figures_.note_drill(drill_.depth_reached_mm.get(), drill_.wear_mm.get());
-  const bool done = drill_.state.get() == static_cast<std::int64_t>(DeepHoleDrill::State::kDone);
-  if (done) {  // retracted out of the hole: back to where the block began, as a rapid
-    hold_z_ = z_mm.get();
-    drill_returning_ = true;
-    step_ = Step::kEnter;
-  }
-  return false;
-}
-
 bool EdmJob::run_finish(const MotionBlock& b, bool hold) noexcept {
   hold_position();
   if (step_ == Step::kEnter) {
@@ -396,6 +403,13 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   // The operator's feed override, read once a cycle for every child that moves.
   feed_override.set(machine_ != nullptr ? machine_->feed_override() : 1.0);
   const double x = x_mm.get(), y = y_mm.get(), z = z_mm.get();
+  const double still_mm = kStillSpeedMmS * ctx.dt_s;
+  const bool still = std::abs(x - last_x_) <= still_mm && std::abs(y - last_y_) <= still_mm &&
+                     std::abs(z - last_z_) <= still_mm;
+  still_cycles_ = still ? still_cycles_ + 1 : 0;
+  last_x_ = x;
+  last_y_ = y;
+  last_z_ = z;
 
   const rt::MachineState ms = ctx.state;
   if (rt::is_safe_state(ms)) hold_valid_ = false;  // loops off: follow the axes

@@ -8,6 +8,7 @@ namespace edm::programs {
 void JobFigures::begin(rt::TimePoint start) noexcept {
   start_ = start;
   wear_before_block_ = 0.0;
+  depth_before_block_ = 0.0;
   job_time_s.set(0.0);
   job_pulses.set(0);
   job_shorts.set(0);

@@ -134,6 +134,8 @@ void ManualMotion::bind() {
 
 void ManualMotion::activate() noexcept {
   step_ = Step::kIdle;
+  job_op_ = false;
+  job_ok_ = false;
   status_ = {};
   stop_outputs();
   mode.set(0);
@@ -153,6 +155,8 @@ void ManualMotion::activate() noexcept {
 
 void ManualMotion::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexcept {
   if (step_ != Step::kIdle) end_operation(false, ManualError::kInterrupted, 0.0);
+  job_op_ = false;
+  job_ok_ = false;
   stop_outputs();
   mode.set(0);
   if (manual_ != nullptr) manual_->rt_publish(status_);
@@ -463,7 +467,16 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
   rt::ManualRequest r;
   const bool fresh = manual_->rt_poll(r, last_seq_);
   if (fresh) status_.seen_seq = r.seq;
-  if (!enable.get()) {
+  if (job_op_ && fresh && r.op != ManualOp::kStop && r.op != ManualOp::kNone) {
+    // The job's touch owns the axes: the operator's request is answered, the touch runs on.
+    status_.result = {};
+    status_.result.seq = r.seq;
+    status_.result.op = r.op;
+    status_.result.target = r.target;
+    status_.result.error = ManualError::kInterrupted;
+    status_.result.t_s = rt::to_seconds(ctx.release);
+  }
+  if (!enable.get() && !job_op_) {
     if (step_ != Step::kIdle) finish(false, ManualError::kInterrupted, ctx);
     // A request made while not READY is answered at once.
     if (fresh && r.op != ManualOp::kStop && r.op != ManualOp::kNone) {
@@ -475,7 +488,7 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
     manual_->rt_publish(status_);
     return rt::BlockStatus::kOk;
   }
-  if (fresh) start(r, ctx);
+  if (fresh && !job_op_) start(r, ctx);
 
   const double dt = dt_s_;
   switch (step_) {
@@ -668,10 +681,35 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
   } else if (step_ != Step::kIdle) {
     command_axes();
   }
+  if (job_op_ && step_ == Step::kIdle) {  // the job's touch has ended
+    job_op_ = false;
+    job_ok_ = status_.result.ok;
+    job_z_mm_ = status_.result.z;
+  }
   mode.set(static_cast<std::int64_t>(status_.mode));
   referenced.set(manual_->referenced());
   manual_->rt_publish(status_);
   return rt::BlockStatus::kOk;
+}
+
+void ManualMotion::abort_job_touch() noexcept {
+  if (!job_op_) return;
+  end_operation(false, ManualError::kInterrupted, 0.0);
+  stop_outputs();
+  job_op_ = false;
+  job_ok_ = false;
+}
+
+bool ManualMotion::begin_job_touch_z(const rt::CycleContext& ctx) noexcept {
+  if (step_ != Step::kIdle || job_op_ || !contact.connected()) return false;
+  rt::ManualRequest r;
+  r.op = ManualOp::kTouch;
+  r.target = TouchTarget::kZ;
+  r.seq = 0;  // no operator's request: nothing in ManualControl waits for this result
+  job_op_ = true;
+  job_ok_ = false;
+  start(r, ctx);
+  return true;
 }
 
 }  // namespace edm::programs

@@ -24,9 +24,7 @@ class OperatorOps : public ::testing::Test {
     std::string text =
         edm::test::read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
     if (!manual_params.empty()) {
-      edm::test::replace_once(
-          text, "params: {drill: {spark_gap_offset_um: 30.3}}",
-          "params: {drill: {spark_gap_offset_um: 30.3}, manual: {" + manual_params + "}}");
+      edm::test::replace_once(text, "manual: {}", "manual: {" + manual_params + "}");
     }
     rt_ = edm::test::build_sim_machine(rt::parse_config_text(text, "drill-sim.yaml"));
     ServerOptions o;

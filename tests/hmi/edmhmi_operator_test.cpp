@@ -34,9 +34,7 @@ class EdmhmiOperatorTest : public EdmhmiProcessTest {
             "params: {preset: drill, seed: 1, wall_sparks: true, work_surface_z_mm: " +
                 std::to_string(kSurfaceZ) + ", work_origin_x_mm: " + std::to_string(kDatumX) +
                 ", work_origin_y_mm: " + std::to_string(kDatumY) + "}");
-    replace("params: {drill: {spark_gap_offset_um: 30.3}}",
-            "params: {drill: {spark_gap_offset_um: 30.3}, manual: {referenced_at_start: false, "
-            "reference_required: true}}");
+    replace("manual: {}", "manual: {referenced_at_start: false, reference_required: true}");
     const std::string path = dir_.file("operator.yaml");
     edm::test::write_file(path, text);
     return path;

@@ -1,12 +1,18 @@
 // Seed 004's headline, depth accuracy, as a property of the method (issue 20 f): a blind hole
-// drilled by the shipped drill machine (config/machines/drill-sim.yaml, one set of parameters:
-// E1's wear ratio and drill.spark_gap_offset_um, calibrated on seeds 1000-1004) from a G-code
-// program interpreted as edmhmi does, at 3, 8, 15, 25 and 30 mm, on scoring seeds (1-5 here;
-// EDM_DEPTH_SEEDS=1-20 for the benchmark table). The truth is the simulator's hole depth
-// (io.depth_mm), not the controller's estimate. Bound asserted: ±30 µm. The issue's target,
-// ±10 µm, is NOT met: the residual (up to ≈ +24 µm at 15-25 mm) is the electrode's wear per
-// depth varying by ±0.2 % with depth (wall sparks, arcs), which one wear ratio cannot follow
-// (docs/benchmarks.md "Depth accuracy" decomposes it with the printed truth).
+// drilled by the shipped drill machine (config/machines/drill-sim.yaml, one set of parameters)
+// from a G-code program interpreted as edmhmi does, at 3, 8, 15, 25 and 30 mm, on scoring seeds
+// (1-5 here; EDM_DEPTH_SEEDS=1-20 for the benchmark table). The truth is the simulator's hole
+// depth (io.depth_mm), not the controller's estimate.
+//   DepthAccuracy      as shipped, with EdmJob's depth probe (the depth measured by touching the
+//                      bottom and the surface, the last 0.1 mm drilled from the measurement;
+//                      contact_offset_um calibrated on seeds 1000-1004): ±10 µm, the issue's
+//                      target; and the probe's measured depth within ±6 µm of the truth.
+//   DepthAccuracyEq8   the paper's method alone (probe_depth off: eq. 8's wear estimate, E1's θ
+//                      and drill.spark_gap_offset_um calibrated on seeds 1000-1004): ±30 µm. The
+//                      ±10 µm target is NOT met that way: the residual (up to ≈ +24 µm at 15-25 mm)
+//                      is the electrode's wear per depth varying by ±0.2 % with depth (wall
+//                      sparks, arcs), which one wear ratio cannot follow (docs/benchmarks.md
+//                      "Depth accuracy" decomposes it with the printed truth).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -41,6 +47,8 @@ struct Hole {
   double gap_touch_um{0.0}, gap_end_um{0.0};   // the frontal gap
   double wear_true_mm{0.0}, wear_est_mm{0.0};  // electrode wear in DRILL: true, eq. 8's
   double td_rms_us{0.0};                       // RMS(Td − Tdr) while drilling (the ISE's e)
+  double measured_mm{0.0};                     // the depth probe's measured depth (0: none)
+  std::int64_t probe_failures{0};
 };
 
 // EDM_DEPTH_CONFIG=PATH runs another config (an experiment: another Kg, another calibration).
@@ -49,7 +57,7 @@ std::string machine_config() {
   return p != nullptr ? p : std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml";
 }
 
-Hole drill(int seed, double depth_mm) {
+Hole drill(int seed, double depth_mm, bool probe) {
   const std::string cfg = machine_config();
   hmi::GcodeOptions o;
   o.start_mm = {0, 0, 0.1};
@@ -58,36 +66,44 @@ Hole drill(int seed, double depth_mm) {
   EXPECT_TRUE(g.ok()) << (g.ok() ? "" : g.messages()[0]);
   Hole h;
   double z_start = 0.0, z_min = 1e9, state = 0.0, electrode0 = 0.0;
-  bool drilling = false;
+  bool drilling = false, touched = false;
   for (const machining::MotionBlock& b : g.blocks) {
     if (b.kind == machining::MotionKind::kDrill) h.planned_travel_mm = b.z_travel_mm;
   }
   double td_sq = 0.0;
   std::int64_t td_n = 0;
-  const JobResult j = run_job(seed, g.blocks, o.start_mm, cfg, [&](const rt::VariableRegistry& v) {
-    const double st = v.read("cnc.job.drill.state").value();
-    if (st == 2.0 && state != 2.0) {  // the touch
-      h.gap_touch_um = v.read("io.true_gap_um").value();
-      electrode0 = v.read("io.electrode_mm").value();
-    }
-    if (st == 2.0) {
-      h.gap_end_um = v.read("io.true_gap_um").value();
-      h.wear_true_mm = electrode0 - v.read("io.electrode_mm").value();
-      h.wear_est_mm = v.read("cnc.job.drill.wear.wear_mm").value();
-    }
-    if (st == 2.0 && v.read("cnc.job.drill.td.valid").value() != 0.0) {
-      const double e =
-          v.read("cnc.job.drill.td.td_us").value() - v.read("cnc.job.drill.tdr_us").value();
-      td_sq += e * e;
-      ++td_n;
-    }
-    state = st;
-    const bool now = st != 0.0;
-    const double z = v.read("io.z_mm").value();
-    if (now && !drilling) z_start = z;
-    drilling = drilling || now;
-    if (drilling) z_min = std::min(z_min, z);
-  });
+  const JobResult j = run_job(
+      seed, g.blocks, o.start_mm, cfg,
+      [&](const rt::VariableRegistry& v) {
+        const double st = v.read("cnc.job.drill.state").value();
+        if (st == 2.0 && state != 2.0 && !touched) {  // the touch (of the first drilling)
+          touched = true;
+          h.gap_touch_um = v.read("io.true_gap_um").value();
+          electrode0 = v.read("io.electrode_mm").value();
+        }
+        if (st == 2.0) {
+          h.gap_end_um = v.read("io.true_gap_um").value();
+          h.wear_true_mm = electrode0 - v.read("io.electrode_mm").value();
+          h.wear_est_mm = v.read("cnc.job.drill.wear.wear_mm").value();
+        }
+        if (st == 2.0 && v.read("cnc.job.drill.td.valid").value() != 0.0) {
+          const double e =
+              v.read("cnc.job.drill.td.td_us").value() - v.read("cnc.job.drill.tdr_us").value();
+          td_sq += e * e;
+          ++td_n;
+        }
+        h.measured_mm = v.read("cnc.job.measured_depth_mm").value();
+        h.probe_failures = static_cast<std::int64_t>(v.read("cnc.job.probe_failures").value());
+        state = st;
+        const bool now = st != 0.0;
+        const double z = v.read("io.z_mm").value();
+        if (now && !drilling) z_start = z;
+        drilling = drilling || now;
+        if (st == 2.0) z_min = std::min(z_min, z);  // the drilling's own travel (not the touches)
+      },
+      [probe](rt::Runtime& r) {
+        ASSERT_TRUE(r.variables().write("cnc.job.probe_depth", rt::ParamValue::of_bool(probe)));
+      });
   h.finished = j.finished;
   h.depth_mm = j.depth_mm;
   h.time_s = j.time_s;
@@ -115,40 +131,60 @@ const std::vector<int> kScoringSeeds = {1};
 const std::vector<int> kScoringSeeds = {1, 2, 3, 4, 5};
 #endif
 
-class DepthAccuracy : public ::testing::TestWithParam<double> {};
-
-TEST_P(DepthAccuracy, BlindHoleEndsWithinThirtyMicrometres) {
+// Drills each scoring seed's hole at the parameter's depth; err_bound_mm on the truth.
+void score(double depth, bool probe, double err_bound_mm) {
   const std::vector<int> seeds = seeds_from_env("EDM_DEPTH_SEEDS", kScoringSeeds);
-  double depth = GetParam();
   if (const char* d = std::getenv("EDM_DEPTH_ONLY")) {  // experiments: one depth
     if (depth != 3.0) GTEST_SKIP() << "EDM_DEPTH_ONLY";
     depth = std::atof(d);
   }
   double sum = 0.0, worst = 0.0;
   for (const int seed : seeds) {
-    const Hole h = drill(seed, depth);
+    const Hole h = drill(seed, depth, probe);
     ASSERT_TRUE(h.finished) << depth << " mm, seed " << seed;
     const double err_um = (h.depth_mm - depth) * 1000.0;
     std::printf(
-        "[depth] %5.1f mm seed %4d: %8.4f mm (%+6.1f um) in %.1f s; Z travel %.3f mm, "
+        "[depth%s] %5.1f mm seed %4d: %8.4f mm (%+6.1f um) in %.1f s; Z travel %.3f mm, "
         "planned lz' %.3f mm; gap touch %.1f end %.1f um, wear true %.4f est %.4f mm; "
-        "RMS(Td-Tdr) %.2f us\n",
-        depth, seed, h.depth_mm, err_um, h.time_s, h.travel_mm, h.planned_travel_mm, h.gap_touch_um,
-        h.gap_end_um, h.wear_true_mm, h.wear_est_mm, h.td_rms_us);
+        "RMS(Td-Tdr) %.2f us; measured %.4f mm (%+.1f um), probe failures %lld\n",
+        probe ? "" : "-eq8", depth, seed, h.depth_mm, err_um, h.time_s, h.travel_mm,
+        h.planned_travel_mm, h.gap_touch_um, h.gap_end_um, h.wear_true_mm, h.wear_est_mm,
+        h.td_rms_us, h.measured_mm, (h.measured_mm - h.depth_mm) * 1000.0,
+        static_cast<long long>(h.probe_failures));
     sum += err_um;
     if (std::abs(err_um) > std::abs(worst)) worst = err_um;
-    EXPECT_NEAR(h.depth_mm, depth, 0.030) << depth << " mm, seed " << seed;
-    // Eq. 9-11 and eq. 8 agree: Z travels the planned lz' (the wear counted once).
-    EXPECT_NEAR(h.travel_mm, h.planned_travel_mm, 0.05) << depth << " mm, seed " << seed;
+    EXPECT_NEAR(h.depth_mm, depth, err_bound_mm) << depth << " mm, seed " << seed;
+    if (probe) {
+      EXPECT_EQ(h.probe_failures, 0);
+      EXPECT_NEAR(h.measured_mm, h.depth_mm, 0.006) << "the measurement against the truth";
+    } else {
+      // Eq. 9-11 and eq. 8 agree: Z travels the planned lz' (the wear counted once). (With the
+      // probe the hole is drilled in two parts, the second from the measurement.)
+      EXPECT_NEAR(h.travel_mm, h.planned_travel_mm, 0.05) << depth << " mm, seed " << seed;
+    }
   }
-  std::printf("[depth] %5.1f mm: mean %+6.1f um, worst %+6.1f um over %zu seeds\n", depth,
-              sum / static_cast<double>(seeds.size()), worst, seeds.size());
+  std::printf("[depth%s] %5.1f mm: mean %+6.1f um, worst %+6.1f um over %zu seeds\n",
+              probe ? "" : "-eq8", depth, sum / static_cast<double>(seeds.size()), worst,
+              seeds.size());
 }
 
+std::string depth_name(const ::testing::TestParamInfo<double>& p) {
+  return std::to_string(static_cast<int>(p.param)) + "mm";
+}
+
+class DepthAccuracy : public ::testing::TestWithParam<double> {};
+
+TEST_P(DepthAccuracy, ProbedBlindHoleEndsWithinTenMicrometres) { score(GetParam(), true, 0.010); }
+
 INSTANTIATE_TEST_SUITE_P(Depths, DepthAccuracy, ::testing::Values(3.0, 8.0, 15.0, 25.0, 30.0),
-                         [](const auto& p) {
-                           return std::to_string(static_cast<int>(p.param)) + "mm";
-                         });
+                         depth_name);
+
+class DepthAccuracyEq8 : public ::testing::TestWithParam<double> {};
+
+TEST_P(DepthAccuracyEq8, BlindHoleEndsWithinThirtyMicrometres) { score(GetParam(), false, 0.030); }
+
+INSTANTIATE_TEST_SUITE_P(Depths, DepthAccuracyEq8, ::testing::Values(3.0, 8.0, 15.0, 25.0, 30.0),
+                         depth_name);
 
 }  // namespace
 }  // namespace edm::test

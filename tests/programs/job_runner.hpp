@@ -94,7 +94,9 @@ inline JobResult run_job(int seed, const std::vector<machining::MotionBlock>& pr
     res.r_min_mm = std::min(res.r_min_mm, plant.wall_bin_radius_mm(j));
     res.r_max_mm = std::max(res.r_max_mm, plant.wall_bin_radius_mm(j));
   }
-  EXPECT_EQ(r->machine().state(), rt::MachineState::kReady) << "the job stops the machine";
+  EXPECT_EQ(r->machine().state(), rt::MachineState::kReady)
+      << "the job stops the machine; last alarm cause "
+      << static_cast<int>(r->machine().last_cause());
   return res;
 }
 

@@ -36,9 +36,7 @@ struct OperatorRig {
     replace_once(text, "params: {preset: drill, seed: 1, wall_sparks: true}",
                  "params: {preset: drill, seed: 1, wall_sparks: true" +
                      (sim_params.empty() ? std::string() : ", " + sim_params) + "}");
-    replace_once(text, "params: {drill: {spark_gap_offset_um: 30.3}}",
-                 "params: {drill: {spark_gap_offset_um: 30.3}" +
-                     (manual.empty() ? std::string() : ", manual: {" + manual + "}") + "}");
+    replace_once(text, "manual: {}", "manual: {" + manual + "}");
     runtime =
         build_sim_machine(rt::parse_config_text(text, "drill-sim-operator.yaml"), seeded(seed));
     runtime->machine().command(rt::MachineCommand::kPowerOn);

@@ -64,9 +64,8 @@ export async function startStack({ speed = String(SPEED) } = {}) {
   const withTokens = base.replace(/^bridge:.*$/m,
     `bridge:\n  token_file: ${op}\n  viewer_token_file: ${vw}`);
   if (withTokens === base) throw new Error('drill-sim.yaml has no bridge: section');
-  const withDeadman = withTokens.replace(/(type: EdmJob, params: \{)/,
-    `$1manual: {deadman: ${DEADMAN_MS}ms}, `);
-  if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob with params');
+  const withDeadman = withTokens.replace('manual: {}', `manual: {deadman: ${DEADMAN_MS}ms}`);
+  if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob manual: {}');
   writeFileSync(config, withDeadman);
   const bridgePort = await freePort();
   const procs = [];

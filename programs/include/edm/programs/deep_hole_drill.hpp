@@ -30,6 +30,15 @@
 //                 (the front touches at the first-spark gap and drills one working gap above
 //                 the bottom; spark_gap_offset_um is their difference, docs/blocks.md)
 //                 (output wear_mm: that estimated electrode wear of this cycle)
+//                 measured (contact_depth_mm > 0: the bottom found by touch at axis Z
+//                 contact_z_mm, EdmJob's depth probe): touch_z_mm is contact_z_mm and
+//                   depth_reached_mm = contact_depth_mm + (contact_z_mm − z_mm) − wear_mm
+//                                      + contact_offset_um·1e-3
+//                 (at the contact the front stood the touch-sensing distance above the bottom,
+//                 drilling it stands one working gap above: contact_offset_um is their
+//                 difference); no wear is counted (the compensator held at 0) while the axis
+//                 is still above contact_z_mm + contact_offset_um·1e-3: the front has not yet
+//                 reached the measured bottom, and the gap it closes there erodes nothing
 //               When it reaches the target → RETRACT. With `through` set, breakthrough_cycles
 //               consecutive cycles without an ignited pulse (td_count = 0) once depth ≥
 //               breakthrough_min_mm mean the front has left the work: breakthrough = true →
@@ -107,12 +116,13 @@
 namespace edm::programs {
 
 struct DeepHoleDrillParams {
-  double depth_default_mm{20.0};          // [mm] target hole depth while the depth_mm input is 0
-  double approach_speed_mm_s{0.5};        // [mm/s] feed down until the first sparks
-  double spark_gap_offset_um{0.0};        // [um] first-spark gap − working gap (depth origin)
-  std::int64_t touch_cycles{3};           // consecutive cycles with sparks = touch
-  double retract_speed_mm_s{5.0};         // [mm/s]
-  double clearance_mm{1.0};               // [mm] retract to touch_z + this
+  double depth_default_mm{20.0};    // [mm] target hole depth while the depth_mm input is 0
+  double approach_speed_mm_s{0.5};  // [mm/s] feed down until the first sparks
+  double spark_gap_offset_um{0.0};  // [um] first-spark gap − working gap (depth origin)
+  double contact_offset_um{0.0};    // [um] working gap − touch-sensing distance (measured origin)
+  std::int64_t touch_cycles{3};     // consecutive cycles with sparks = touch
+  double retract_speed_mm_s{5.0};   // [mm/s]
+  double clearance_mm{1.0};         // [mm] retract to touch_z + this
   std::int64_t breakthrough_cycles{300};  // cycles without ignition = breakthrough (through)
   double breakthrough_min_mm{0.5};        // [mm] no breakthrough before this depth
   double overtravel_mm{0.3};              // [mm] feed on after breakthrough, then retract
@@ -154,6 +164,11 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   // new first sparks (inside a hole they may strike the wall well above the bottom).
   rt::Input<double> resume_touch_z_mm{pins_, "resume_touch_z_mm", "mm"};
   rt::Input<double> resume_wear_mm{pins_, "resume_wear_mm", "mm"};
+  // A hole whose depth was measured by touch (EdmJob's depth probe): contact_depth_mm > 0 is its
+  // measured depth and contact_z_mm the axis Z at which the electrode touched its bottom; the
+  // depth counts on from there (takes precedence over the resume inputs).
+  rt::Input<double> contact_z_mm{pins_, "contact_z_mm", "mm"};
+  rt::Input<double> contact_depth_mm{pins_, "contact_depth_mm", "mm"};
   rt::Input<double> wear_ratio{pins_,
                                "wear_ratio"};  // ≤ 0 (unwired): the wear child's wear_ratio_default
   rt::Input<double> area_ratio{pins_, "area_ratio"};  // ≤ 0 (unwired): the wear child's areas
@@ -220,6 +235,9 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   double target_depth_mm_{0.0};
   double depth_done_mm_{0.0};  // depth_done_mm at the start of the cycle
   bool resume_{false};         // counting on from an interrupted drill's touch and wear
+  bool measured_{false};       // counting on from a measured bottom (contact_depth_mm > 0)
+  double contact_z_mm_{0.0};
+  double contact_depth_mm_{0.0};
   double resume_touch_z_mm_{0.0};
   double resume_wear_mm_{0.0};
   double retract_to_z_mm_{0.0};

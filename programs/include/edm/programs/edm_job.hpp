@@ -44,6 +44,21 @@
 //              drill child is DONE (after its retract) a rapid takes the electrode back to where
 //              the block began, so a drilling block ends at its start point (the G-code
 //              interpreter's current point after it, docs/gcode.md).
+//              With probe_depth (and touch sensing wired to manual.contact), a blind hole's
+//              depth is measured, not estimated (docs/blocks.md "The depth probe"):
+//                rough    the drill to depth − probe_margin_mm (eq. 8's estimate);
+//                bottom   touch −Z on the hole's bottom (manual's touch): axis Z z_b;
+//                surface  up to the block's start Z, over by (probe_dx_mm, probe_dy_mm), touch
+//                         −Z on the work's surface: z_s; measured depth d1 = z_s − z_b (one
+//                         electrode, one touch-sensing distance: the wear cancels);
+//                finish   back into the hole, the drill from the contact (contact_z_mm = z_b,
+//                         contact_depth_mm = d1) to the depth;
+//                check    touch the bottom again: z_b2; the depth measured,
+//                         d = d1 + (z_b − z_b2) − the finish's wear (eq. 8 over ≈ margin only)
+//                         → measured_depth_mm, the job's depth figure.
+//              A touch that finds nothing (no contact within manual.touch_max_mm, already in
+//              contact) ends the probe: probe_failures counts it and the rest is drilled on the
+//              estimate (as a resumed hole), so the hole is still finished.
 //   orbit_finish  finish.final_offset_mm = final_radius_mm − orbit_radius_offset_mm (the
 //              electrode radius plus the finishing side gap, calibrated: docs/blocks.md); Z held.
 //   end        finishes the job.
@@ -86,6 +101,12 @@ struct EdmJobParams {
   double feed_default_mm_s{2.0};          // [mm/s] linear/arc feed when the block has none
   double orbit_radius_offset_mm{0.5549};  // [mm] electrode radius + finishing side gap
   rt::Duration polarity_settle{std::chrono::milliseconds(20)};
+  // The depth probe (issue 20 f): a blind hole's depth measured by touch, not estimated.
+  bool probe_depth{false};      // on: drill, touch the bottom and the surface, drill the rest
+  double probe_margin_mm{0.1};  // [mm] the first drilling stops this much short of the depth
+  double probe_dx_mm{2.0};      // [mm] where the surface is touched, relative to the hole
+  double probe_dy_mm{0.0};      // [mm]
+  double probe_clear_mm{0.2};   // [mm] a touch starts this far above the expected contact
 
   void visit(rt::ParamVisitor& v);
 };
@@ -127,6 +148,13 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<double> drill_depth_done_mm{pins_, "drill_depth_done_mm", "mm"};
   rt::Output<double> drill_resume_touch_z_mm{pins_, "drill_resume_touch_z_mm", "mm"};
   rt::Output<double> drill_resume_wear_mm{pins_, "drill_resume_wear_mm", "mm"};
+  rt::Output<double> drill_contact_z_mm{pins_, "drill_contact_z_mm", "mm"};
+  rt::Output<double> drill_contact_depth_mm{pins_, "drill_contact_depth_mm", "mm"};
+  // The depth probe: its step (Probe), the last hole's measured depth (0: none measured) and the
+  // probes that found no contact.
+  rt::Output<std::int64_t> probe_step{pins_, "probe_step"};
+  rt::Output<double> measured_depth_mm{pins_, "measured_depth_mm", "mm"};
+  rt::Output<std::int64_t> probe_failures{pins_, "probe_failures"};
   rt::Output<bool> manual_enable{pins_, "manual_enable"};
   rt::Output<bool> dry_run{pins_, "dry_run"};
   rt::Output<double> wear_ratio{pins_, "wear_ratio"};
@@ -194,11 +222,22 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   bool run_drill(const machining::MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                  rt::BlockStatus& status) noexcept;
   bool run_finish(const machining::MotionBlock& b, bool hold) noexcept;
+  /// The depth probe's steps between the drillings (the rapids and touches).
+  void run_probe(const rt::CycleContext& ctx, bool hold, rt::BlockStatus& status) noexcept;
+  /// A rapid of the probe to (x, y, z); true when it has arrived.
+  bool probe_rapid(double x, double y, double z, const rt::CycleContext& ctx, bool hold,
+                   rt::BlockStatus& status) noexcept;
+  /// A −Z touch of the probe; true when it has ended (ok: contact at z).
+  bool probe_touch(const rt::CycleContext& ctx, bool& ok, double& z) noexcept;
+  void start_drill(double depth_mm) noexcept;
+  void set_probe(std::int64_t step) noexcept;
   void set_reference(double x, double y, double z, double vx, double vy, double vz) noexcept;
   void hold_position() noexcept;
   /// Sets move_from_* (see there) for the move that starts this cycle.
   void set_move_from() noexcept;
   void stop_outputs() noexcept;
+  /// Every loop in position and every axis standing still (≤ kStillSpeed for kStillCycles): the
+  /// loops' window alone also holds while an axis sweeps through it at speed.
   [[nodiscard]] bool in_position() const noexcept;
 
   DeepHoleDrill& drill_;
@@ -219,11 +258,27 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   Step step_{Step::kEnter};
   double hold_x_{0.0}, hold_y_{0.0}, hold_z_{0.0};  // references while no move is interpolated
   bool hold_valid_{false};  // hold_* are set (false after activation and in a safe state)
+  double last_x_{0.0}, last_y_{0.0}, last_z_{0.0};  // the positions of the previous cycle
+  std::int64_t still_cycles_{0};                    // consecutive cycles every axis stood still
   rt::TimePoint wait_until_{};
   const machining::Condition* condition_{nullptr};
   bool polarity_positive_value_{false};
   bool drill_returning_{false};  // the drill is done; rapid back to the block's start
   machining::MotionBlock drill_return_{};
+  // The depth probe (run_drill with probe_depth).
+  std::int64_t probe_{0};     // 0: off (the drilling block runs without it); see edm_job_drill.cpp
+  bool probe_moving_{false};  // a probe rapid or touch has started
+  bool probe_fallback_{false};  // a touch failed: the rest is drilled on the estimate
+  double probe_x_{0.0}, probe_y_{0.0}, probe_z_start_{0.0};
+  double probe_depth_mm_{0.0};  // the block's depth
+  double probe_rough_mm_{0.0};  // the rough drilling's depth
+  double probe_z_low_{0.0};     // the lowest axis Z of the drilling that ran last
+  double probe_z_b_{0.0};       // the bottom's contact
+  double probe_d1_{0.0};        // the depth measured before the finish
+  double probe_wear_rough_{0.0};
+  double probe_rough_touch_z_{0.0};
+  double probe_rough_reached_{0.0};
+  machining::MotionBlock probe_move_{};
 };
 
 }  // namespace edm::programs

@@ -47,13 +47,21 @@ class JobFigures {
   /// One cycle of the job at `now`.
   void count(rt::TimePoint now, const Counts& c) noexcept;
   /// A drilling block begins: its wear adds to the job's wear so far.
-  void begin_drill_block() noexcept { wear_before_block_ = job_wear_mm.get(); }
+  void begin_drill_block() noexcept {
+    wear_before_block_ = job_wear_mm.get();
+    depth_before_block_ = job_depth_mm.get();
+  }
   /// The running drilling block's depth reached and estimated wear.
   void note_drill(double depth_mm, double wear_mm) noexcept;
+  /// The running drilling block's depth measured by touch: it replaces the block's estimate.
+  void note_measured(double depth_mm) noexcept {
+    job_depth_mm.set(depth_before_block_ > depth_mm ? depth_before_block_ : depth_mm);
+  }
 
  private:
   rt::TimePoint start_{};
-  double wear_before_block_{0.0};  // job_wear_mm when the current drilling block began
+  double wear_before_block_{0.0};   // job_wear_mm when the current drilling block began
+  double depth_before_block_{0.0};  // job_depth_mm when the current drilling block began
 };
 
 }  // namespace edm::programs

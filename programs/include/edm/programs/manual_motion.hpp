@@ -111,6 +111,21 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
 
+  // The job's own touch (EdmJob's depth probe, issue 20 f): a −Z touch (fast, back, slow, off,
+  // back to the start) from where the axes stand, run while `enable` is false (a job runs). It
+  // moves the axes (`active`) and reports like an operator's touch, except that its result is
+  // read here, not through ManualControl; an operator's request meanwhile is answered
+  // kInterrupted. RT-safe.
+  /// Starts it; false (nothing starts) when an operation runs or touch sensing is not wired.
+  bool begin_job_touch_z(const rt::CycleContext& ctx) noexcept;
+  /// Ends the job's touch at once (the job was stopped): the axes stop, touch mode off.
+  void abort_job_touch() noexcept;
+  /// True from begin_job_touch_z() until the touch has ended (back at its start, in position).
+  [[nodiscard]] bool job_touch_busy() const noexcept { return job_op_; }
+  /// The last job touch: whether it found the work, and the axis Z at the contact.
+  [[nodiscard]] bool job_touch_ok() const noexcept { return job_ok_; }
+  [[nodiscard]] double job_touch_z_mm() const noexcept { return job_z_mm_; }
+
  private:
   enum class Step : std::uint8_t {
     kIdle,
@@ -182,6 +197,10 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   int touch_index_{0};  // center: 0 x+, 1 x−, 2 y+, 3 y−
   double contact_[4]{};
   double found_{0.0};
+  // The job's touch.
+  bool job_op_{false};
+  bool job_ok_{false};
+  double job_z_mm_{0.0};
 };
 
 }  // namespace edm::programs
