@@ -21,7 +21,7 @@ inline constexpr int kExitInterrupted = 130;
 
 /// The arguments of each command, filled by CLI11 in main.cpp.
 struct CheckArgs {
-  std::string machine{EDM_DEFAULT_MACHINE};
+  std::string machine;  // --machine; "" = machines/drill-sim.yaml of the data directory
   std::string offsets;  // --offsets FILE: the work frames as offset.get returns them; "" = zero
   std::string part;
 };
@@ -62,7 +62,7 @@ struct TraceArgs {
 };
 struct ServeArgs {
   std::string listen{"127.0.0.1:8080"};
-  std::string web_root{EDM_DEFAULT_WEB_ROOT};
+  std::string web_root;       // --web-root; "" = web/ of the data directory (data_dir.hpp)
   bool insecure{false};       // --insecure-listen: plain HTTP off loopback (bridge without TLS)
   std::string tls_cert;       // --tls-cert, else $EDM_WEB_TLS_CERT: HTTPS when set (with the key)
   std::string tls_key;        // --tls-key, else $EDM_WEB_TLS_KEY

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cli.hpp"
+#include "data_dir.hpp"
 
 namespace edmhmi {
 
@@ -39,12 +40,17 @@ int run(int argc, char** argv) {
                  "TLS, the server verified by this CA file (else $EDM_TLS_CA)");
   app.add_option("--tls-fingerprint", flags.tls_fingerprint,
                  "TLS, the server certificate's SHA-256 pinned (else $EDM_TLS_FINGERPRINT)");
+  std::string data_dir;
+  app.add_option("--data-dir", data_dir,
+                 "the shipped machines/ and web/ (else $EDM_DATA_DIR, else ../share/edmplc "
+                 "beside this program, else the build tree it runs from)");
 
   CheckArgs check;
   CLI::App* c = app.add_subcommand("check",
                                    "interpret PART.nc offline against a machine's "
                                    "conditions and soft limits; nothing is sent");
-  c->add_option("--machine", check.machine, "the machine config")->capture_default_str();
+  c->add_option("--machine", check.machine,
+                "the machine config (default: machines/drill-sim.yaml of the data directory)");
   c->add_option("--offsets", check.offsets,
                 "the work frames G54..G59 as JSON, as `edmhmi offset --json` prints them "
                 "(default: all zero)");
@@ -135,7 +141,8 @@ int run(int argc, char** argv) {
   ServeArgs serve;
   CLI::App* s = app.add_subcommand("serve", "the operator's page in a browser (docs/web.md)");
   s->add_option("--listen", serve.listen, "HOST:PORT")->capture_default_str();
-  s->add_option("--web-root", serve.web_root, "the built page")->capture_default_str();
+  s->add_option("--web-root", serve.web_root,
+                "the built page (default: web/ of the data directory)");
   s->add_flag("--insecure-listen", serve.insecure,
               "allow a non-loopback address (plain HTTP: tokens in clear)");
   s->add_option("--tls-cert", serve.tls_cert,
@@ -147,6 +154,19 @@ int run(int argc, char** argv) {
 
   if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
   const std::string command = app.get_subcommands().front()->get_name();
+  if ((command == "check" && check.machine.empty()) ||
+      (command == "serve" && serve.web_root.empty())) {
+    const DataPaths data = find_data_paths(data_dir, std::getenv("EDM_DATA_DIR"), self_exe());
+    if (data.config_dir.empty()) {
+      return usage(command == "check" ? "no machine config: pass --machine, or --data-dir"
+                                      : "no built page: pass --web-root, or --data-dir");
+    }
+    if (command == "check") {
+      check.machine = (data.config_dir / kDefaultMachine).string();
+    } else {
+      serve.web_root = data.web_root.string();
+    }
+  }
   if (command == "check") return cmd_check(check);
 
   edm::hmi::ConnectionSettings settings;

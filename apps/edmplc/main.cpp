@@ -1,7 +1,8 @@
 // edmplc — the runtime daemon: loads a machine config, runs its tasks on the real or the
 // virtual clock, and on SIGINT/SIGTERM (or --run-for) stops in order: safe state, tasks joined,
 // retain flushed, statistics and trace written. Exit codes: 0 ok, 1 runtime failure or alarm,
-// 2 bad input. See docs/runtime.md.
+// 2 bad input. See docs/runtime.md. Under systemd it tells its readiness and feeds the watchdog
+// (systemd_notify.hpp, docs/deploy.md).
 
 #include <spdlog/spdlog.h>
 
@@ -26,6 +27,7 @@
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/stats_json.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "systemd_notify.hpp"
 
 namespace {
 
@@ -266,6 +268,8 @@ int main(int argc, char** argv) {
   ro.stop = &g_stop;
   ro.trace_out = opt.trace_out;
   int code = kExitOk;
+  edmplc::SystemdNotifier notifier(*rt, g_stop);
+  notifier.start();  // READY=1 once every task cycles, then WATCHDOG=1: off the RT threads
   spdlog::info("running {} task(s) on the {} clock{}", rt->tasks().size(),
                opt.clock == edm::rt::ClockKind::kReal ? "real" : "virtual",
                opt.run_for ? " for " + edm::rt::format_duration(*opt.run_for) : "");
@@ -285,6 +289,7 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
     code = kExitFailure;
   }
+  notifier.stop();
   if (bridge) {
     bridge->stop();  // before the runtime goes: the server reads its machine, job and registry
     bridge.reset();
