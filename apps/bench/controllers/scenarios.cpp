@@ -262,12 +262,18 @@ std::vector<Scenario> make_scenarios(bool quick) {
     // fixed step is a variant, as is a smaller kr and the coarse fixed step of 10 µm/rev.
     RunSpec adaptive = w;
     adaptive.edits = {{"kr: 0.0001,", "kr: 0.00002,"}};
+    RunSpec kr5 = w;  // the sweep that picks kr on the tuning seeds (--first-seed 1000)
+    kr5.edits = {{"kr: 0.0001,", "kr: 0.00005,"}};
+    RunSpec kr20 = w;
+    kr20.edits = {{"kr: 0.0001,", "kr: 0.0002,"}};
     RunSpec fixed2 = w;
     fixed2.edits = {{"dr_max_mm: 0.01", "dr_max_mm: 0.002"}};
     RunSpec coarse = w;
     coarse.edits = {{"kr: 0.0001, dr_max_mm: 0.01", "kr: 1.0, dr_max_mm: 0.01"}};
     s.variants = {{"WallFinish as shipped (eq. 21 live: dr = kr·Tdm, kr 1e-4 mm/µs)", w},
                   {"WallFinish, kr 2e-5 (dr = kr·Tdm ≈ 1 µm/rev)", adaptive},
+                  {"WallFinish, kr 5e-5", kr5},
+                  {"WallFinish, kr 2e-4 (dr_max 10 µm clamps above Tdm 50 µs)", kr20},
                   {"fixed 2 µm step (dr_max 2 µm clamps every step; before issue 20)", fixed2},
                   {"fixed coarse step (kr 1, dr_max 10 µm: 10 µm/rev)", coarse}};
     s.columns = {col("done", &Outcome::reached),
