@@ -1,13 +1,9 @@
 #include "bench_util.hpp"
 
-#include <fcntl.h>
 #include <fmt/core.h>
 #include <unistd.h>
 
-#include <cerrno>
-#include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -54,23 +50,6 @@ std::string child_failure(const std::string& tool, const ChildResult& r, const f
     return {};
   }
   return fmt::format("{}\n{}{}", what, tail_lines(read_file(err), 15), tail_lines(r.out, 5));
-}
-
-/// Same C-state limit for both tools: cyclictest sets it by itself, edmplc does not.
-int hold_pm_qos() {
-  const int fd = open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
-  const std::int32_t zero = 0;
-  if (fd < 0 || write(fd, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
-    fmt::print(
-        "note: cannot hold /dev/cpu_dma_latency at 0 us ({}): edmplc may see deeper "
-        "C-states than cyclictest, which sets it itself\n",
-        std::strerror(errno));
-    if (fd >= 0) {
-      close(fd);
-    }
-    return -1;
-  }
-  return fd;
 }
 
 }  // namespace edm::bench

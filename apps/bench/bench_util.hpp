@@ -1,7 +1,7 @@
 #pragma once
 // What the bench drivers share: a temp directory, a tool run the drivers' way (edm::apps::run with
-// stdout captured and stderr into a file), failure texts with the tool's last lines, the PM QoS
-// hold. Non-RT. Not thread-safe: from the main thread.
+// stdout captured and stderr into a file), failure texts with the tool's last lines. Non-RT.
+// Not thread-safe: from the main thread.
 
 #include <chrono>
 #include <cstddef>
@@ -59,9 +59,5 @@ std::string read_file(const fs::path& path);
 
 /// The last `n` lines of `text`, indented with "    | ", for error messages.
 std::string tail_lines(const std::string& text, std::size_t n);
-
-/// Holds /dev/cpu_dma_latency at 0 us (no deep C-states) until the returned fd is closed; -1 and
-/// a note on stdout when that is not allowed.
-int hold_pm_qos();
 
 }  // namespace edm::bench

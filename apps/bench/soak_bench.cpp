@@ -3,6 +3,8 @@
 //   1. Baseline: edmplc + the job loop for --baseline-minutes, nobody else connected.
 //   2. Soak: a fresh edmplc + the job loop for --minutes, with the hostile clients.
 // Each phase samples edmplc's VmRSS and open fds every second and takes its --stats-out at SIGINT.
+// --memory: one phase only, the job loop alone for --minutes (default 10), and a memory report:
+// VmRSS loaded and idle, after the first job, every minute, at the end; flat or not.
 // Exit: 0 all criteria PASS, 1 a criterion failed (or edmplc crashed), 2 bad arguments.
 #include <arpa/inet.h>
 #include <fmt/core.h>
@@ -51,6 +53,7 @@ struct Options {
   std::uint64_t seed{1};
   int max_stall_s{60};
   std::set<std::string, std::less<>> skip;  // hostile action kinds left out (--skip a,b)
+  bool memory{false};                       // --memory: the job loop alone, a memory report
 };
 
 struct JobRecord {
@@ -429,6 +432,50 @@ void write_samples(const fs::path& path, const Phase& ph) {
   }
 }
 
+constexpr long kMemoryFlatKb = 1024;  // --memory: "flat" = end ≤ after job 1 + 1 MiB
+
+/// --memory: the resident size over a run of the job loop alone. Exit 0 flat, 1 not (or failed).
+int memory_report(const Phase& ph, const fs::path& out) {
+  write_samples(out / "memory-samples.csv", ph);
+  const MemFigures m = mem_figures(ph);
+  const bool ran = ph.crash.empty() && ph.clean_stop && m.rss_ref_kb > 0;
+  // Least-squares slope of VmRSS over the samples from the end of job 1 on, KiB per minute.
+  double n = 0, st = 0, sr = 0, stt = 0, str = 0;
+  for (std::size_t i = ph.ref.value_or(ph.samples.size()); i < ph.samples.size(); ++i) {
+    const double t = ph.samples[i].t_s / 60.0;
+    const auto r = static_cast<double>(ph.samples[i].rss_kb);
+    n += 1;
+    st += t;
+    sr += r;
+    stt += t * t;
+    str += t * r;
+  }
+  const double den = n * stt - st * st;
+  const double slope = n > 1 && den > 0 ? (n * str - st * sr) / den : 0.0;
+  fmt::print("\nmemory (VmRSS of edmplc, drill-sim; the job loop alone, {:.0f} s, {} jobs)\n",
+             ph.seconds, ph.jobs.size());
+  fmt::print("  loaded, idle (bridge up, before job 1)   {:>8} MiB\n", mib(m.rss_start_kb));
+  fmt::print("  after job 1                              {:>8} MiB\n", mib(m.rss_ref_kb));
+  double next_min = 1;
+  for (const auto& smp : ph.samples) {
+    if (smp.t_s >= next_min * 60.0) {
+      fmt::print("  at {:>4.0f} s                                {:>8} MiB\n", smp.t_s,
+                 mib(smp.rss_kb));
+      next_min += 1;
+    }
+  }
+  fmt::print("  end (quiesced)                           {:>8} MiB\n", mib(m.rss_end_kb));
+  fmt::print("  max                                      {:>8} MiB\n", mib(m.rss_max_kb));
+  fmt::print("  slope after job 1                        {:>8.1f} KiB/min\n", slope);
+  const bool flat = ran && m.rss_end_kb <= m.rss_ref_kb + kMemoryFlatKb;
+  fmt::print("  {} flat: end {} MiB <= after job 1 {} MiB + 1 MiB{}\n", flat ? "PASS" : "FAIL",
+             mib(m.rss_end_kb), mib(m.rss_ref_kb),
+             ran ? "" : " (edmplc did not run to the end cleanly: " + ph.crash + ")");
+  fmt::print("  written: {}/memory-samples.csv (t_s, rss_kb, fds), memory/edmplc.log\n",
+             out.string());
+  return flat ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -458,14 +505,31 @@ int main(int argc, char** argv) {
         }
       },
       "hostile kinds not run, KIND,...");
+  app.add_flag("--memory", o.memory, "only the job loop for --minutes (default 10): VmRSS report");
   app.add_option("--max-stall-s", o.max_stall_s, "a job stalled longer fails the soak")
       ->check(edm::apps::kPositive)
       ->capture_default_str();
   if (const auto code = edm::apps::parse(
           app, argc, argv,
           "edm-bench-soak [--root DIR] [--minutes N] [--baseline-minutes M] [--seed S] "
-          "[--max-stall-s S] [--skip KIND,...]")) {
+          "[--max-stall-s S] [--skip KIND,...]\n       edm-bench-soak --memory [--root DIR] "
+          "[--minutes N]")) {
     return *code;
+  }
+  if (o.memory) {
+    if (app.get_option("--minutes")->count() == 0) {
+      o.minutes = 10;
+    }
+    const fs::path out = fs::path(o.root) / "out/bench/memory";
+    fs::create_directories(out);
+    edm::bench::install_stop_handlers();
+    fmt::print("edm-bench-soak --memory: the job loop alone for {} min; output {}\n", o.minutes,
+               out.string());
+    Runner runner(o, out);
+    if (!runner.prepare()) {
+      return 2;
+    }
+    return memory_report(runner.run_phase("memory", o.minutes, false), out);
   }
   if (o.baseline_minutes < 0) {
     o.baseline_minutes = std::min(o.minutes, 5.0);

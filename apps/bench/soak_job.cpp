@@ -61,10 +61,9 @@ std::string soak_config(const std::string& shipped_yaml, std::string& error) {
 
 std::string job_program(const std::string& demo_nc, int k, double worn_mm, std::string& error) {
   std::string p = demo_nc;
-  const bool ok =
-      replace_once(p, "G00 X5 Y5 ",
-                   fmt::format("G00 X{} Y{} ", -95 + 3 * (k % 64), -95 + 3 * (k / 64))) &&
-      replace_once(p, "G00 Z-11.8 ", fmt::format("G00 Z{:.3f} ", -11.8 - worn_mm));
+  const bool ok = replace_once(p, "G00 X5 Y5 ",
+                               fmt::format("G00 X{} Y{} ", 5 + 3 * (k % 30), 5 + 3 * (k / 30))) &&
+                  replace_once(p, "G00 Z-11.8 ", fmt::format("G00 Z{:.3f} ", -11.8 - worn_mm));
   if (!ok) {
     error = "examples/parts/demo.nc changed: 'G00 X5 Y5' or 'G00 Z-11.8' is not there once";
     return {};

@@ -22,11 +22,12 @@ inline constexpr double kSoakElectrodeMm = 1200.0;
 /// on success.
 std::string soak_config(const std::string& shipped_yaml, std::string& error);
 
-/// demo.nc for the k-th job (0-based): a new hole at X = -95 + 3 (k mod 64) mm, Y = -95 + 3 (k /
-/// 64) mm, inside the ±100 mm soft limits (the simulator starts a new hole when the electrode moves
-/// away), and the rapid back into the hole for the wall finish lowered by `worn_mm`, the
-/// electrode worn by the previous jobs (the touch-off an operator does; the dialect has no
-/// tool-length offset).
+/// demo.nc for the k-th job (0-based): a new hole at X = 5 + 3 (k mod 30) mm, Y = 5 + 3 (k / 30)
+/// mm, inside the ±100 mm soft limits and starting where demo.nc drills (a first rapid of 134 mm
+/// to −95, −95 tripped the supervisor's following-error alarm 140), 3 mm apart (the simulator
+/// starts a new hole when the electrode moves away), and the rapid back into the hole for the wall
+/// finish lowered by `worn_mm`, the electrode worn by the previous jobs (the touch-off an operator
+/// does; the dialect has no tool-length offset).
 std::string job_program(const std::string& demo_nc, int k, double worn_mm, std::string& error);
 
 struct JobFigures {

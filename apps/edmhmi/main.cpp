@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cli.hpp"
+#include "cmd_fleet.hpp"
 #include "data_dir.hpp"
 
 namespace edmhmi {
@@ -152,8 +153,12 @@ int run(int argc, char** argv) {
   s->add_flag("--insecure-http", serve.insecure_http,
               "allow plain HTTP on any address even when the bridge uses TLS (tokens in clear)");
 
+  FleetArgs fleet;
+  add_fleet_command(app, fleet);
+
   if (const auto code = edm::apps::parse(app, argc, argv, kUsage)) return *code;
   const std::string command = app.get_subcommands().front()->get_name();
+  if (command == "fleet") return cmd_fleet(fleet);  // MQTT, not the bridge (docs/mqtt.md)
   if ((command == "check" && check.machine.empty()) ||
       (command == "serve" && serve.web_root.empty())) {
     const DataPaths data = find_data_paths(data_dir, std::getenv("EDM_DATA_DIR"), self_exe());

@@ -19,6 +19,8 @@
 
 #include "edm/apps/cli.hpp"
 #include "edm/blocks/register.hpp"
+#include "edm/modbus/driver.hpp"
+#include "edm/modbus/server.hpp"
 #include "edm/bridge/server.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/runtime/config.hpp"
@@ -27,6 +29,7 @@
 #include "edm/runtime/runtime.hpp"
 #include "edm/runtime/stats_json.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "edm/telemetry/publisher.hpp"
 #include "systemd_notify.hpp"
 
 namespace {
@@ -40,6 +43,7 @@ constexpr const char* kUsage =
     "edmplc --config FILE [--clock real|virtual [--speed F]] [--run-for DURATION]\n"
     "              [--stats-out FILE.json] [--trace-out FILE.csv] [--seed N]\n"
     "              [--bridge-port P] [--state-dir DIR] [--check] [--list-vars]\n"
+    "              [--modbus-map]\n"
     "              [--log-level LEVEL]";
 
 std::atomic<bool> g_stop{false};
@@ -58,6 +62,7 @@ struct Options {
   std::string state_dir;  // --state-dir, else $EDM_STATE_DIR: where a relative retain.file lives
   bool check{false};
   bool list_vars{false};
+  bool modbus_map{false};  // print the modbus_server register map and exit
   std::string log_level{"info"};
 };
 
@@ -140,6 +145,8 @@ std::variant<Options, int> parse_args(int argc, char** argv) {
   app.add_flag("--list-vars", o.list_vars,
                "print every variable (name, kind, type, unit, task; parameters also range, "
                "load-time or runtime, description) and exit");
+  app.add_flag("--modbus-map", o.modbus_map,
+               "print the modbus_server register map (docs/modbus.md) and exit");
   app.add_option_function<std::string>(
       "--log-level",
       [&](const std::string& v) {
@@ -182,18 +189,24 @@ int main(int argc, char** argv) {
   edm::rt::DriverRegistry drivers;
   edm::rt::register_runtime_drivers(drivers);
   edm::sim::register_sim_driver(drivers);
+  edm::modbus::register_modbus_driver(drivers);
 
   std::unique_ptr<edm::rt::Runtime> rt;
+  // `mqtt:` (docs/mqtt.md), checked against the built runtime's variables.
+  std::optional<edm::telemetry::MqttConfig> mqtt_cfg;
+  std::optional<edm::modbus::ServerConfig> modbus_cfg;  // `modbus_server:` (docs/modbus.md)
   try {
     edm::rt::Config cfg = edm::rt::parse_config_file(opt.config);
     edm::rt::BuildOptions bo;
     bo.seed = opt.seed;
-    bo.load_retain = !opt.check && !opt.list_vars;
+    bo.load_retain = !opt.check && !opt.list_vars && !opt.modbus_map;
     bo.state_dir = opt.state_dir;
     if (const char* env = std::getenv("EDM_STATE_DIR"); bo.state_dir.empty() && env != nullptr) {
       bo.state_dir = env;  // the packaging's seam (systemd StateDirectory=, docs/runtime.md)
     }
     rt = edm::rt::Runtime::build(cfg, blocks, drivers, bo);
+    mqtt_cfg = edm::telemetry::load_mqtt_config(rt->config(), rt->variables());
+    modbus_cfg = edm::modbus::load_server_config(rt->config(), rt->variables());
   } catch (const edm::rt::ConfigError& e) {
     edm::rt::shutdown_logging();
     print_diagnostics(e);
@@ -224,6 +237,15 @@ int main(int argc, char** argv) {
     edm::rt::shutdown_logging();
     std::cout << opt.config << ": OK (" << rt->tasks().size() << " tasks, " << n_blocks
               << " blocks, " << rt->variables().all().size() << " variables)\n";
+    return kExitOk;
+  }
+  if (opt.modbus_map) {
+    edm::rt::shutdown_logging();
+    if (!modbus_cfg) {
+      std::cerr << opt.config << ": no modbus_server section\n";
+      return kExitBadInput;
+    }
+    std::cout << edm::modbus::format_register_map(*modbus_cfg);
     return kExitOk;
   }
   if (opt.list_vars) {
@@ -261,6 +283,26 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 
+  std::unique_ptr<edm::modbus::Server> modbus_server;  // its own thread, never the RT ones
+  if (modbus_cfg) {
+    modbus_server = std::make_unique<edm::modbus::Server>(rt->variables(), *modbus_cfg);
+    try {
+      modbus_server->start();
+    } catch (const std::exception& e) {
+      spdlog::error("{}", e.what());
+      modbus_server.reset();
+      if (bridge) {
+        bridge->stop();
+        bridge.reset();
+      }
+      rt.reset();
+      edm::rt::shutdown_logging();
+      return kExitBadInput;
+    }
+  }
+  std::unique_ptr<edm::telemetry::Publisher> mqtt;  // its own thread, never the RT ones
+  if (mqtt_cfg) (mqtt = std::make_unique<edm::telemetry::Publisher>(*rt, *mqtt_cfg))->start();
+
   edm::rt::RunOptions ro;
   ro.speed = opt.speed;
   ro.clock = opt.clock;
@@ -290,6 +332,9 @@ int main(int argc, char** argv) {
     code = kExitFailure;
   }
   notifier.stop();
+  // DDEATH + NDEATH with the final state, before the runtime goes.
+  mqtt.reset();
+  modbus_server.reset();  // before the runtime goes: it reads and writes its registry
   if (bridge) {
     bridge->stop();  // before the runtime goes: the server reads its machine, job and registry
     bridge.reset();

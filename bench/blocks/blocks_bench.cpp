@@ -19,6 +19,7 @@
 #include <random>
 #include <string_view>
 
+#include "bench_support.hpp"
 #include "edm/blocks/discharge_state_counter.hpp"
 #include "edm/blocks/fuzzy_servo_lut.hpp"
 #include "edm/blocks/gain.hpp"
@@ -34,110 +35,7 @@
 namespace edm::blocks {
 namespace {
 
-using namespace std::chrono_literals;
-
-constexpr int kBatch = 64;
-constexpr std::size_t kTableSize = 4096;  // power of two: index with a mask
-constexpr rt::Duration kPeriod = 1ms;
-
-const std::array<double, kTableSize>& input_table() {
-  static const auto table = [] {
-    std::array<double, kTableSize> t{};
-    std::mt19937_64 rng(42);
-    std::uniform_real_distribution<double> d(-10.0, 10.0);
-    for (double& x : t) {
-      x = d(rng);
-    }
-    return t;
-  }();
-  return table;
-}
-
-// Finds a pin by name (the benchmark wires blocks the way the loader does, through visit_pins).
-class PinFinder final : public rt::PinVisitor {
- public:
-  explicit PinFinder(std::string_view name) : name_(name) {}
-  rt::PinRef found;
-
- protected:
-  void on_pin(std::string_view name, rt::PinRef ref, std::string_view /*unit*/) override {
-    if (name == name_) {
-      found = ref;
-    }
-  }
-
- private:
-  std::string_view name_;
-};
-
-rt::PinRef pin_of(rt::Block& b, std::string_view name) {
-  PinFinder f(name);
-  b.visit_pins(f);
-  return f.found;
-}
-
-// Non-RT setup in the runtime's order; aborts the benchmark on a configuration error.
-template <class B>
-bool start(benchmark::State& state, B& block, const typename B::Params& p) {
-  block.set_params(p);
-  if (!block.validate().empty() || !block.configure({"bench.block", kPeriod}).empty()) {
-    state.SkipWithError("block configuration refused");
-    return false;
-  }
-  block.commit_params();
-  block.activate();
-  return true;
-}
-
-// Per-cycle means of the timed batches: 0.25 ns buckets up to 1 µs, the exact maximum beyond.
-class BatchHistogram {
- public:
-  void add(double ns) {
-    const auto bucket = static_cast<std::size_t>(std::max(ns, 0.0) / kBucketNs);
-    ++counts_[std::min(bucket, kBuckets)];
-    ++total_;
-    max_ns_ = std::max(max_ns_, ns);
-  }
-  [[nodiscard]] double percentile(double q) const {
-    const auto rank = static_cast<std::uint64_t>(q * static_cast<double>(total_));
-    std::uint64_t seen = 0;
-    for (std::size_t i = 0; i < kBuckets; ++i) {
-      seen += counts_[i];
-      if (seen > rank) {
-        return std::min(static_cast<double>(i + 1) * kBucketNs, max_ns_);
-      }
-    }
-    return max_ns_;
-  }
-  [[nodiscard]] double max_ns() const { return max_ns_; }
-
- private:
-  static constexpr double kBucketNs = 0.25;
-  static constexpr std::size_t kBuckets = 4096;
-  std::array<std::uint64_t, kBuckets + 1> counts_{};  // last one: beyond 1 µs
-  std::uint64_t total_{0};
-  double max_ns_{0.0};
-};
-
-// Runs one_cycle once per benchmark iteration; see the file comment for what is reported.
-template <class Fn>
-void run_cycles(benchmark::State& state, Fn&& one_cycle) {
-  BatchHistogram hist;
-  int in_batch = 0;
-  auto t0 = std::chrono::steady_clock::now();
-  for (auto _ : state) {
-    one_cycle();
-    if (++in_batch == kBatch) {
-      const auto t1 = std::chrono::steady_clock::now();
-      hist.add(std::chrono::duration<double, std::nano>(t1 - t0).count() / kBatch);
-      t0 = t1;
-      in_batch = 0;
-    }
-  }
-  state.counters["p50_ns"] = hist.percentile(0.50);
-  state.counters["p99_ns"] = hist.percentile(0.99);
-  state.counters["max_ns"] = hist.max_ns();
-}
+using namespace edm::bench;
 
 // Runs block b once per iteration with `source` fed from the random table; `per_cycle(cycle)`
 // sets any further inputs before each update.
@@ -333,7 +231,8 @@ void BM_FuzzyMamdaniDirect(benchmark::State& state) {
   const fuzzy::MamdaniEngine& engine = *block.engine();
   const auto& pairs = count_pairs();
   std::uint64_t cycle = 0;
-  run_cycles(state, [&] {
+  // ~1 µs a call: timed one by one (batch means beyond 1 µs would read as the maximum).
+  run_timed(state, [&] {
     const CountPair& c = pairs[cycle & (kTableSize - 1)];
     const double x[3] = {static_cast<double>(c.open), static_cast<double>(c.shorts),
                          static_cast<double>(32 - c.open - c.shorts)};

@@ -11,6 +11,12 @@ TimePoint RealClock::now() const noexcept {
   return TimePoint{static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec};
 }
 
+Duration RealClock::thread_cpu_time() const noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return Duration{static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec};
+}
+
 void RealClock::sleep_until(TimePoint t) noexcept {
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(t.count() / 1'000'000'000);

@@ -34,8 +34,10 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
                       Reader::describe(root));
     return;
   }
-  auto m = r_.map(
-      top, {"version", "machine", "conditions", "tasks", "programs", "trace", "bridge", "retain"});
+  // `mqtt` is read by the telemetry library (telemetry/, docs/mqtt.md), `modbus_server` by the
+  // modbus library (modbus/, docs/modbus.md); only their places are kept.
+  auto m = r_.map(top, {"version", "machine", "conditions", "tasks", "programs", "trace", "bridge",
+                        "retain", "mqtt", "modbus_server"});
   if (const Field* f = r_.require(*m, "version")) {
     auto v = r_.integer(f->value, 0, INT64_MAX);
     if (!v) {
@@ -85,6 +87,12 @@ void Parser::parse_document(const YAML::Node& root, Config& cfg) {
   }
   if (const Field* f = m->find("retain")) {
     parse_retain(f->value, cfg.retain);
+  }
+  if (const Field* f = m->find("mqtt")) {
+    cfg.mqtt_loc = f->key_loc;
+  }
+  if (const Field* f = m->find("modbus_server")) {
+    cfg.modbus_server_loc = f->key_loc;
   }
   cross_check(cfg);
 }

@@ -52,6 +52,11 @@ class Parser {
  private:
   void parse_machine(const Value& v, MachineSpec& out);
   void parse_io(const Value& v, IoSpec& out);
+  // config_io.cpp: a driver's pin map and a composite's drivers.
+  void parse_io_extras(const MapView& m, IoSpec& out);
+  void parse_io_child(const Value& v, IoSpec& out);
+  void parse_pin_map(const Value& v, std::vector<PinMapSpec>& out);
+  void parse_realtime(const Value& v, RealtimeSpec& out);
   void parse_safety(const Value& v, MachineSpec& machine);  // config_safety.cpp
   void parse_safety_axis(const Value& v, const MachineSpec& machine, SafetyAxisSpec& out);
   std::optional<NameRef> io_pin_name(const Value& v);

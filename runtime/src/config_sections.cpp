@@ -20,7 +20,7 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "io", "axes", "safety"});
+  auto m = r_.map(v, {"name", "io", "axes", "safety", "realtime"});
   if (!m) {
     return;
   }
@@ -38,12 +38,54 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
   if (const Field* f = m->find("safety")) {
     parse_safety(f->value, out);  // after the axes: it names them
   }
+  if (const Field* f = m->find("realtime")) {
+    parse_realtime(f->value, out.realtime);
+  }
+}
+
+void Parser::parse_realtime(const Value& v, RealtimeSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"pm_qos_latency", "pm_qos_device", "lock_memory"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = m->find("pm_qos_latency")) {
+    // The kernel takes a whole number of microseconds (an s32); `off` makes no request.
+    const std::string text = f->value.node.IsScalar() ? f->value.node.Scalar() : "";
+    if (text == "off" && !Reader::is_quoted(f->value.node)) {
+      out.pm_qos_latency_us.reset();
+    } else if (auto d = r_.duration(f->value)) {
+      constexpr std::int64_t kMaxUs = 2'000'000'000;  // the kernel's own default (2000 s)
+      const std::int64_t ns = d->count();
+      if (ns % 1000 != 0) {
+        r_.error(f->value, "must be whole microseconds (got " + text + ")");
+      } else if (ns / 1000 > kMaxUs) {
+        r_.error(f->value, "must be <= 2000s (got " + text + ")");
+      } else {
+        out.pm_qos_latency_us = static_cast<std::int32_t>(ns / 1000);
+      }
+    }
+  }
+  if (const Field* f = m->find("pm_qos_device")) {
+    if (auto s = r_.string(f->value)) {
+      if (s->front() != '/') {
+        r_.error(f->value, "must be an absolute path (got " + yaml_util::quote(*s) + ")");
+      } else {
+        out.pm_qos_device = *s;
+      }
+    }
+  }
+  if (const Field* f = m->find("lock_memory")) {
+    if (auto s = r_.choice(f->value, {"true", "false"})) {
+      out.lock_memory = *s == "true";
+    }
+  }
 }
 
 void Parser::parse_io(const Value& v, IoSpec& out) {
   out.loc = v.loc;
   out.driver_loc = v.loc;
-  auto m = r_.map(v, {"driver", "task", "params"});
+  auto m = r_.map(v, {"driver", "task", "params", "pins", "drivers"});
   if (!m) {
     return;
   }
@@ -61,6 +103,7 @@ void Parser::parse_io(const Value& v, IoSpec& out) {
   if (const Field* f = m->find("params")) {
     parse_params(f->value, out.params);
   }
+  parse_io_extras(*m, out);  // config_io.cpp: pins, drivers (composite)
 }
 
 void Parser::parse_task(const Value& v, TaskSpec& out) {
@@ -121,7 +164,7 @@ void Parser::parse_task(const Value& v, TaskSpec& out) {
 
 void Parser::parse_watchdog(const Value& v, WatchdogSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"time", "sensitivity", "action"});
+  auto m = r_.map(v, {"time", "sensitivity", "action", "host_stall"});
   if (!m) {
     return;
   }
@@ -139,6 +182,11 @@ void Parser::parse_watchdog(const Value& v, WatchdogSpec& out) {
   if (const Field* f = m->find("action")) {
     if (auto s = r_.choice(f->value, {"fault", "warn"})) {
       out.action = *s == "warn" ? WatchdogAction::kWarn : WatchdogAction::kFault;
+    }
+  }
+  if (const Field* f = m->find("host_stall")) {
+    if (auto s = r_.choice(f->value, {"fault", "tolerate"})) {
+      out.host_stall = *s == "tolerate" ? HostStallPolicy::kTolerate : HostStallPolicy::kFault;
     }
   }
 }

@@ -52,12 +52,18 @@ std::string_view to_string(AlarmCode c) noexcept {
       return "watchdog";
     case AlarmCode::kWatchdogWarning:
       return "watchdog_warning";
+    case AlarmCode::kHostStall:
+      return "host_stall";
     case AlarmCode::kBlockFault:
       return "block_fault";
     case AlarmCode::kIoFault:
       return "io_fault";
+    case AlarmCode::kIoStale:
+      return "io_stale";
     case AlarmCode::kEstop:
       return "estop";
+    case AlarmCode::kInterlockOpen:
+      return "interlock_open";
     case AlarmCode::kFollowingError:
       return "following_error";
     case AlarmCode::kSoftLimit:

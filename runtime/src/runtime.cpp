@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "edm/runtime/rt_environment.hpp"
 #include "edm/runtime/scheduler.hpp"
 
 namespace edm::rt {
@@ -88,6 +89,16 @@ RunSummary Runtime::run(const RunOptions& options) {
     machine_.raise(a);
     job_alarm_raised_ = true;
   }
+  for (const auto& t : tasks_) {
+    const WatchdogSpec& w = t->spec().watchdog;
+    if (w.enabled && w.host_stall == HostStallPolicy::kTolerate) {
+      spdlog::info(
+          "task '{}': host stalls tolerated (watchdog host_stall: tolerate): a cycle late only "
+          "because the host descheduled the process is warning 102, not a watchdog fault; a "
+          "setting for simulated machines",
+          t->name());
+    }
+  }
   if (options.trace_out.empty()) {
     // Nobody drains the rings without a trace file: don't sample, don't count drops.
     for (auto& t : tasks_) {
@@ -96,6 +107,19 @@ RunSummary Runtime::run(const RunOptions& options) {
     has_trace_ = false;
   }
   RunSummary summary;
+  // A field-bus driver's own thread runs while the tasks do (io_driver.hpp); stopped last, after
+  // the tasks' final safe state, so that it can still send the safe outputs.
+  struct DriverRun {
+    IoDriver* driver;
+    ~DriverRun() {
+      if (driver != nullptr) {
+        driver->stop();
+      }
+    }
+  } const driver_run{driver_.get()};
+  if (driver_) {
+    driver_->start();
+  }
   const auto stop_requested = [&] {
     return options.stop != nullptr && options.stop->load(std::memory_order_relaxed);
   };
@@ -139,10 +163,8 @@ RunSummary Runtime::run(const RunOptions& options) {
       trace_.drain(trace_file);
     }
   } else {
-    const std::string mlock_warning = lock_memory();
-    if (!mlock_warning.empty()) {
-      spdlog::warn("{}", mlock_warning);
-    }
+    // Held until the tasks have stopped (end of this block): PM QoS request, locked memory.
+    RtEnvironment rt_env(config_.machine.realtime);
     RealClock clock;
     if (!options.trace_out.empty() && has_trace_) {
       trace_.start_file_writer(options.trace_out);
@@ -152,6 +174,7 @@ RunSummary Runtime::run(const RunOptions& options) {
     }
     RealTimeScheduler sched;
     sched.start(tasks, clock, options.run_for);
+    rt_env.report_threads(sched.thread_setups());
     // With run_for the tasks stop by themselves at T0 + run_for (exact cycle counts); the
     // controlling thread only watches the time and the stop flag.
     const TimePoint deadline = sched.end();
@@ -173,6 +196,15 @@ RunSummary Runtime::run(const RunOptions& options) {
     retain_->stop();
   }
   drain_alarms();
+  for (const auto& t : tasks_) {
+    if (const std::uint64_t n = t->host_stalls(); n > 0) {
+      spdlog::warn("task '{}': {} host stall(s), the longest cycle {:.3f} ms ({})", t->name(), n,
+                   to_micros(t->longest_host_stall()) / 1000.0,
+                   t->spec().watchdog.host_stall == HostStallPolicy::kTolerate
+                       ? "tolerated"
+                       : "judged by the watchdog");
+    }
+  }
   summary.final_state = machine_.state();
   summary.trace_dropped = has_trace_ ? trace_.dropped() : 0;
   summary.alarms_dropped = machine_.dropped_alarms();

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <map>
 
+#include "edm/runtime/composite_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "param_reader.hpp"
 #include "retain_builder.hpp"
@@ -136,32 +137,112 @@ class RuntimeBuilder {
 
   void make_driver() {
     const IoSpec& io = cfg_.machine.io;
-    rt_->driver_ = driver_types_.create(io.driver);
-    if (!rt_->driver_) {
-      diag_.error(io.driver_loc, "machine.io.driver: unknown I/O driver '" + io.driver +
-                                     "' (known: " + join_names(driver_types_.names()) + ")");
-      return;
-    }
-    const std::string what = "I/O driver '" + io.driver + "'";
-    read_params(*rt_->driver_, io.params, what, diag_);
-    report_validation(*rt_->driver_, io.params, what, io.loc, diag_);
-    if (options_.seed && !rt_->driver_->set_seed(*options_.seed)) {
-      diag_.error(SourceLoc{cfg_.path, 0, 0},
-                  "--seed: the '" + io.driver + "' driver has no random seed");
-    }
-    if (!diag_.empty()) {
-      return;
-    }
     const Duration period = io_task_ != nullptr ? io_task_->spec().interval : Duration{};
-    report_param_errors(rt_->driver_->configure(setup("io", period)), io.params, what, io.loc,
-                        diag_);
+    bool configured = false;
+    if (io.driver == "composite") {
+      auto composite = std::make_unique<CompositeDriver>();
+      bool seeded = false;
+      configured = true;
+      for (const IoSpec& child : io.drivers) {
+        std::unique_ptr<IoDriver> d;
+        const std::string what =
+            "I/O driver '" + (child.name.empty() ? child.driver : child.name) + "'";
+        configured = make_one_driver(child, what, period, seeded, d) && configured;
+        if (!d) {
+          return;  // unknown type (reported): io.* names would only add noise
+        }
+        composite->add(child.name, std::move(d));
+      }
+      ParamLister params;
+      composite->visit_params(params);
+      std::map<std::string, int> seen;
+      for (const ParamLister::Field& f : params.fields) {
+        if (++seen[f.name] == 2) {
+          diag_.error(io.loc, "machine.io: parameter 'io." + f.name +
+                                  "' is declared by two drivers (give one a `name:`)");
+        }
+      }
+      rt_->driver_ = std::move(composite);
+      if (options_.seed && !seeded) {
+        diag_.error(SourceLoc{cfg_.path, 0, 0}, "--seed: no driver of the composite has a seed");
+      }
+    } else {
+      bool seeded = false;
+      configured = make_one_driver(io, "I/O driver '" + io.driver + "'", period, seeded,
+                                   rt_->driver_);
+    }
+    if (!configured) {
+      return;
+    }
     std::vector<std::string> names;
     PinCollector pc("io", io_task_, pins_, names);
     rt_->driver_->visit_pins(pc);
+    for (const auto& d : pc.duplicates) {
+      diag_.error(io.loc, "machine.io: pin '" + d + "' is declared by two drivers (rename one)");
+    }
     if (io_task_ != nullptr) {
       io_task_->attach_driver(*rt_->driver_);
     }
     block_pin_names_["io"] = names;
+  }
+
+  // Creates one driver (`out`, null for an unknown type) from its spec: parameters, pin map,
+  // seed and configure(), every problem located. True when it was configured (its pins can be
+  // collected); `seeded` is set when it took --seed.
+  bool make_one_driver(const IoSpec& io, const std::string& what, Duration period, bool& seeded,
+                       std::unique_ptr<IoDriver>& out) {
+    out = driver_types_.create(io.driver);
+    if (!out) {
+      std::vector<std::string> known = driver_types_.names();
+      known.emplace_back("composite");
+      diag_.error(io.driver_loc, "machine.io.driver: unknown I/O driver '" + io.driver +
+                                     "' (known: " + join_names(known) + ")");
+      return false;
+    }
+    IoDriver& d = *out;
+    read_params(d, io.params, what, diag_);
+    report_validation(d, io.params, what, io.loc, diag_);
+    if (!io.pins.empty() && !d.has_pin_map()) {
+      diag_.error(io.pins.front().loc, what + ": this driver has no pin map (`pins:`)");
+    } else if (d.has_pin_map()) {
+      report_pin_map(io, what, d);
+    }
+    if (options_.seed) {
+      if (d.set_seed(*options_.seed)) {
+        seeded = true;
+      } else if (cfg_.machine.io.driver != "composite") {  // a child of one may have none
+        diag_.error(SourceLoc{cfg_.path, 0, 0},
+                    "--seed: the '" + io.driver + "' driver has no random seed");
+      }
+    }
+    if (!diag_.empty()) {
+      return false;
+    }
+    report_param_errors(d.configure(setup("io", period)), io.params, what, io.loc, diag_);
+    return true;
+  }
+
+  void report_pin_map(const IoSpec& io, const std::string& what, IoDriver& d) {
+    std::vector<PinMapEntry> entries;
+    for (const PinMapSpec& e : io.pins) {
+      PinMapEntry entry;
+      for (const ParamSetting& f : e.fields) {
+        entry.push_back({f.key, f.value, f.quoted});
+      }
+      entries.push_back(std::move(entry));
+    }
+    for (const PinMapError& e : d.set_pin_map(entries)) {
+      SourceLoc loc = e.entry < io.pins.size() ? io.pins[e.entry].loc : io.loc;
+      if (e.entry < io.pins.size()) {
+        for (const ParamSetting& f : io.pins[e.entry].fields) {
+          if (f.key == e.key) {
+            loc = f.value_loc;
+          }
+        }
+      }
+      diag_.error(loc, what + ": pins[" + std::to_string(e.entry) + "]" +
+                           (e.key.empty() ? "" : "." + e.key) + ": " + e.message);
+    }
   }
 
   // The safety supervisor watches and drives the driver's pins on the I/O task.

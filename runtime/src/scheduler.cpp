@@ -2,42 +2,21 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <spdlog/spdlog.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <csignal>
-#include <cstring>
 #include <stdexcept>
 
+#include "edm/runtime/rt_environment.hpp"
 #include "edm/runtime/scheduling.hpp"
 
 namespace edm::rt {
 
 namespace {
 
-constexpr std::size_t kPrefaultStackBytes = 256 * 1024;
 constexpr Duration kStartLead = std::chrono::milliseconds(5);
 
-// Touches the stack the RT loop will use so it never page-faults mid-cycle.
-[[gnu::noinline]] void prefault_stack() {
-  volatile unsigned char buf[kPrefaultStackBytes];
-  for (std::size_t i = 0; i < kPrefaultStackBytes; i += 4096) {
-    buf[i] = 0;
-  }
-  (void)buf[0];
-}
-
 }  // namespace
-
-std::string lock_memory() {
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    return std::string("mlockall failed (") + std::strerror(errno) +
-           "): page faults may add latency; run as root or raise RLIMIT_MEMLOCK";
-  }
-  return {};
-}
 
 void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& clock,
                               std::optional<Duration> run_for) {
@@ -52,8 +31,10 @@ void RealTimeScheduler::start(const std::vector<Task*>& tasks, const RealClock& 
   }
   ready_.store(0);
   t0_ns_.store(0);
-  for (Task* t : tasks) {
-    threads_.emplace_back([this, t] { task_main(*t); });
+  setups_.assign(tasks.size(), ThreadSetup{});
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    Task* t = tasks[i];
+    threads_.emplace_back([this, t, i] { task_main(*t, i); });
   }
   // The origin is chosen only once every thread runs at its RT priority with a pre-faulted
   // stack, so the first release is not late because of our own start-up.
@@ -82,7 +63,7 @@ void RealTimeScheduler::stop() {
   threads_.clear();
 }
 
-void RealTimeScheduler::task_main(Task& task) noexcept {
+void RealTimeScheduler::task_main(Task& task, std::size_t index) noexcept {
   const TaskSpec& spec = task.spec();
   // Signals go to the controlling thread, never into an RT cycle.
   sigset_t block;
@@ -91,27 +72,12 @@ void RealTimeScheduler::task_main(Task& task) noexcept {
   sigaddset(&block, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &block, nullptr);
   pthread_setname_np(pthread_self(), spec.name.substr(0, 15).c_str());
-  sched_param sp{};
-  sp.sched_priority = fifo_priority(spec.priority);
-  const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
-  if (rc != 0) {
+  // SCHED_FIFO, affinity and stack; the controlling thread reports them (rt_environment.hpp).
+  ThreadSetup& setup = setups_[index];
+  setup = setup_task_thread(spec);
+  if (setup.fifo_error != 0) {
     degraded_.store(true);
-    if (!warned_.exchange(true)) {
-      spdlog::warn(
-          "SCHED_FIFO refused ({}): tasks run under SCHED_OTHER and release jitter will be "
-          "large. Run as root, with CAP_SYS_NICE, or raise RLIMIT_RTPRIO.",
-          std::strerror(rc));
-    }
   }
-  if (spec.cpu) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(static_cast<std::size_t>(*spec.cpu), &set);
-    if (pthread_setaffinity_np(pthread_self(), sizeof set, &set) != 0) {
-      spdlog::warn("task '{}': could not pin to cpu {}", spec.name, *spec.cpu);
-    }
-  }
-  prefault_stack();
   ready_.fetch_add(1);
   t0_ns_.wait(0);
 

@@ -35,6 +35,7 @@ Supervisor::Supervisor(Machine& machine, SupervisorSetup setup, Duration period)
       wire_broken_(setup.wire_broken),
       generator_(std::move(setup.generator)),
       manual_(setup.manual),
+      period_(period),
       dt_s_(to_seconds(period)) {
   for (std::size_t k = 0; k < axes_.size(); ++k) {
     axes_[k].cfg = setup.axes[k];
@@ -101,6 +102,7 @@ void Supervisor::check_axis(Axis& a, TimePoint now, bool track) noexcept {
   if (!track || !a.tracking) {
     a.x_cmd_mm = x;  // (re)start the model where the axis is
     a.v_cmd_mm_s = 0.0;
+    a.v_target_mm_s = 0.0;
     a.tracking = track;
   }
 
@@ -153,6 +155,25 @@ double Supervisor::limit_command(Axis& a, TimePoint now) noexcept {
   return v;
 }
 
+void Supervisor::advance_model(Axis& a, double v) const noexcept {
+  const double dv = a.cfg.limits.a_max_mm_s2 * dt_s_;
+  a.v_cmd_mm_s += std::clamp(v - a.v_cmd_mm_s, -dv, dv);
+  a.x_cmd_mm += a.v_cmd_mm_s * dt_s_;
+}
+
+std::int64_t Supervisor::omitted_since_last(TimePoint release) noexcept {
+  std::int64_t omitted = 0;
+  if (have_release_ && release > last_release_ && period_.count() > 0) {
+    omitted = (release - last_release_) / period_ - 1;
+    if (omitted > 9) {
+      omitted = 0;  // a pause (the task stopped), not a drive running on
+    }
+  }
+  have_release_ = true;
+  last_release_ = release;
+  return omitted;
+}
+
 void Supervisor::supervise(const CycleContext& ctx) noexcept {
   const MachineState before = machine_.state();
   bool track = before != MachineState::kOff && !is_safe_state(before);
@@ -161,6 +182,13 @@ void Supervisor::supervise(const CycleContext& ctx) noexcept {
     if (epoch != epoch_seen_) {  // an encoder was set: the readings jumped, restart the models
       epoch_seen_ = epoch;
       for (Axis& a : axes_) a.tracking = false;
+    }
+  }
+  // Omitted cycles (a late cycle on a busy host): the drives followed the last command meanwhile.
+  const std::int64_t omitted = omitted_since_last(ctx.release);
+  for (Axis& a : axes_) {
+    for (std::int64_t k = 0; a.tracking && k < omitted; ++k) {
+      advance_model(a, a.v_target_mm_s);
     }
   }
   check_machine(ctx.release);
@@ -189,9 +217,8 @@ void Supervisor::supervise(const CycleContext& ctx) noexcept {
       a.cfg.velocity->end_supervision();
     }
     if (a.tracking && !is_safe_state(s)) {
-      const double dv = a.cfg.limits.a_max_mm_s2 * dt_s_;
-      a.v_cmd_mm_s += std::clamp(v - a.v_cmd_mm_s, -dv, dv);
-      a.x_cmd_mm += a.v_cmd_mm_s * dt_s_;
+      a.v_target_mm_s = v;
+      advance_model(a, v);
     } else {
       a.tracking = false;
     }

@@ -46,6 +46,9 @@ void Task::enter_safe_state_now(const SafeStateRequest& r) noexcept {
 
 TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   const TimePoint start = clock.now();
+  // The thread's CPU time, to tell a host stall from an overrun (judge_cycle); only for a task
+  // with a watchdog (one system call on the real clock).
+  const Duration cpu_start = watchdog_.enabled() ? clock.thread_cpu_time() : Duration{};
   apply_pending_param_writes();
 
   machine_->note_release(release);
@@ -110,6 +113,48 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
   const TimePoint end = clock.now();
   const Duration exec = end - start;
   stats_.record_cycle(start - release, exec);
+  judge_cycle(release, exec, clock, cpu_start);
+  cycle_.store(cycle + 1, std::memory_order_relaxed);
+  return end;
+}
+
+void Task::judge_cycle(TimePoint release, Duration exec, const Clock& clock,
+                       Duration cpu_start) noexcept {
+  if (!watchdog_.enabled()) {
+    return;
+  }
+  // A cycle over `time` whose own CPU time stayed within it was late because the thread did not
+  // run (the process descheduled, the hypervisor's vCPU stolen), not because of its work.
+  bool stalled = false;
+  if (exec > spec_.watchdog.time) {
+    const Duration cpu = clock.thread_cpu_time() - cpu_start;
+    stalled = cpu <= spec_.watchdog.time;
+  }
+  if (stalled) {
+    host_stalls_.fetch_add(1, std::memory_order_relaxed);
+    const auto stall_ns = exec.count();
+    if (stall_ns > longest_stall_ns_.load(std::memory_order_relaxed)) {
+      longest_stall_ns_.store(stall_ns, std::memory_order_relaxed);
+    }
+    stall_latched_ = true;
+    Alarm a;
+    a.code = AlarmCode::kHostStall;
+    a.severity = AlarmSeverity::kWarning;
+    a.time = release;
+    a.source = spec_.name.c_str();
+    a.value = to_micros(exec);
+    a.text = spec_.watchdog.host_stall == HostStallPolicy::kTolerate
+                 ? "host stall: the task was descheduled in its cycle (tolerated: host_stall)"
+                 : "host stall: the task was descheduled in its cycle (judged by the watchdog)";
+    machine_->raise(a);
+    if (spec_.watchdog.host_stall == HostStallPolicy::kTolerate) {
+      return;  // neither counted against the watchdog nor ending an overload
+    }
+  } else if (stall_latched_ && exec <= spec_.watchdog.time) {
+    stall_latched_ = false;
+    machine_->clear_alarm(AlarmCode::kHostStall, spec_.name.c_str());
+  }
+
   if (watchdog_.check(exec) != WatchdogVerdict::kTrip) {
     // Only a cycle in time ends the occurrence; an overload that goes on is one alarm, counted.
     if (watchdog_tripped_ && watchdog_.consecutive() == 0) {
@@ -117,26 +162,24 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
       machine_->clear_alarm(AlarmCode::kWatchdog, spec_.name.c_str());
       machine_->clear_alarm(AlarmCode::kWatchdogWarning, spec_.name.c_str());
     }
-  } else {
-    watchdog_tripped_ = true;
-    Alarm a;
-    a.time = release;
-    a.source = spec_.name.c_str();
-    a.value = to_micros(exec);
-    if (spec_.watchdog.action == WatchdogAction::kFault) {
-      a.code = AlarmCode::kWatchdog;
-      a.severity = AlarmSeverity::kFault;
-      a.text = "watchdog: cycle execution time exceeded";
-    } else {
-      a.code = AlarmCode::kWatchdogWarning;
-      a.severity = AlarmSeverity::kWarning;
-      a.text = "watchdog warning: cycle execution time exceeded";
-      watchdog_warnings_.fetch_add(1, std::memory_order_relaxed);
-    }
-    machine_->raise(a);
+    return;
   }
-  cycle_.store(cycle + 1, std::memory_order_relaxed);
-  return end;
+  watchdog_tripped_ = true;
+  Alarm a;
+  a.time = release;
+  a.source = spec_.name.c_str();
+  a.value = to_micros(exec);
+  if (spec_.watchdog.action == WatchdogAction::kFault) {
+    a.code = AlarmCode::kWatchdog;
+    a.severity = AlarmSeverity::kFault;
+    a.text = "watchdog: cycle execution time exceeded";
+  } else {
+    a.code = AlarmCode::kWatchdogWarning;
+    a.severity = AlarmSeverity::kWarning;
+    a.text = "watchdog warning: cycle execution time exceeded";
+    watchdog_warnings_.fetch_add(1, std::memory_order_relaxed);
+  }
+  machine_->raise(a);
 }
 
 }  // namespace edm::rt

@@ -91,7 +91,10 @@ trace_hash() {
   sha256sum < "$csv" | cut -d' ' -f1
 }
 
-configs=$(cd "$root" && ls config/machines/*.yaml config/bench/controllers/*.yaml)
+# A config that needs outside equipment (a Modbus remote I/O: drill-modbus-sim.yaml, tested in
+# tests/modbus/) says `edm-reference: skip` in a comment and has no reference.
+configs=$(cd "$root" && grep -L 'edm-reference: skip' config/machines/*.yaml \
+  config/bench/controllers/*.yaml)
 status=0
 if [ "$mode" = record ]; then
   : > "$tmp/sums"

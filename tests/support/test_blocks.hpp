@@ -1,6 +1,8 @@
 #pragma once
 // Blocks used only by tests: they record what the scheduler did and inject execution time.
 
+#include <time.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -75,6 +77,83 @@ class Cost final : public rt::BlockWithParams<CostParams> {
     if (active && ctx.clock != nullptr && ctx.clock->kind() == rt::ClockKind::kVirtual) {
       auto* vc = const_cast<rt::VirtualClock*>(static_cast<const rt::VirtualClock*>(ctx.clock));
       vc->advance(rt::Duration{static_cast<std::int64_t>(params_.cost_us * 1000.0)});
+    }
+    return rt::BlockStatus::kOk;
+  }
+};
+
+/// Cycles [from_cycle, from_cycle + cycles) of a block's task (cycles < 0: forever).
+struct InjectWindow {
+  std::int64_t from_cycle{0};
+  std::int64_t cycles{-1};
+  void visit(rt::ParamVisitor& v) {
+    v.param("from_cycle", from_cycle);
+    v.param("cycles", cycles);
+  }
+  [[nodiscard]] bool active(std::uint64_t cycle) const {
+    const auto c = static_cast<std::int64_t>(cycle);
+    return c >= from_cycle && (cycles < 0 || c < from_cycle + cycles);
+  }
+};
+
+/// A host stall of stall_us inside the cycle on the active cycles: the virtual clock's time moves
+/// without CPU time (VirtualClock::stall); on the real clock the thread sleeps (wall time passes,
+/// its CPU time does not: what the runtime sees when the host deschedules the process).
+struct HostStallParams {
+  double stall_us{0.0};
+  InjectWindow window;
+  void visit(rt::ParamVisitor& v) {
+    v.param("stall_us", stall_us, "us");
+    window.visit(v);
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const { return {}; }
+};
+class HostStall final : public rt::BlockWithParams<HostStallParams> {
+ public:
+  void visit_pins(rt::PinVisitor& /*v*/) override {}
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
+    if (!params_.window.active(ctx.cycle) || ctx.clock == nullptr) {
+      return rt::BlockStatus::kOk;
+    }
+    const rt::Duration d{static_cast<std::int64_t>(params_.stall_us * 1000.0)};
+    if (ctx.clock->kind() == rt::ClockKind::kVirtual) {
+      const_cast<rt::VirtualClock*>(static_cast<const rt::VirtualClock*>(ctx.clock))->stall(d);
+    } else {
+      timespec ts{static_cast<time_t>(d.count() / 1'000'000'000),
+                  static_cast<long>(d.count() % 1'000'000'000)};
+      while (nanosleep(&ts, &ts) != 0) {
+      }
+    }
+    return rt::BlockStatus::kOk;
+  }
+};
+
+/// Burns burn_us of the thread's own CPU time on the active cycles (a block that really takes
+/// that long): virtual clock, charged with VirtualClock::advance; real clock, a busy loop until
+/// the thread's CPU clock has moved by burn_us (however much the host preempts it meanwhile).
+struct CpuBurnParams {
+  double burn_us{0.0};
+  InjectWindow window;
+  void visit(rt::ParamVisitor& v) {
+    v.param("burn_us", burn_us, "us");
+    window.visit(v);
+  }
+  [[nodiscard]] std::vector<rt::ParamError> validate() const { return {}; }
+};
+class CpuBurn final : public rt::BlockWithParams<CpuBurnParams> {
+ public:
+  void visit_pins(rt::PinVisitor& /*v*/) override {}
+  rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override {
+    if (!params_.window.active(ctx.cycle) || ctx.clock == nullptr) {
+      return rt::BlockStatus::kOk;
+    }
+    const rt::Duration d{static_cast<std::int64_t>(params_.burn_us * 1000.0)};
+    if (ctx.clock->kind() == rt::ClockKind::kVirtual) {
+      const_cast<rt::VirtualClock*>(static_cast<const rt::VirtualClock*>(ctx.clock))->advance(d);
+    } else {
+      const rt::Duration until = ctx.clock->thread_cpu_time() + d;
+      while (ctx.clock->thread_cpu_time() < until) {
+      }
     }
     return rt::BlockStatus::kOk;
   }
@@ -190,6 +269,8 @@ inline void register_test_blocks(rt::BlockRegistry& r) {
   r.add<TwoStep>("TwoStep");
   r.add<Recorder>("Recorder");
   r.add<Cost>("Cost");
+  r.add<HostStall>("HostStall");
+  r.add<CpuBurn>("CpuBurn");
   r.add<AddOne>("AddOne");
   r.add<ParamProbe>("ParamProbe");
 }

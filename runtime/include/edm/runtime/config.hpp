@@ -60,6 +60,12 @@ struct ProgramSpec {
 };
 
 enum class WatchdogAction : std::uint8_t { kFault, kWarn };
+/// What the watchdog makes of a host stall: a cycle over `time` whose own CPU time was within it
+/// (the process was descheduled — a busy or virtual host — not the cycle's work). Either way the
+/// stall is counted and raised as warning alarm 102. kFault: the watchdog judges the cycle's wall
+/// time as for any overrun (a real machine: its outputs were late). kTolerate: the stalled cycle
+/// is not held against the watchdog (simulated machines: nothing a stall can harm).
+enum class HostStallPolicy : std::uint8_t { kFault, kTolerate };
 enum class OverrunPolicy : std::uint8_t { kSkip, kAsap };
 
 struct WatchdogSpec {
@@ -67,6 +73,7 @@ struct WatchdogSpec {
   Duration time{};     // > 0 when enabled
   int sensitivity{1};  // >= 1
   WatchdogAction action{WatchdogAction::kFault};
+  HostStallPolicy host_stall{HostStallPolicy::kFault};
   SourceLoc loc;
 };
 
@@ -82,12 +89,25 @@ struct TaskSpec {
   SourceLoc name_loc;
 };
 
+/// One entry of a driver's pin map (`machine.io.pins`, e.g. the modbus driver's registers): a
+/// flat map of scalars, interpreted by the driver (IoDriver::set_pin_map).
+struct PinMapSpec {
+  std::vector<ParamSetting> fields;
+  SourceLoc loc;
+};
+
 struct IoSpec {
   std::string driver{"loopback"};
   std::optional<NameRef> task;  // default: the highest-priority task (lowest number; first wins)
   std::vector<ParamSetting> params;
+  std::vector<PinMapSpec> pins;  // drivers with a pin map only
+  /// `driver: composite`: the drivers it combines (their pins share the io. namespace; their
+  /// parameters too, or io.<name>.<param> for a child given a `name`).
+  std::vector<IoSpec> drivers;
+  std::string name;  // a composite's child: its optional `name` ("" = none)
   SourceLoc loc;
   SourceLoc driver_loc;
+  SourceLoc name_loc;
 };
 
 /// An axis (soft limits, dynamics) as read by machining's shared section reader.
@@ -119,11 +139,22 @@ struct SafetySpec {
   SourceLoc loc;
 };
 
+/// `machine.realtime`: what the runtime sets up for itself on the real clock
+/// (rt_environment.hpp). Every key is optional; the defaults are what a real machine wants.
+struct RealtimeSpec {
+  /// The PM QoS CPU latency request held while the runtime runs, µs; nullopt = `off` (none).
+  std::optional<std::int32_t> pm_qos_latency_us{0};
+  std::string pm_qos_device{"/dev/cpu_dma_latency"};  // absolute path; tests point it elsewhere
+  bool lock_memory{true};                             // mlockall(MCL_CURRENT | MCL_FUTURE)
+  SourceLoc loc;
+};
+
 struct MachineSpec {
   std::string name;
   IoSpec io;
   std::vector<AxisSpec> axes;
   SafetySpec safety;
+  RealtimeSpec realtime;
   SourceLoc loc;
 };
 
@@ -186,6 +217,13 @@ struct Config {
   TraceSpec trace;
   BridgeSpec bridge;
   RetainSpec retain;
+  /// Where the `mqtt:` key is (line 0: absent). The section itself is read and checked by the
+  /// telemetry library (telemetry/, edm::telemetry::load_mqtt_config), which the runtime does not
+  /// depend on (DESIGN §3).
+  SourceLoc mqtt_loc;
+  /// Where the `modbus_server:` key is (line 0: absent). Read and checked by the modbus library
+  /// (modbus/, edm::modbus::parse_server_file; docs/modbus.md), like `mqtt:`.
+  SourceLoc modbus_server_loc;
 };
 
 /// The conditions and soft limits in the form part programs are checked against (machining/).

@@ -9,7 +9,10 @@
 //
 // update() is unused for drivers: the work is in read_inputs() and write_outputs().
 
+#include <cstddef>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "edm/runtime/block.hpp"
 
@@ -19,6 +22,21 @@ namespace edm::rt {
 struct IoFault {
   int code{0};
   const char* text{""};
+};
+
+/// One `key: value` of a pin-map entry (`machine.io.pins[i]`), the scalar's text as written.
+struct PinMapField {
+  std::string key;
+  std::string value;
+  bool quoted{false};  // written quoted: a string, whatever its text
+};
+using PinMapEntry = std::vector<PinMapField>;
+
+/// A problem with entry `entry` of a pin map: at its key `key` ("" = the entry as a whole).
+struct PinMapError {
+  std::size_t entry{0};
+  std::string key;
+  std::string message;
 };
 
 class IoDriver : public Block {
@@ -32,6 +50,17 @@ class IoDriver : public Block {
   [[nodiscard]] virtual IoFault fault() const noexcept { return {}; }
   /// Optional seed for drivers with randomness (the simulator). Returns false if unsupported.
   virtual bool set_seed(std::uint64_t /*seed*/) { return false; }
+  /// Drivers with a pin map (`machine.io.pins`, e.g. modbus): takes the entries before
+  /// configure() and returns their problems. Non-RT, load time. The default has no pin map.
+  [[nodiscard]] virtual bool has_pin_map() const noexcept { return false; }
+  virtual std::vector<PinMapError> set_pin_map(const std::vector<PinMapEntry>& /*entries*/) {
+    return {};
+  }
+  /// Called by Runtime::run() before the first cycle and after the last (tasks joined): a driver
+  /// with a non-RT thread of its own (a field bus) starts and stops it here, never at build time
+  /// (`--check`, `--list-vars` build without running). Non-RT.
+  virtual void start() {}
+  virtual void stop() noexcept {}
 
   BlockStatus update(const CycleContext& /*ctx*/) noexcept final { return BlockStatus::kOk; }
 };

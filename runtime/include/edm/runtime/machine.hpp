@@ -53,9 +53,12 @@ enum class AlarmCode : std::uint16_t {
   kNone = 0,
   kWatchdog = 100,         // task watchdog fault
   kWatchdogWarning = 101,  // task watchdog with action: warn
+  kHostStall = 102,        // warning: a cycle over its watchdog time because the host stalled
   kBlockFault = 110,       // a block's update() returned kFault
   kIoFault = 120,          // the I/O driver reported a fault
+  kIoStale = 121,          // a field-bus driver's process image is too old (value: age, cycles)
   kEstop = 130,            // emergency stop requested
+  kInterlockOpen = 131,    // a safety interlock input (door switch) is open
   kFollowingError = 140,   // axis following error (safety supervisor)
   kSoftLimit = 141,        // soft limit: command refused or axis outside (safety supervisor)
   kShortCircuit = 150,     // reserved: sustained short circuit after N retracts

@@ -2,9 +2,11 @@
 // Schedulers: when each task's run_cycle() is called.
 //
 // RealTimeScheduler — one thread per task, released on the absolute grid
-//   T0 + k·interval with clock_nanosleep(TIMER_ABSTIME); SCHED_FIFO priority 90 − priority when
-//   the process may use it (otherwise one loud warning and SCHED_OTHER); optional CPU
-//   affinity; stack pre-faulted. mlockall() is done once by lock_memory().
+//   T0 + k·interval with clock_nanosleep(TIMER_ABSTIME). Each thread sets itself up with
+//   setup_task_thread() (SCHED_FIFO 90 − priority when the process may use it, else
+//   SCHED_OTHER; optional CPU affinity; stack pre-faulted) and the controlling thread reports
+//   the result (thread_setups(), RtEnvironment); the PM QoS request and mlockall are
+//   RtEnvironment's.
 // VirtualScheduler — one thread, deterministic: the task with the earliest release runs next,
 //   ties broken by priority (0 first), then by task order. A cycle executes atomically at its
 //   release time (no preemption in virtual time); execution time is zero unless a block charges
@@ -22,12 +24,10 @@
 #include <vector>
 
 #include "edm/runtime/clock.hpp"
+#include "edm/runtime/rt_environment.hpp"
 #include "edm/runtime/task.hpp"
 
 namespace edm::rt {
-
-/// Locks current and future memory (mlockall). Returns an empty string or a warning.
-std::string lock_memory();
 
 class RealTimeScheduler {
  public:
@@ -50,15 +50,17 @@ class RealTimeScheduler {
   void stop();
   /// True if any task fell back from SCHED_FIFO to SCHED_OTHER.
   [[nodiscard]] bool degraded() const noexcept { return degraded_.load(); }
+  /// What each task thread set up for itself, in task order (valid once start() has returned).
+  [[nodiscard]] const std::vector<ThreadSetup>& thread_setups() const noexcept { return setups_; }
 
  private:
-  void task_main(Task& task) noexcept;
+  void task_main(Task& task, std::size_t index) noexcept;
 
   const RealClock* clock_{nullptr};
   std::vector<std::thread> threads_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> degraded_{false};
-  std::atomic<bool> warned_{false};
+  std::vector<ThreadSetup> setups_;     // slot i written by thread i before it counts as ready
   std::atomic<std::size_t> ready_{0};   // threads set up and waiting for the origin
   std::atomic<std::int64_t> t0_ns_{0};  // the common origin; 0 until every thread is ready
   std::atomic<std::int64_t> end_ns_{std::numeric_limits<std::int64_t>::max()};

@@ -22,6 +22,10 @@
 // where x_cmd, v_cmd integrate the supervised command through the axis's a_max_mm_s2 (the drive's
 // trajectory generator); they restart from the actual position on the first cycle, in OFF and
 // in FAULT/ESTOP, and when homing sets an axis's encoder (ManualControl::position_epoch()).
+// They integrate over the time between the cycles' releases: when cycles were omitted after an
+// overrun (up to 9 in a row; a longer gap is a pause and is not integrated), the drive went on at
+// the last command meanwhile, and so does the model (else the actual position runs ahead of it
+// by v·gap on every late cycle of a busy host, a false following error at the next standstill).
 //
 // Referencing (issue 21): the range checks (141 outside, commands cut at the limits) apply to
 // the axes ManualControl says are referenced (X, Y, Z by name; an axis of another name always
@@ -102,6 +106,7 @@ class Supervisor {
     bool tracking{false};      // the commanded-position model is running
     double x_cmd_mm{0.0};
     double v_cmd_mm_s{0.0};
+    double v_target_mm_s{0.0};  // the command published last cycle (what the drive follows)
     bool ferror_raised{false};
     bool limit_raised{false};
     bool speed_raised{false};
@@ -114,6 +119,10 @@ class Supervisor {
   void check_axis(Axis& a, TimePoint now, bool track) noexcept;
   /// The command after the speed and range limits; raises/clears 141.
   double limit_command(Axis& a, TimePoint now) noexcept;
+  /// One period of the commanded-position model towards the command v (a_max-limited).
+  void advance_model(Axis& a, double v) const noexcept;
+  /// The cycles omitted since the previous one's release (0..9; 0 after a longer pause).
+  [[nodiscard]] std::int64_t omitted_since_last(TimePoint release) noexcept;
   /// Raises `code` while `active`, clears it when it ends; `raised` remembers which.
   void condition(bool active, bool& raised, const Alarm& alarm) noexcept;
 
@@ -126,7 +135,10 @@ class Supervisor {
   std::vector<Input<bool>*> generator_;
   const ManualControl* manual_;
   std::uint64_t epoch_seen_{0};
+  Duration period_;
   double dt_s_;
+  TimePoint last_release_{};
+  bool have_release_{false};
   bool electrode_raised_{false};
   bool wire_raised_{false};
   std::atomic<std::uint64_t> refused_cycles_{0};

@@ -5,7 +5,9 @@
 //   release every force while in FAULT/ESTOP (the safe state wins at the output latch) →
 //   latch inputs (I/O task only) → programs in order → safety supervisor (I/O task only: it
 //   refuses commands and holds the safe state at the output latch) → publish outputs (I/O task
-//   only) → trace sample → statistics → watchdog.
+//   only) → trace sample → statistics → watchdog (a host stall — the cycle over its watchdog
+//   time while its own CPU time was within it — is counted, raised as warning alarm 102 and, with
+//   `host_stall: tolerate`, not held against the watchdog).
 // The schedulers (scheduler.hpp) decide when run_cycle() is called.
 //
 // Thread-safety: run_cycle() runs on the task's own thread only. post_param_write() may be
@@ -88,12 +90,23 @@ class Task {
   [[nodiscard]] std::uint64_t watchdog_warnings() const noexcept {
     return watchdog_warnings_.load(std::memory_order_relaxed);
   }
+  /// Cycles over the watchdog time that were host stalls (see run_cycle), whatever the policy.
+  [[nodiscard]] std::uint64_t host_stalls() const noexcept {
+    return host_stalls_.load(std::memory_order_relaxed);
+  }
+  /// The longest of them (its execution time, wall clock).
+  [[nodiscard]] Duration longest_host_stall() const noexcept {
+    return Duration{longest_stall_ns_.load(std::memory_order_relaxed)};
+  }
   /// Puts this task's programs and driver into the safe state now (orderly shutdown). Only
   /// while the task thread is not running.
   void enter_safe_state_now(const SafeStateRequest& r) noexcept;
 
  private:
   void on_safe_state(MachineState s) noexcept;
+  /// Host-stall check and watchdog for a cycle that ran `exec` (wall clock). RT-safe.
+  void judge_cycle(TimePoint release, Duration exec, const Clock& clock,
+                   Duration cpu_start) noexcept;
 
   TaskSpec spec_;
   Machine* machine_;
@@ -108,9 +121,12 @@ class Task {
   Watchdog watchdog_;
   std::atomic<std::uint64_t> cycle_{0};
   std::atomic<std::uint64_t> watchdog_warnings_{0};
+  std::atomic<std::uint64_t> host_stalls_{0};
+  std::atomic<std::int64_t> longest_stall_ns_{0};
   std::uint64_t seen_safe_epoch_{0};
   bool driver_faulted_{false};
   bool watchdog_tripped_{false};
+  bool stall_latched_{false};
   double dt_s_;
 
   std::mutex producer_mutex_;  // serialises non-RT producers; the RT consumer never takes it
