@@ -8,7 +8,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <set>
 #include <utility>
 
 #include "edm/runtime/scheduling.hpp"
@@ -87,6 +90,7 @@ ThreadSetup setup_task_thread(const TaskSpec& spec) noexcept {
   }
   prefault_stack();
   s.prefaulted_bytes = kPrefaultStackBytes;
+  s.tid = static_cast<int>(gettid());
   return s;
 }
 
@@ -116,6 +120,9 @@ RtEnvironment::RtEnvironment(const RealtimeSpec& spec) {
 }
 
 RtEnvironment::~RtEnvironment() {
+  for (const Moved& m : moved_) {
+    sched_setaffinity(m.tid, sizeof m.before, &m.before);  // a thread that has ended: ESRCH
+  }
   pm_qos_.release();
   if (memory_locked_) {
     munlockall();
@@ -163,6 +170,72 @@ void RtEnvironment::report_threads(const std::vector<ThreadSetup>& threads) {
   add(prefaulted == threads.size(),
       fmt::format("stacks: {} KiB pre-faulted on {} of {} task threads", kPrefaultStackBytes / 1024,
                   prefaulted, threads.size()));
+}
+
+void RtEnvironment::keep_off_rt_cpus(const std::vector<ThreadSetup>& threads) {
+  std::set<int> rt_tids;
+  cpu_set_t rt_cpus;
+  CPU_ZERO(&rt_cpus);
+  for (const ThreadSetup& t : threads) {
+    rt_tids.insert(t.tid);
+    if (t.cpu && t.affinity_error == 0 && *t.cpu >= 0 && *t.cpu < CPU_SETSIZE) {
+      CPU_SET(static_cast<std::size_t>(*t.cpu), &rt_cpus);
+    }
+  }
+  if (CPU_COUNT(&rt_cpus) == 0) {
+    add(true, "non-RT threads: on any CPU (no task is pinned to a CPU)");
+    return;
+  }
+  // The CPUs this (controlling) thread may use, less the tasks' ones.
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) {
+    add(false, fmt::format("non-RT threads: left where they are (sched_getaffinity: {})",
+                           std::strerror(errno)));
+    return;
+  }
+  cpu_set_t others;
+  CPU_ZERO(&others);
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &allowed) && !CPU_ISSET(c, &rt_cpus)) {
+      CPU_SET(static_cast<std::size_t>(c), &others);
+    }
+  }
+  if (CPU_COUNT(&others) == 0) {
+    add(false,
+        "non-RT threads: share the tasks' CPUs (every CPU this process may use has a pinned "
+        "task): the bridge and the logger can delay a task's wake-up; leave a CPU without tasks");
+    return;
+  }
+  std::size_t moved = 0;
+  std::size_t failed = 0;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/task", ec)) {
+    const int tid = std::atoi(entry.path().filename().c_str());
+    if (tid <= 0 || rt_tids.count(tid) != 0) {
+      continue;
+    }
+    Moved m{tid, {}};
+    if (sched_getaffinity(tid, sizeof m.before, &m.before) != 0) {
+      continue;  // ended meanwhile
+    }
+    if (sched_setaffinity(tid, sizeof others, &others) == 0) {
+      moved_.push_back(m);
+      ++moved;
+    } else {
+      ++failed;
+    }
+  }
+  std::string cpus;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &others)) {
+      cpus += fmt::format("{}{}", cpus.empty() ? "" : ",", c);
+    }
+  }
+  add(failed == 0 && !ec,
+      fmt::format(
+          "non-RT threads: {} moved to CPU {} (off the tasks' CPUs){}", moved, cpus,
+          failed == 0 && !ec ? std::string() : fmt::format(", {} could not be moved", failed)));
 }
 
 void RtEnvironment::add(bool ok, std::string text) {

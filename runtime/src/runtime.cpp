@@ -175,6 +175,7 @@ RunSummary Runtime::run(const RunOptions& options) {
     RealTimeScheduler sched;
     sched.start(tasks, clock, options.run_for);
     rt_env.report_threads(sched.thread_setups());
+    rt_env.keep_off_rt_cpus(sched.thread_setups());
     // With run_for the tasks stop by themselves at T0 + run_for (exact cycle counts); the
     // controlling thread only watches the time and the stop flag.
     const TimePoint deadline = sched.end();

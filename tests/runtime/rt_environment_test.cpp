@@ -7,6 +7,7 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -14,9 +15,12 @@
 #include <chrono>
 #include <cstdint>
 #include <fstream>
+#include <future>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "support/subprocess.hpp"
 #include "support/temp_dir.hpp"
@@ -176,6 +180,100 @@ TEST(RtEnvironment, a_task_thread_sets_itself_up) {
   EXPECT_EQ(s.prefaulted_bytes, kPrefaultStackBytes);
   // fifo_error is 0 with the right to use SCHED_FIFO (root, CAP_SYS_NICE), EPERM without.
   EXPECT_TRUE(s.fifo_error == 0 || s.fifo_error == EPERM) << s.fifo_error;
+}
+
+/// The CPUs thread `tid` may run on.
+std::set<int> cpus_of(int tid) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  std::set<int> out;
+  if (sched_getaffinity(tid, sizeof set, &set) == 0) {
+    for (int c = 0; c < CPU_SETSIZE; ++c) {
+      if (CPU_ISSET(c, &set)) out.insert(c);
+    }
+  }
+  return out;
+}
+
+/// A thread that reports its tid and waits until released (explicit synchronisation, no sleeps).
+class ParkedThread {
+ public:
+  ParkedThread()
+      : thread_([this] {
+          tid_.set_value(static_cast<int>(gettid()));
+          release_.get_future().wait();
+        }) {
+    tid = tid_.get_future().get();
+  }
+  ~ParkedThread() {
+    release_.set_value();
+    thread_.join();
+  }
+  ParkedThread(const ParkedThread&) = delete;
+  ParkedThread& operator=(const ParkedThread&) = delete;
+  int tid{0};
+
+ private:
+  std::promise<int> tid_;
+  std::promise<void> release_;
+  std::thread thread_;
+};
+
+// A task pinned to a CPU keeps it to itself: every other thread of the process (here the test's
+// own and a parked "bridge" thread) moves to the other CPUs while the environment lives, and back
+// after; a task thread is never moved.
+TEST(RtEnvironment, the_non_rt_threads_leave_the_cpus_the_tasks_are_pinned_to) {
+  const std::set<int> all = cpus_of(0);
+  if (all.size() < 2) {
+    GTEST_SKIP() << "needs 2 CPUs";
+  }
+  const int rt_cpu = *all.rbegin();
+  ParkedThread bridge;
+  ParkedThread task;
+  ThreadSetup setup{"fast", 90, 0, rt_cpu, 0, kPrefaultStackBytes, task.tid};
+  const std::set<int> task_before = cpus_of(task.tid);
+  RealtimeSpec spec;
+  spec.pm_qos_latency_us.reset();
+  spec.lock_memory = false;
+  {
+    RtEnvironment env(spec);
+    env.keep_off_rt_cpus({setup});
+    std::set<int> others = all;
+    others.erase(rt_cpu);
+    EXPECT_EQ(cpus_of(bridge.tid), others);
+    EXPECT_EQ(cpus_of(static_cast<int>(gettid())), others);
+    EXPECT_EQ(cpus_of(task.tid), task_before);
+    ASSERT_FALSE(env.lines().empty());
+    EXPECT_TRUE(env.lines().back().ok) << env.lines().back().text;
+    EXPECT_NE(env.lines().back().text.find("moved to CPU"), std::string::npos)
+        << env.lines().back().text;
+    // A thread started now inherits the restriction from its creator.
+    ParkedThread later;
+    EXPECT_EQ(cpus_of(later.tid), others);
+  }
+  EXPECT_EQ(cpus_of(bridge.tid), all);
+  EXPECT_EQ(cpus_of(static_cast<int>(gettid())), all);
+}
+
+// No pinned task: nothing moves. Every CPU pinned: nothing moves, and one warning says why.
+TEST(RtEnvironment, non_rt_threads_stay_when_no_task_is_pinned_or_no_cpu_is_left) {
+  const std::set<int> all = cpus_of(0);
+  RealtimeSpec spec;
+  spec.pm_qos_latency_us.reset();
+  spec.lock_memory = false;
+  RtEnvironment env(spec);
+  env.keep_off_rt_cpus({ThreadSetup{"fast", 90, 0, std::nullopt, 0, kPrefaultStackBytes, 0}});
+  EXPECT_TRUE(env.lines().back().ok);
+  EXPECT_EQ(env.lines().back().text, "non-RT threads: on any CPU (no task is pinned to a CPU)");
+  std::vector<ThreadSetup> every;
+  for (const int c : all) {
+    every.push_back(ThreadSetup{"t" + std::to_string(c), 90, 0, c, 0, kPrefaultStackBytes, 0});
+  }
+  env.keep_off_rt_cpus(every);
+  EXPECT_FALSE(env.lines().back().ok);
+  EXPECT_EQ(env.lines().back().text.rfind("non-RT threads: share the tasks' CPUs", 0), 0u)
+      << env.lines().back().text;
+  EXPECT_EQ(cpus_of(static_cast<int>(gettid())), all);
 }
 
 // edmplc as shipped holds its own request from start to exit; the config points it at a FIFO.

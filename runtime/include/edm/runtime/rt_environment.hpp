@@ -7,13 +7,19 @@
 //   - locked memory (mlockall current and future pages, `machine.realtime.lock_memory`);
 //   - per task thread, set by the thread on itself: SCHED_FIFO 90 − priority (never the whole
 //     process: the main, bridge and logging threads stay SCHED_OTHER), the task's `cpu:`
-//     affinity, and a pre-faulted stack.
-// Nothing here is fatal: at start the runtime logs one line for each of these five items, at
+//     affinity, and a pre-faulted stack;
+//   - the process's other (non-RT) threads moved off the CPUs the tasks are pinned to, while
+//     another CPU is left for them (keep_off_rt_cpus()), so that a task's wake-up never has to
+//     preempt the bridge, the logger or the controlling thread; threads they start later inherit
+//     it. Restored when the RtEnvironment ends.
+// Nothing here is fatal: at start the runtime logs one line for each of these six items, at
 // info when it was set up and at warn (with the reason and the remedy) when it was not.
 //
 // Non-RT: allocates and logs. RtEnvironment and PmQosRequest are thread-compatible (one
 // controlling thread); setup_task_thread() is called by each task thread on itself, before its
 // first cycle.
+
+#include <sched.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -56,6 +62,7 @@ struct ThreadSetup {
   std::optional<int> cpu;           // the task's `cpu:`, if any
   int affinity_error{0};            // 0: pinned (or nothing to pin); else the error
   std::size_t prefaulted_bytes{0};  // stack touched before the first cycle
+  int tid{0};                       // the thread's kernel id (gettid)
 };
 
 /// Bytes of stack each task thread touches before its first cycle.
@@ -82,6 +89,9 @@ class RtEnvironment {
 
   /// Logs one line each for the task threads' SCHED_FIFO, CPU affinity and stacks.
   void report_threads(const std::vector<ThreadSetup>& threads);
+  /// Moves every thread of the process but the task threads to the allowed CPUs that no task is
+  /// pinned to (when there is at least one), and logs one line saying what it did.
+  void keep_off_rt_cpus(const std::vector<ThreadSetup>& threads);
 
   [[nodiscard]] bool pm_qos_held() const noexcept { return pm_qos_.held(); }
   [[nodiscard]] bool memory_locked() const noexcept { return memory_locked_; }
@@ -93,6 +103,11 @@ class RtEnvironment {
 
   PmQosRequest pm_qos_;
   bool memory_locked_{false};
+  struct Moved {
+    int tid;
+    cpu_set_t before;
+  };
+  std::vector<Moved> moved_;  // threads keep_off_rt_cpus() moved, restored at the end
   std::vector<Line> lines_;
 };
 
