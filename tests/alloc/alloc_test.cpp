@@ -1,28 +1,43 @@
 // Zero heap allocations inside a cycle: global operator new/delete are replaced in this test
-// executable and count calls made while a cycle runs.
+// executable (below; alloc_counter.hpp) and count the calls made on the thread that runs the
+// cycles while it runs them. The cycles run on the test thread (a virtual clock, run_cycle
+// called here); another thread's allocations (a driver's exchange thread) are not counted.
 
 #include <gtest/gtest.h>
 
-#include <atomic>
+#include <condition_variable>
 #include <cstdlib>
+#include <mutex>
 #include <new>
 #include <sstream>
+#include <thread>
+#include <vector>
 
+#include "alloc/alloc_counter.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/sim/sim_driver.hpp"
 #include "support/files.hpp"
 #include "support/runtime_fixture.hpp"
 
+// The replacements are in this file, the one that holds TheCounterSeesAllocations: with them in
+// another translation unit GCC's -O2 removes the `new`/`delete` pair of an object that does not
+// escape (allocation DCE) and the guard would see one allocation of its two.
 namespace {
 
-std::atomic<bool> g_counting{false};
-std::atomic<std::size_t> g_allocations{0};
+using edm::test::g_all_allocations;
+using edm::test::g_allocations;
+using edm::test::t_counting;
 
-void* counted_alloc(std::size_t n) {
-  if (g_counting.load(std::memory_order_relaxed)) {
+void count() noexcept {
+  g_all_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (t_counting) {
     g_allocations.fetch_add(1, std::memory_order_relaxed);
   }
+}
+
+void* counted_alloc(std::size_t n) {
+  count();
   if (void* p = std::malloc(n == 0 ? 1 : n)) {
     return p;
   }
@@ -30,9 +45,7 @@ void* counted_alloc(std::size_t n) {
 }
 
 void* counted_aligned_alloc(std::size_t n, std::align_val_t al) {
-  if (g_counting.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
+  count();
   const auto a = static_cast<std::size_t>(al);
   if (void* p = std::aligned_alloc(a, (n + a - 1) / a * a)) {
     return p;
@@ -126,7 +139,7 @@ TEST(Allocations, NoneInsideCyclesOfARealisticProgram) {
     ASSERT_TRUE(r->variables().write("gap.meas.tau", 0.001 * (round + 1)));
     ASSERT_TRUE(r->variables().force("gap.err.out", 0.5 * round));
     g_allocations = 0;
-    g_counting = true;
+    t_counting = true;
     for (int k = 0; k < 500; ++k) {
       const rt::TimePoint release{1ms * (round * 500 + k)};
       clock.advance_to(release);
@@ -135,7 +148,7 @@ TEST(Allocations, NoneInsideCyclesOfARealisticProgram) {
         tasks[1]->run_cycle(release, clock);
       }
     }
-    g_counting = false;
+    t_counting = false;
     total += g_allocations.load();
     r->trace().drain(sink);
   }
@@ -177,9 +190,9 @@ std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
     const rt::TimePoint release{1ms * k};
     clock.advance_to(release);
     g_allocations = 0;
-    g_counting = true;
+    t_counting = true;
     task.run_cycle(release, clock);
-    g_counting = false;
+    t_counting = false;
     total += g_allocations.load();
     if (k % 500 == 499) {
       r.trace().drain(sink);
@@ -243,9 +256,9 @@ TEST(Allocations, NoneInsideCyclesOfTheManualMotion) {
       const rt::TimePoint release{1ms * k};
       clock.advance_to(release);
       g_allocations = 0;
-      g_counting = true;
+      t_counting = true;
       task.run_cycle(release, clock);
-      g_counting = false;
+      t_counting = false;
       total += g_allocations.load();
       const rt::ManualStatus st = r->manual().status();
       if (st.seen_seq >= seq && !st.busy) break;
@@ -368,11 +381,47 @@ TEST(Allocations, NoneInsideCyclesOfTheSafetySupervisorActing) {
 TEST(Allocations, TheCounterSeesAllocations) {
   // Guards the guard: the replaced operator new really counts.
   g_allocations = 0;
-  g_counting = true;
+  t_counting = true;
   auto* p = new std::vector<int>(100);
-  g_counting = false;
+  t_counting = false;
   delete p;
   EXPECT_GE(g_allocations.load(), 2u);
+}
+
+TEST(Allocations, TheCounterSeesOnlyTheCycleThread) {
+  // A driver's own thread (the Modbus exchange) allocates while the cycles run: not counted;
+  // the thread that set t_counting is. The other thread is made before counting starts and
+  // steps under a mutex and condition variable (futexes: neither allocates).
+  std::mutex m;
+  std::condition_variable cv;
+  int step = 0;
+  std::size_t seen_there = 0;  // allocations through operator new on the other thread
+  std::thread other([&] {
+    std::unique_lock lock(m);
+    cv.wait(lock, [&] { return step == 1; });
+    const std::size_t before = g_all_allocations.load();
+    auto* p = new std::vector<int>(100);
+    seen_there = g_all_allocations.load() - before;
+    delete p;
+    step = 2;
+    cv.notify_all();
+  });
+  g_allocations = 0;
+  t_counting = true;
+  {
+    std::unique_lock lock(m);
+    step = 1;
+    cv.notify_all();
+    cv.wait(lock, [&] { return step == 2; });
+  }
+  const std::size_t counted_while_other_allocated = g_allocations.load();
+  auto* mine = new std::vector<int>(100);
+  t_counting = false;
+  delete mine;
+  other.join();
+  EXPECT_GE(seen_there, 2u) << "the other thread's allocations went through operator new";
+  EXPECT_EQ(counted_while_other_allocated, 0u) << "another thread's allocations are not counted";
+  EXPECT_GE(g_allocations.load(), 2u) << "the counting thread's are";
 }
 
 }  // namespace
