@@ -5,6 +5,7 @@ telemetry/proto/sparkplug_b.proto, and edmplc started on a config written from a
 import os
 import signal
 import socket
+import ssl
 import subprocess
 import sys
 import tempfile
@@ -113,7 +114,8 @@ class Subscriber:
         if username:
             self.client.username_pw_set(username, password)
         if tls_ca:
-            self.client.tls_set(ca_certs=tls_ca)
+            # A client context: the broker's certificate chains to tls_ca and names the host.
+            self.client.tls_set(ca_certs=tls_ca, tls_version=ssl.PROTOCOL_TLS_CLIENT)
         self.client.on_connect = lambda c, u, f, rc: c.subscribe("spBv1.0/#", qos=1)
         self.client.on_message = self._on_message
         self.client.reconnect_delay_set(0.1, 0.5)

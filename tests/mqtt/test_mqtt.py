@@ -240,11 +240,20 @@ class BadConfig(unittest.TestCase):
         ("interval: 1us", "mqtt.interval: must be between"),
         ("tls: {ca_file: /nonexistent/ca.pem}", "cannot read the CA file"),
         ("password_file: /nonexistent/pw", "cannot read the password file"),
+        # Files that exist (written by the test next to bad.yaml: relative to the config's folder).
+        ("password_file: edm.pass", "mqtt.password_file: password_file needs a username"),
+        ("password_file: empty.pass", "mqtt.password_file: the password file is empty"),
+        ("tls: {verify_hostname: true}", "mqtt.tls: missing required key 'ca_file'"),
+        ("tls: {ca_file: ca.pem, cert_file: ca.pem}",
+         "mqtt.tls: cert_file and key_file go together"),
     ]
 
     def test_bad_sections(self):
         d = rig.tmpdir()
         self.addCleanup(shutil.rmtree, d, True)
+        for name, text in (("edm.pass", "secret\n"), ("empty.pass", ""), ("ca.pem", "-\n")):
+            with open(os.path.join(d, name), "w") as f:
+                f.write(text)
         base = ("version: 1\nmachine:\n  name: m\n  io: {driver: loopback, params: {channels: 1}}\n"
                 "tasks:\n  - {name: t, interval: 10ms, priority: 10, programs: [p]}\n"
                 "programs:\n  - name: p\n    blocks:\n"

@@ -167,6 +167,7 @@ struct Publisher::Impl {
     o.store_capacity = cfg.store_forward;
     o.heartbeat = cfg.heartbeat;
     o.log = [](const std::string& line) { spdlog::info("{}", line); };
+    o.warn = [](const std::string& line) { spdlog::warn("{}", line); };
     node = std::make_unique<sp::EdgeNode>(
         std::move(o), [this](sp::MessageType t, const sp::Metric& m, std::string& why) {
           return on_command(t, m, why);

@@ -2,8 +2,10 @@
 
 #include <mosquitto.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <string_view>
 #include <utility>
 
 namespace edm::sparkplug {
@@ -29,6 +31,13 @@ bool same(const Value& a, const Value& b, double deadband) {
     return deadband > 0.0 ? std::fabs(*da - *db) <= deadband : *da == *db;
   }
   return a == b;
+}
+
+// libmosquitto's messages end with a full stop; ours go on after them.
+std::string clause(const char* text) {
+  std::string s = text != nullptr ? text : "";
+  while (!s.empty() && (s.back() == '.' || s.back() == ' ')) s.pop_back();
+  return s;
 }
 
 Metric metric(std::string_view name, DataType type, Value v, std::uint64_t t_ms) {
@@ -72,6 +81,28 @@ void EdgeNode::log(const std::string& line) const {
   if (opt_.log) opt_.log(line);
 }
 
+void EdgeNode::warn(const std::string& line) const {
+  if (opt_.warn) {
+    opt_.warn(line);
+  } else {
+    log(line);
+  }
+}
+
+std::string EdgeNode::broker() const { return opt_.host + ":" + std::to_string(opt_.port); }
+
+void EdgeNode::connect_failed(const std::string& why) {
+  {
+    std::lock_guard lock(mu_);
+    // libmosquitto retries every few seconds: say each reason once, not every 8 s for days.
+    if (failures_.size() >= 16 ||
+        std::find(failures_.begin(), failures_.end(), why) != failures_.end())
+      return;
+    failures_.push_back(why);
+  }
+  warn(why);
+}
+
 void EdgeNode::set_will_locked() {
   Payload death;
   death.timestamp = now_ms();
@@ -92,6 +123,7 @@ void EdgeNode::start() {
   mosquitto_connect_callback_set(mosq_, &EdgeNode::on_connect_cb);
   mosquitto_disconnect_callback_set(mosq_, &EdgeNode::on_disconnect_cb);
   mosquitto_message_callback_set(mosq_, &EdgeNode::on_message_cb);
+  mosquitto_log_callback_set(mosq_, &EdgeNode::on_log_cb);
   mosquitto_reconnect_delay_set(mosq_, static_cast<unsigned>(opt_.reconnect_min_s),
                                 static_cast<unsigned>(opt_.reconnect_max_s), true);
   if (!opt_.username.empty() &&
@@ -115,9 +147,10 @@ void EdgeNode::start() {
     set_will_locked();
   }
   started_at_ = std::chrono::steady_clock::now();
-  // A broker that is not up yet is not an error: the network thread keeps retrying.
+  // A broker that is not up yet is not an error: the network thread keeps retrying. Nor is a
+  // handshake that failed at once (MOSQ_ERR_TLS): on_log_cb told why, tick() tries again.
   const int rc = mosquitto_connect_async(mosq_, opt_.host.c_str(), opt_.port, opt_.keepalive_s);
-  if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO) {
+  if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO && rc != MOSQ_ERR_TLS) {
     throw EdgeNodeError(std::string("mqtt: connect to ") + opt_.host + ": " +
                         mosquitto_strerror(rc));
   }
@@ -131,8 +164,21 @@ void EdgeNode::start() {
 void EdgeNode::on_connect_cb(mosquitto* m, void* self_ptr, int rc) {
   auto* self = static_cast<EdgeNode*>(self_ptr);
   if (rc != 0) {
-    self->log(std::string("mqtt: the broker refused the connection: ") +
-              mosquitto_connack_string(rc));
+    {
+      std::lock_guard lock(self->mu_);
+      self->conn_refused_ = true;  // the disconnect that follows says nothing more
+    }
+    // MQTT 3.1.1 CONNACK 4 "bad user name or password", 5 "not authorised" (mosquitto's answer
+    // to a wrong password, an unknown user and to no credentials with allow_anonymous false).
+    const bool credentials = rc == 4 || rc == 5;
+    self->connect_failed("mqtt: the broker " + self->broker() +
+                         " refused the connection: " + clause(mosquitto_connack_string(rc)) +
+                         (credentials ? (self->opt_.username.empty()
+                                             ? " (no mqtt.username and mqtt.password_file set)"
+                                             : " (check mqtt.username '" + self->opt_.username +
+                                                   "' and its mqtt.password_file)")
+                                      : std::string()) +
+                         "; retrying");
     return;
   }
   // Commands first, so none sent right after the births is missed (Sparkplug: subscribe before
@@ -141,26 +187,95 @@ void EdgeNode::on_connect_cb(mosquitto* m, void* self_ptr, int rc) {
   const std::string d = self->dcmd_.str();
   mosquitto_subscribe(m, nullptr, n.c_str(), 1);
   mosquitto_subscribe(m, nullptr, d.c_str(), 1);
-  std::lock_guard lock(self->mu_);
-  self->connected_ = true;
-  self->need_birth_ = true;
-  self->will_used_ = true;
-  ++self->connects_;
+  {
+    std::lock_guard lock(self->mu_);
+    self->connected_ = true;
+    self->need_birth_ = true;
+    self->will_used_ = true;
+    self->tls_failed_ = false;
+    self->failures_.clear();
+    ++self->connects_;
+  }
+  self->log("mqtt: connected to the broker " + self->broker() +
+            (self->opt_.tls ? " over TLS" : ""));
 }
 
 void EdgeNode::on_disconnect_cb(mosquitto* /*m*/, void* self_ptr, int rc) {
   auto* self = static_cast<EdgeNode*>(self_ptr);
-  std::lock_guard lock(self->mu_);
-  const bool was = self->connected_;
-  self->connected_ = false;
-  if (self->will_used_) {
-    // The next CONNECT carries a new will: Sparkplug's bdSeq counts sessions, 0..255.
-    self->bdseq_ = (self->bdseq_ + 1) % 256;
-    self->will_used_ = false;
-    self->set_will_locked();
+  bool was = false;
+  bool said = false;  // a refusal or a TLS error, already told
+  {
+    std::lock_guard lock(self->mu_);
+    was = self->connected_;
+    self->connected_ = false;
+    said = std::exchange(self->conn_refused_, false) || self->tls_failed_;
+    if (self->will_used_) {
+      // The next CONNECT carries a new will: Sparkplug's bdSeq counts sessions, 0..255.
+      self->bdseq_ = (self->bdseq_ + 1) % 256;
+      self->will_used_ = false;
+      self->set_will_locked();
+    }
   }
-  if (was && rc != 0)
+  if (rc == 0) return;  // our own DISCONNECT
+  if (was) {
     self->log("mqtt: connection to the broker lost; storing data until it is back");
+  } else if (!said) {
+    // E.g. plain MQTT to a TLS listener: the broker closes the connection before any CONNACK.
+    self->connect_failed("mqtt: cannot connect to the broker " + self->broker() + ": " +
+                         clause(mosquitto_strerror(rc)) + "; retrying");
+  }
+}
+
+void EdgeNode::on_log_cb(mosquitto* /*m*/, void* self_ptr, int level, const char* line) {
+  if (level != MOSQ_LOG_ERR || line == nullptr) return;
+  auto* self = static_cast<EdgeNode*>(self_ptr);
+  const std::string_view text(line);
+  constexpr std::string_view kOpenSsl = "OpenSSL Error[";          // "OpenSSL Error[0]: error:…"
+  if (text.starts_with("Error: host name verification failed")) {  // followed by OpenSSL's line
+    self->connect_failed("mqtt: TLS with the broker " + self->broker() +
+                         " failed: its certificate does not name " + self->opt_.host +
+                         " (mqtt.tls.verify_hostname: true); retrying");
+    return;
+  }
+  if (!text.starts_with(kOpenSsl)) {
+    self->connect_failed("mqtt: libmosquitto: " + std::string(text));
+    return;
+  }
+  // A failed handshake (or any TLS error): libmosquitto's network thread ends after it; tick()
+  // starts it again.
+  {
+    std::lock_guard lock(self->mu_);
+    self->tls_failed_ = true;
+  }
+  const auto colon = text.find("]: ");
+  const std::string what(colon == std::string_view::npos ? text : text.substr(colon + 3));
+  std::string hint;
+  if (what.find("certificate verify failed") != std::string::npos) {
+    hint = " (the broker's certificate is not signed by mqtt.tls.ca_file";
+    if (self->opt_.tls && self->opt_.tls->verify_hostname) {
+      hint += ", or does not name " + self->opt_.host;
+    }
+    hint += ")";
+  }
+  self->connect_failed("mqtt: TLS with the broker " + self->broker() + " failed: " + what + hint +
+                       "; retrying");
+}
+
+void EdgeNode::restart_network_thread() {
+  // libmosquitto's thread has returned (a TLS error is fatal to its loop) or is about to:
+  // join it (cancelling is safe either way: stop() does the same), connect again, start it.
+  // A handshake failing again right here is MOSQ_ERR_TLS, already told by on_log_cb, and
+  // scheduled again by it.
+  mosquitto_loop_stop(mosq_, true);
+  const int rc = mosquitto_connect_async(mosq_, opt_.host.c_str(), opt_.port, opt_.keepalive_s);
+  if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_ERRNO && rc != MOSQ_ERR_TLS) {
+    connect_failed("mqtt: cannot connect to the broker " + broker() + ": " +
+                   clause(mosquitto_strerror(rc)) + "; retrying");
+  }
+  if (mosquitto_loop_start(mosq_) != MOSQ_ERR_SUCCESS) {
+    warn("mqtt: cannot start libmosquitto's network thread again; telemetry is off");
+    started_ = false;
+  }
 }
 
 void EdgeNode::on_message_cb(mosquitto* /*m*/, void* self_ptr, const mosquitto_message* msg) {
@@ -306,11 +421,31 @@ void EdgeNode::tick(std::span<const Value> values, std::uint64_t t_ms) {
   handle_commands();
   bool connected = false;
   bool birth = false;
+  bool tls_failed = false;
   {
     std::lock_guard lock(mu_);
     connected = connected_;
     birth = need_birth_ && connected_;
     need_birth_ = false;
+    tls_failed = tls_failed_ && !connected_;
+    tls_failed_ = tls_failed;
+  }
+  if (connected) restart_delay_s_ = 0;
+  if (tls_failed) {
+    const auto now = std::chrono::steady_clock::now();
+    if (restart_at_ == std::chrono::steady_clock::time_point{}) {
+      const int lo = std::max(opt_.reconnect_min_s, 1);
+      restart_delay_s_ = std::clamp(restart_delay_s_ * 2, lo, std::max(opt_.reconnect_max_s, lo));
+      restart_at_ = now + std::chrono::seconds(restart_delay_s_);
+    } else if (now >= restart_at_) {
+      restart_at_ = {};
+      {
+        std::lock_guard lock(mu_);
+        tls_failed_ = false;
+      }
+      restart_network_thread();
+      if (!started_) return;
+    }
   }
   if (!connected) birthed_ = false;
   if (birth) {

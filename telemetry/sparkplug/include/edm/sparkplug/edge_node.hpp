@@ -6,10 +6,13 @@
 // docs/mqtt.md describes the topics and the behaviour.
 //
 // Threads: libmosquitto's network thread (mosquitto_loop_start) connects, reconnects and
-// receives; it only records what happened (connected, commands) under a mutex. Everything that
-// publishes runs on the owner's thread in tick(): births after a (re)connect, replays, data and
-// command handling, so seq numbers are assigned in one place. start(), tick() and stop() from
-// one owner thread; stats() from any thread. Never on an RT thread (allocates, locks, syscalls).
+// receives; it only records what happened (connected, commands, why a connect failed) under a
+// mutex. That thread ends for good after a TLS error (libmosquitto's loop treats it as fatal):
+// tick() starts it again, 1 s doubling to reconnect_max_s, like libmosquitto's own reconnects.
+// Everything that publishes runs on the owner's thread in tick(): births after a (re)connect,
+// replays, data and command handling, so seq numbers are assigned in one place. start(), tick()
+// and stop() from one owner thread; stats() from any thread. Never on an RT thread (allocates,
+// locks, syscalls).
 
 #include <atomic>
 #include <chrono>
@@ -69,8 +72,11 @@ struct EdgeNodeOptions {
   std::chrono::milliseconds heartbeat{std::chrono::seconds(2)};
   int reconnect_min_s{1};
   int reconnect_max_s{8};
-  /// Informational lines (connect, refusals); may be empty.
+  /// Informational lines (connected, connection lost); may be empty.
   std::function<void(const std::string&)> log;
+  /// Why a connect failed (refused by the broker: credentials; TLS: certificate), once per
+  /// distinct reason until a connect succeeds; empty: `log`.
+  std::function<void(const std::string&)> warn;
 };
 
 /// A command's metric: accept (true) or refuse (false, `why` says why). Called from tick().
@@ -117,6 +123,7 @@ class EdgeNode {
   static void on_connect_cb(mosquitto*, void* self, int rc);
   static void on_disconnect_cb(mosquitto*, void* self, int rc);
   static void on_message_cb(mosquitto*, void* self, const mosquitto_message* msg);
+  static void on_log_cb(mosquitto*, void* self, int level, const char* line);
 
   void set_will_locked();
   bool publish(const Topic& topic, Payload& p);  // assigns seq unless NDEATH
@@ -126,6 +133,11 @@ class EdgeNode {
   void publish_node_data(std::uint64_t t_ms, bool force);
   void store(Payload p);
   void log(const std::string& line) const;
+  void warn(const std::string& line) const;
+  /// A connect failed: warns once per distinct reason until a connect succeeds.
+  void connect_failed(const std::string& why);
+  void restart_network_thread();
+  [[nodiscard]] std::string broker() const;
   [[nodiscard]] std::vector<Metric> node_counters(std::uint64_t t_ms) const;
 
   EdgeNodeOptions opt_;
@@ -143,6 +155,9 @@ class EdgeNode {
   std::uint64_t bdseq_{0};
   std::uint64_t connects_{0};
   std::deque<std::pair<std::string, std::string>> inbox_;  // (topic, payload) of NCMD/DCMD
+  std::vector<std::string> failures_;  // connect failures warned about since the last connect
+  bool conn_refused_{false};           // the broker refused the CONNECT being closed now
+  bool tls_failed_{false};             // a TLS error ended libmosquitto's network thread
 
   // Owner thread only.
   std::uint64_t seq_{0};
@@ -153,6 +168,8 @@ class EdgeNode {
   std::vector<Value> last_counters_;
   std::chrono::steady_clock::time_point last_ndata_{};
   std::chrono::steady_clock::time_point started_at_{};
+  std::chrono::steady_clock::time_point restart_at_{};  // after a TLS error; epoch: not pending
+  int restart_delay_s_{0};
 
   std::atomic<std::uint64_t> births_{0}, published_{0}, stored_{0}, dropped_{0}, replayed_{0},
       accepted_{0}, refused_{0}, queued_{0};
