@@ -17,22 +17,8 @@ constexpr auto kProgressPeriod = std::chrono::milliseconds(100);
 constexpr auto kTracePeriod = std::chrono::milliseconds(20);
 constexpr std::size_t kTraceSamplesPerEvent = 512;
 
-std::string_view outcome_name(rt::JobOutcome o) {
-  switch (o) {
-    case rt::JobOutcome::kNone:
-      return "none";
-    case rt::JobOutcome::kRunning:
-      return "running";
-    case rt::JobOutcome::kFinished:
-      return "finished";
-    case rt::JobOutcome::kAborted:
-      return "aborted";
-  }
-  return "none";
-}
-
 Json progress_json(const rt::JobProgress& p) {
-  return {{"outcome", std::string(outcome_name(p.outcome))},
+  return {{"outcome", std::string(rt::outcome_name(p.outcome))},
           {"generation", p.generation},
           {"jobs_started", p.jobs_started},
           {"block", p.block_index},
@@ -485,7 +471,7 @@ StatusMessage Server::Impl::status_message() {
   }
   // Progress is read live (it is atomics already): the snapshot's copy may be a cycle old.
   const rt::JobProgress p = rt.job().progress();
-  m.job_outcome = std::string(outcome_name(p.outcome));
+  m.job_outcome = std::string(rt::outcome_name(p.outcome));
   m.job_generation = p.generation;
   m.job_block = p.block_index;
   m.job_blocks = p.block_count;

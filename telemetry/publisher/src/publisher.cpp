@@ -53,20 +53,6 @@ class SnapshotObserver final : public rt::CycleObserver {
   rt::Seqlock<Snapshot> board_;
 };
 
-std::string_view outcome_name(rt::JobOutcome o) {
-  switch (o) {
-    case rt::JobOutcome::kRunning:
-      return "running";
-    case rt::JobOutcome::kFinished:
-      return "finished";
-    case rt::JobOutcome::kAborted:
-      return "aborted";
-    case rt::JobOutcome::kNone:
-      break;
-  }
-  return "none";
-}
-
 // The fixed device metrics, in this order, before the configured ones (docs/mqtt.md).
 enum Fixed : std::size_t {
   kState,
@@ -217,7 +203,7 @@ struct Publisher::Impl {
     v[kLastCause] = cause == rt::AlarmCode::kNone ? std::string("none")
                                                   : std::to_string(static_cast<int>(cause)) + " " +
                                                         std::string(rt::to_string(cause));
-    v[kJobOutcome] = std::string(outcome_name(job.outcome));
+    v[kJobOutcome] = std::string(rt::outcome_name(job.outcome));
     v[kJobBlock] = static_cast<std::uint64_t>(job.block_index);
     v[kJobBlocks] = static_cast<std::uint64_t>(job.block_count);
     v[kJobLine] = static_cast<std::int64_t>(job.line);

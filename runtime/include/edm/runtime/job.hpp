@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string_view>
 #include <vector>
 
 #include "edm/machining/motion_block.hpp"
@@ -29,6 +30,22 @@ enum class JobOutcome : std::uint8_t {
   kFinished = 2,  // the last job reached its end
   kAborted = 3,   // the last job was stopped (operator stop, fault, E-stop)
 };
+
+/// The outcome's name in the bridge protocol and the MQTT metrics: none, running, finished,
+/// aborted.
+constexpr std::string_view outcome_name(JobOutcome o) noexcept {
+  switch (o) {
+    case JobOutcome::kNone:
+      return "none";
+    case JobOutcome::kRunning:
+      return "running";
+    case JobOutcome::kFinished:
+      return "finished";
+    case JobOutcome::kAborted:
+      return "aborted";
+  }
+  return "none";
+}
 
 enum class LoadResult : std::uint8_t { kOk, kBusy };
 
