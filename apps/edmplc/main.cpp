@@ -19,9 +19,9 @@
 
 #include "edm/apps/cli.hpp"
 #include "edm/blocks/register.hpp"
+#include "edm/bridge/server.hpp"
 #include "edm/modbus/driver.hpp"
 #include "edm/modbus/server.hpp"
-#include "edm/bridge/server.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/log.hpp"
@@ -254,6 +254,16 @@ int main(int argc, char** argv) {
       std::cout << edm::rt::list_row(v) << "\n";
     }
     return kExitOk;
+  }
+  // A field bus's image ages in wall time: faster-than-real virtual time would read it as stale
+  // (alarm 121) at once. Paced at 1x or slower it runs as on the real clock.
+  if (opt.clock == edm::rt::ClockKind::kVirtual && !(opt.speed > 0.0 && opt.speed <= 1.0) &&
+      rt->wall_time_io()) {
+    edm::rt::shutdown_logging();
+    std::cerr << opt.config
+              << ": its I/O driver exchanges with real devices in wall time (modbus): run it with "
+                 "--clock real, or --clock virtual --speed 1 (or slower)\n";
+    return kExitBadInput;
   }
   if (!rt->retain_warning().empty()) {
     spdlog::error("retain: {} (alarm retain_corrupt: the machine starts in FAULT)",

@@ -149,6 +149,15 @@ void CompositeDriver::start() {
   }
 }
 
+bool CompositeDriver::wall_time_io() const noexcept {
+  for (const Child& c : children_) {
+    if (c.driver->wall_time_io()) {
+      return true;
+    }
+  }
+  return false;
+}
+
 void CompositeDriver::stop() noexcept {
   for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
     it->driver->stop();

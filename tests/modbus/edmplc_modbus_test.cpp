@@ -300,5 +300,33 @@ TEST(DrillModbusSim, AnOpenDoorIsAlarm131) {
       << plc.output();
 }
 
+// A field bus's image ages in wall time: the virtual clock faster than 1x is refused before any
+// cycle (no server needed: nothing connects); --check and 1x pass that point.
+TEST(DrillModbusSim, TheVirtualClockFasterThanWallTimeIsRefused) {
+  TempDir dir;
+  const std::string cfg =
+      write_file(dir, "drill-modbus-sim.yaml", drill_modbus_sim(free_port(), free_port()));
+  for (const std::vector<std::string>& clock :
+       {std::vector<std::string>{"--clock", "virtual"},
+        std::vector<std::string>{"--clock", "virtual", "--speed", "10"}}) {
+    std::vector<std::string> args{EDM_EDMPLC_PATH, "--config", cfg, "--bridge-port", "0",
+                                  "--run-for",     "1s"};
+    args.insert(args.end(), clock.begin(), clock.end());
+    Child plc(args);
+    EXPECT_EQ(plc.wait(), 2) << plc.output();
+    EXPECT_NE(plc.output().find("drill-modbus-sim.yaml: its I/O driver exchanges with real "
+                                "devices in wall time (modbus)"),
+              std::string::npos)
+        << plc.output();
+  }
+  Child check({EDM_EDMPLC_PATH, "--config", cfg, "--check", "--clock", "virtual"});
+  EXPECT_EQ(check.wait(), 0) << check.output();
+  // Paced at 1x it runs (the remote I/O is absent: alarm 121, as on the real clock).
+  Child paced({EDM_EDMPLC_PATH, "--config", cfg, "--bridge-port", "0", "--run-for", "1s", "--clock",
+               "virtual", "--speed", "1"});
+  EXPECT_EQ(paced.wait(), 1) << paced.output();
+  EXPECT_NE(paced.output().find("ALARM 121 (io_stale)"), std::string::npos) << paced.output();
+}
+
 }  // namespace
 }  // namespace edm::test

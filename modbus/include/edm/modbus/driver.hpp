@@ -65,6 +65,8 @@ class ModbusDriver final : public rt::BlockWithParams<ModbusDriverParams, rt::Io
   void write_outputs(const rt::CycleContext& ctx) noexcept override;
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
   void start() override;
+  /// A field bus: its image ages in wall time.
+  [[nodiscard]] bool wall_time_io() const noexcept override { return true; }
   void stop() noexcept override;
 
   /// Counters of the exchange thread. Any thread.

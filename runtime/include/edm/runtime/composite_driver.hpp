@@ -49,6 +49,8 @@ class CompositeDriver final : public IoDriver {
   bool set_seed(std::uint64_t seed) override;
   void start() override;
   void stop() noexcept override;
+  /// True when any of its drivers is.
+  [[nodiscard]] bool wall_time_io() const noexcept override;
 
  private:
   struct Child {

@@ -61,6 +61,10 @@ class IoDriver : public Block {
   /// (`--check`, `--list-vars` build without running). Non-RT.
   virtual void start() {}
   virtual void stop() noexcept {}
+  /// True for a driver that exchanges with real devices in wall time (a field bus): its image
+  /// ages in wall time, so the virtual clock may run it only paced at 1x or slower (edmplc
+  /// refuses anything faster). The simulator and loopback: false.
+  [[nodiscard]] virtual bool wall_time_io() const noexcept { return false; }
 
   BlockStatus update(const CycleContext& /*ctx*/) noexcept final { return BlockStatus::kOk; }
 };

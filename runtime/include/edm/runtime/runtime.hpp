@@ -91,6 +91,8 @@ class Runtime {
   [[nodiscard]] Machine& machine() noexcept { return machine_; }
   [[nodiscard]] VariableRegistry& variables() noexcept { return variables_; }
   [[nodiscard]] IoDriver& driver() noexcept { return *driver_; }
+  /// The I/O driver exchanges with real devices in wall time (IoDriver::wall_time_io()).
+  [[nodiscard]] bool wall_time_io() const noexcept { return driver_ && driver_->wall_time_io(); }
   [[nodiscard]] const std::vector<std::unique_ptr<Task>>& tasks() const noexcept { return tasks_; }
   [[nodiscard]] Program* program(std::string_view name) const;
   [[nodiscard]] TraceRecorder& trace() noexcept { return trace_; }
