@@ -165,13 +165,27 @@ std::int64_t Supervisor::omitted_since_last(TimePoint release) noexcept {
   std::int64_t omitted = 0;
   if (have_release_ && release > last_release_ && period_.count() > 0) {
     omitted = (release - last_release_) / period_ - 1;
-    if (omitted > 9) {
-      omitted = 0;  // a pause (the task stopped), not a drive running on
+    if (release - last_release_ > kLongestFollowedGap) {
+      omitted = -1;  // a pause (the task stopped and started again): restart the models
     }
   }
   have_release_ = true;
   last_release_ = release;
   return omitted;
+}
+
+void Supervisor::follow_omitted(Axis& a, std::int64_t cycles) const noexcept {
+  // The a_max-limited approach to the last command takes at most 2·v_max / (a_max·dt) periods;
+  // after that the model moves at that command, so a long gap costs no more than a short one.
+  const double v = a.v_target_mm_s;
+  for (std::int64_t k = 0; k < cycles; ++k) {
+    if (std::abs(v - a.v_cmd_mm_s) <= 1e-12) {
+      a.v_cmd_mm_s = v;
+      a.x_cmd_mm += v * dt_s_ * static_cast<double>(cycles - k);
+      return;
+    }
+    advance_model(a, v);
+  }
 }
 
 void Supervisor::supervise(const CycleContext& ctx) noexcept {
@@ -187,8 +201,10 @@ void Supervisor::supervise(const CycleContext& ctx) noexcept {
   // Omitted cycles (a late cycle on a busy host): the drives followed the last command meanwhile.
   const std::int64_t omitted = omitted_since_last(ctx.release);
   for (Axis& a : axes_) {
-    for (std::int64_t k = 0; a.tracking && k < omitted; ++k) {
-      advance_model(a, a.v_target_mm_s);
+    if (omitted < 0) {
+      a.tracking = false;  // check_axis restarts the model where the axis is
+    } else if (a.tracking && omitted > 0) {
+      follow_omitted(a, omitted);
     }
   }
   check_machine(ctx.release);

@@ -178,6 +178,82 @@ TEST(HostStall, OmittedCyclesDoNotBuildUpAFollowingError) {
   EXPECT_EQ(m.state(), MachineState::kReady);
 }
 
+// One long stall in a rapid (a loaded VM did not run the task for 27 ms: 26 releases omitted):
+// the drive went on at the last command, the supervisor's model follows all of it, and the job
+// ends without alarm 140. (A stall so long that the axis overshoots the interpolator's reference
+// by the position loop's f_err_max, 1 mm, is that loop's fault, 110: the next test.)
+TEST(HostStall, ALongStallInARapidIsFollowedWholeNotAFollowingError) {
+  for (const double stall_ms : {27.0, 80.0}) {
+    // At cycle 1020: 1000 cycles into the move, at full speed in its middle.
+    SafetyRig m(drill_sim_with(
+        "{name: late, type: HostStall, params: {stall_us: " + std::to_string(stall_ms * 1000.0) +
+        ", from_cycle: 1020, cycles: 1}}"));
+    m.run_ms(20);
+    const double z0 = m.read("io.z_mm");
+    std::vector<machining::MotionBlock> program(2);
+    program[0].kind = machining::MotionKind::kRapid;
+    program[0].target = {20.0, 0.0, z0};
+    program[0].line = 1;
+    program[1].kind = machining::MotionKind::kEnd;
+    program[1].line = 2;
+    ASSERT_EQ(m.runtime->job().load(program), rt::LoadResult::kOk);
+    ASSERT_EQ(m.machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+    double worst_mm = 0.0;
+    double x_at_stall = 0.0;
+    for (int k = 0; k < 20000 && m.runtime->job().progress().outcome != rt::JobOutcome::kFinished &&
+                    m.state() == MachineState::kRunning;
+         ++k) {
+      if (k == 999) x_at_stall = m.read("io.x_mm");
+      m.step();
+      worst_mm = std::max(worst_mm, m.runtime->supervisor()->following_error_mm(0));
+    }
+    (void)m.alarms(AlarmCode::kBlockFault);  // drains them into m.seen, for the messages
+    EXPECT_GT(x_at_stall, 1.0) << stall_ms << " ms: the stall must fall in the move";
+    EXPECT_LT(x_at_stall, 19.0) << stall_ms << " ms";
+    EXPECT_EQ(m.runtime->job().progress().outcome, rt::JobOutcome::kFinished)
+        << stall_ms << " ms: state " << static_cast<int>(m.state()) << ", cause "
+        << static_cast<int>(m.machine().last_cause()) << " from "
+        << (m.seen.empty() ? "" : m.seen.back().source) << ": "
+        << (m.seen.empty() ? "" : m.seen.back().text) << ", worst " << worst_mm << " mm";
+    EXPECT_GE(m.runtime->tasks()[0]->stats().snapshot().omitted_cycles,
+              static_cast<std::uint64_t>(stall_ms) - 1);
+    EXPECT_LT(worst_mm, 0.1) << stall_ms << " ms";
+    EXPECT_EQ(m.alarms(AlarmCode::kFollowingError), 0u) << stall_ms << " ms";
+    EXPECT_NEAR(m.read("io.x_mm"), 20.0, 0.01) << stall_ms << " ms";
+  }
+}
+
+// A stall of 1.5 s in a rapid: the supervisor takes a gap over 1 s for a pause (its model
+// restarts at the axis, no alarm 140), but the axis, which ran on at the last command, has
+// overshot the interpolator's reference by far more than f_err_max: the position loop's fault
+// brings the safe state at the first cycle after the stall, and the axis stops.
+TEST(HostStall, AStallOfSecondsInARapidEndsInTheSafeState) {
+  SafetyRig m(drill_sim_with(
+      "{name: late, type: HostStall, params: {stall_us: 1500000, from_cycle: 1020, cycles: 1}}"));
+  m.run_ms(20);
+  const double z0 = m.read("io.z_mm");
+  std::vector<machining::MotionBlock> program(2);
+  program[0].kind = machining::MotionKind::kRapid;
+  program[0].target = {20.0, 0.0, z0};
+  program[0].line = 1;
+  program[1].kind = machining::MotionKind::kEnd;
+  program[1].line = 2;
+  ASSERT_EQ(m.runtime->job().load(program), rt::LoadResult::kOk);
+  ASSERT_EQ(m.machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  const rt::Task& motion = *m.runtime->tasks()[0];
+  for (int k = 0; k < 5000 && m.state() == MachineState::kRunning; ++k) {
+    m.step();
+  }
+  EXPECT_EQ(m.state(), MachineState::kFault);
+  EXPECT_EQ(motion.cycles(), 1022u) << "the safe state in the cycle after the stall (1020)";
+  EXPECT_EQ(m.alarms(AlarmCode::kBlockFault), 1u);
+  EXPECT_EQ(m.alarms(AlarmCode::kFollowingError), 0u);
+  m.run_ms(200);
+  const double x = m.read("io.x_mm");
+  m.run_ms(100);
+  EXPECT_NEAR(m.read("io.x_mm"), x, 1e-6) << "the axis stands";
+}
+
 // The real clock: the thread's CPU clock, not a model of it. A cycle that sleeps 5 ms (wall
 // time, no CPU time) is a stall; a cycle that burns 5 ms of CPU time is not.
 constexpr const char* kRealClockRig = R"(version: 1
