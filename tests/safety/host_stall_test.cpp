@@ -144,22 +144,26 @@ TEST(HostStall, AStallDoesNotHideWorkOverTheWatchdogTime) {
   EXPECT_EQ(o.stalls, 0u);
 }
 
+/// After 20 ms of idle cycles, loads and starts a job of one rapid to X 20 mm (as a job makes it).
+bool start_rapid_to_x20(SafetyRig& m) {
+  m.run_ms(20);
+  std::vector<machining::MotionBlock> program(2);
+  program[0].kind = machining::MotionKind::kRapid;
+  program[0].target = {20.0, 0.0, m.read("io.z_mm")};
+  program[0].line = 1;
+  program[1].kind = machining::MotionKind::kEnd;
+  program[1].line = 2;
+  return m.runtime->job().load(program) == rt::LoadResult::kOk &&
+         m.machine().command(rt::MachineCommand::kStart) == rt::CommandResult::kOk;
+}
+
 // Late cycles while an axis moves (a busy host: every 3rd cycle takes 1.5 ms, the next slot is
 // omitted): the drive goes on at the last command through the omitted slot, and so does the
 // supervisor's commanded-position model, so no following error builds up (before: the model lost
 // v·1 ms on every late cycle, alarm 140 within the move). A rapid of 20 mm in X, as a job makes it.
 TEST(HostStall, OmittedCyclesDoNotBuildUpAFollowingError) {
   SafetyRig m(drill_sim_with("{name: late, type: CpuBurn, params: {burn_us: 0}}"));
-  m.run_ms(20);
-  const double z0 = m.read("io.z_mm");
-  std::vector<machining::MotionBlock> program(2);
-  program[0].kind = machining::MotionKind::kRapid;
-  program[0].target = {20.0, 0.0, z0};
-  program[0].line = 1;
-  program[1].kind = machining::MotionKind::kEnd;
-  program[1].line = 2;
-  ASSERT_EQ(m.runtime->job().load(program), rt::LoadResult::kOk);
-  ASSERT_EQ(m.machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  ASSERT_TRUE(start_rapid_to_x20(m));
   double worst_mm = 0.0;
   for (int k = 0; k < 5000 && m.runtime->job().progress().outcome != rt::JobOutcome::kFinished &&
                   m.state() == MachineState::kRunning;
@@ -188,16 +192,7 @@ TEST(HostStall, ALongStallInARapidIsFollowedWholeNotAFollowingError) {
     SafetyRig m(drill_sim_with(
         "{name: late, type: HostStall, params: {stall_us: " + std::to_string(stall_ms * 1000.0) +
         ", from_cycle: 1020, cycles: 1}}"));
-    m.run_ms(20);
-    const double z0 = m.read("io.z_mm");
-    std::vector<machining::MotionBlock> program(2);
-    program[0].kind = machining::MotionKind::kRapid;
-    program[0].target = {20.0, 0.0, z0};
-    program[0].line = 1;
-    program[1].kind = machining::MotionKind::kEnd;
-    program[1].line = 2;
-    ASSERT_EQ(m.runtime->job().load(program), rt::LoadResult::kOk);
-    ASSERT_EQ(m.machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+    ASSERT_TRUE(start_rapid_to_x20(m));
     double worst_mm = 0.0;
     double x_at_stall = 0.0;
     for (int k = 0; k < 20000 && m.runtime->job().progress().outcome != rt::JobOutcome::kFinished &&
@@ -230,16 +225,7 @@ TEST(HostStall, ALongStallInARapidIsFollowedWholeNotAFollowingError) {
 TEST(HostStall, AStallOfSecondsInARapidEndsInTheSafeState) {
   SafetyRig m(drill_sim_with(
       "{name: late, type: HostStall, params: {stall_us: 1500000, from_cycle: 1020, cycles: 1}}"));
-  m.run_ms(20);
-  const double z0 = m.read("io.z_mm");
-  std::vector<machining::MotionBlock> program(2);
-  program[0].kind = machining::MotionKind::kRapid;
-  program[0].target = {20.0, 0.0, z0};
-  program[0].line = 1;
-  program[1].kind = machining::MotionKind::kEnd;
-  program[1].line = 2;
-  ASSERT_EQ(m.runtime->job().load(program), rt::LoadResult::kOk);
-  ASSERT_EQ(m.machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  ASSERT_TRUE(start_rapid_to_x20(m));
   const rt::Task& motion = *m.runtime->tasks()[0];
   for (int k = 0; k < 5000 && m.state() == MachineState::kRunning; ++k) {
     m.step();
