@@ -161,17 +161,22 @@ void Supervisor::advance_model(Axis& a, double v) const noexcept {
   a.x_cmd_mm += a.v_cmd_mm_s * dt_s_;
 }
 
-std::int64_t Supervisor::omitted_since_last(TimePoint release) noexcept {
-  std::int64_t omitted = 0;
-  if (have_release_ && release > last_release_ && period_.count() > 0) {
-    omitted = (release - last_release_) / period_ - 1;
-    if (release - last_release_ > kLongestFollowedGap) {
-      omitted = -1;  // a pause (the task stopped and started again): restart the models
-    }
+std::int64_t Supervisor::periods_behind(TimePoint inputs_at) noexcept {
+  if (!have_model_time_ || period_.count() <= 0) {
+    have_model_time_ = true;
+    model_at_ = inputs_at;
+    return 0;
   }
-  have_release_ = true;
-  last_release_ = release;
-  return omitted;
+  if (inputs_at - model_at_ > kLongestFollowedGap) {
+    model_at_ = inputs_at;
+    return -2;  // a pause (the task stopped and started again): restart the models
+  }
+  // The inputs' age against the model's time, in whole periods (rounded: the wake-up jitter of
+  // the real clock is not an omitted cycle).
+  const std::int64_t p = period_.count();
+  const std::int64_t g = (inputs_at - model_at_).count();
+  const std::int64_t n = g >= 0 ? (g + p / 2) / p : -((-g + p / 2) / p);
+  return std::max<std::int64_t>(n, -1);
 }
 
 void Supervisor::follow_omitted(Axis& a, std::int64_t cycles) const noexcept {
@@ -188,7 +193,7 @@ void Supervisor::follow_omitted(Axis& a, std::int64_t cycles) const noexcept {
   }
 }
 
-void Supervisor::supervise(const CycleContext& ctx) noexcept {
+void Supervisor::supervise(const CycleContext& ctx, TimePoint inputs_at) noexcept {
   const MachineState before = machine_.state();
   bool track = before != MachineState::kOff && !is_safe_state(before);
   if (manual_ != nullptr) {
@@ -198,14 +203,18 @@ void Supervisor::supervise(const CycleContext& ctx) noexcept {
       for (Axis& a : axes_) a.tracking = false;
     }
   }
-  // Omitted cycles (a late cycle on a busy host): the drives followed the last command meanwhile.
-  const std::int64_t omitted = omitted_since_last(ctx.release);
+  // Omitted cycles (a late cycle, a host that did not run the task): the drives followed the
+  // last command until these inputs were read, and so does the model.
+  const std::int64_t behind = periods_behind(inputs_at);
   for (Axis& a : axes_) {
-    if (omitted < 0) {
+    if (behind == -2) {
       a.tracking = false;  // check_axis restarts the model where the axis is
-    } else if (a.tracking && omitted > 0) {
-      follow_omitted(a, omitted);
+    } else if (a.tracking && behind > 0) {
+      follow_omitted(a, behind);
     }
+  }
+  if (behind > 0) {
+    model_at_ += behind * period_;
   }
   check_machine(ctx.release);
   for (Axis& a : axes_) {
@@ -234,10 +243,15 @@ void Supervisor::supervise(const CycleContext& ctx) noexcept {
     }
     if (a.tracking && !is_safe_state(s)) {
       a.v_target_mm_s = v;
-      advance_model(a, v);
+      if (behind != -1) {  // -1: these inputs came a period early (after a late cycle): wait
+        advance_model(a, v);
+      }
     } else {
       a.tracking = false;
     }
+  }
+  if (behind != -1) {
+    model_at_ += period_;  // the models now stand for the next cycle's inputs, one period on
   }
   const bool safe = is_safe_state(s);
   for (Input<bool>* g : generator_) {

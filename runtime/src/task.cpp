@@ -98,7 +98,7 @@ TimePoint Task::run_cycle(TimePoint release, const Clock& clock) noexcept {
     p->run(ctx);
   }
   if (supervisor_ != nullptr) {
-    supervisor_->supervise(ctx);
+    supervisor_->supervise(ctx, start);  // the driver read the inputs just after `start`
   }
   if (driver_ != nullptr) {
     driver_->write_outputs(ctx);

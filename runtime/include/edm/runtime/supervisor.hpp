@@ -22,11 +22,12 @@
 // where x_cmd, v_cmd integrate the supervised command through the axis's a_max_mm_s2 (the drive's
 // trajectory generator); they restart from the actual position on the first cycle, in OFF and
 // in FAULT/ESTOP, and when homing sets an axis's encoder (ManualControl::position_epoch()).
-// They integrate over the time between the cycles' releases: when cycles were omitted (an overrun,
-// or a host that did not run the task for a while: 27 ms seen on a loaded VM), the drive went on
-// at the last command meanwhile, and so does the model (else the actual position runs ahead of it
-// by v·gap, a false following error). A gap over kLongestFollowedGap (1 s) is a pause, not a
-// drive running on: the model restarts from the actual position.
+// They integrate up to the time the inputs were read (not the release): when cycles were omitted
+// or the task woke late (a host that did not run it: 22–27 ms seen on a loaded VM), the drive
+// went on at the last command until the inputs were read, and so does the model, in whole
+// periods (else the actual position runs ahead of it by v·delay, a false following error). A
+// gap over kLongestFollowedGap (1 s) is a pause, not a drive running on: the model restarts from
+// the actual position.
 //
 // Referencing (issue 21): the range checks (141 outside, commands cut at the limits) apply to
 // the axes ManualControl says are referenced (X, Y, Z by name; an axis of another name always
@@ -85,8 +86,10 @@ class Supervisor {
   Supervisor& operator=(const Supervisor&) = delete;
 
   /// One cycle: checks, refusals and the safe state, written into the driver's input pins
-  /// before write_outputs(). RT-safe.
-  void supervise(const CycleContext& ctx) noexcept;
+  /// before write_outputs(). `inputs_at`: when the driver read this cycle's inputs (the task's
+  /// clock at the cycle's start; the release on the virtual clock). RT-safe.
+  void supervise(const CycleContext& ctx, TimePoint inputs_at) noexcept;
+  void supervise(const CycleContext& ctx) noexcept { supervise(ctx, ctx.release); }
 
   /// Cycles in which a command was cut at a soft limit (position or speed). Any thread.
   [[nodiscard]] std::uint64_t refused_cycles() const noexcept {
@@ -122,9 +125,10 @@ class Supervisor {
   double limit_command(Axis& a, TimePoint now) noexcept;
   /// One period of the commanded-position model towards the command v (a_max-limited).
   void advance_model(Axis& a, double v) const noexcept;
-  /// The cycles omitted since the previous one's release; -1 after a gap over
-  /// kLongestFollowedGap (a pause).
-  [[nodiscard]] std::int64_t omitted_since_last(TimePoint release) noexcept;
+  /// How many periods the models are behind inputs read at `inputs_at` (rounded): 0 normally,
+  /// n after n omitted cycles or a wake-up n periods late, -1 when the inputs came a period
+  /// early (the cycle after a late one), -2 after a gap over kLongestFollowedGap (a pause).
+  [[nodiscard]] std::int64_t periods_behind(TimePoint inputs_at) noexcept;
   /// `cycles` omitted periods of the model at the last published command (bounded work).
   void follow_omitted(Axis& a, std::int64_t cycles) const noexcept;
 
@@ -143,8 +147,8 @@ class Supervisor {
   std::uint64_t epoch_seen_{0};
   Duration period_;
   double dt_s_;
-  TimePoint last_release_{};
-  bool have_release_{false};
+  TimePoint model_at_{};  // when the inputs the models stand for are read (next cycle's)
+  bool have_model_time_{false};
   bool electrode_raised_{false};
   bool wire_raised_{false};
   std::atomic<std::uint64_t> refused_cycles_{0};
