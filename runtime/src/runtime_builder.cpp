@@ -168,8 +168,8 @@ class RuntimeBuilder {
       }
     } else {
       bool seeded = false;
-      configured = make_one_driver(io, "I/O driver '" + io.driver + "'", period, seeded,
-                                   rt_->driver_);
+      configured =
+          make_one_driver(io, "I/O driver '" + io.driver + "'", period, seeded, rt_->driver_);
     }
     if (!configured) {
       return;
