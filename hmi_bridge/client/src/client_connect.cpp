@@ -107,7 +107,7 @@ Role Client::Impl::connect_once() {
     self->start_read(c);
     self->arm_keepalive(c);
   });
-  const Reply hello = request("hello", {{"protocol", kProtocolVersion}, {"token", o.token}}, {});
+  const Reply hello = request("hello", hello_params(o.token, o.peer), {});
   if (!hello) {
     drop_connection();
     throw ClientError(

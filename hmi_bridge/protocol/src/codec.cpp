@@ -241,6 +241,12 @@ Json make_request(std::int64_t id, std::string_view op, const Json& params) {
   return j;
 }
 
+Json hello_params(std::string_view token, std::string_view peer) {
+  Json j = {{"protocol", kProtocolVersion}, {"token", std::string(token)}};
+  if (!peer.empty()) j["peer"] = std::string(peer);
+  return j;
+}
+
 Json make_reply(const Json& id, const Json& body) {
   Json j = body.is_object() ? body : Json::object();
   if (!id.is_null()) {

@@ -10,7 +10,7 @@ namespace {
 
 constexpr std::array<std::string_view, kErrorCodeCount> kErrorNames = {
     "bad_json",      "bad_request", "unknown_op", "unauthorized", "forbidden",
-    "invalid_state", "not_found",   "too_large",  "busy"};
+    "invalid_state", "not_found",   "too_large",  "busy",         "retain_failed"};
 
 constexpr std::array<OpInfo, 32> kOps = {{
     {"hello", false},        {"ping", false},          {"status", false},
@@ -37,6 +37,15 @@ bool error_code_from_string(std::string_view s, ErrorCode& out) noexcept {
 std::string_view to_string(Role r) noexcept { return r == Role::kOperator ? "operator" : "viewer"; }
 
 std::span<const OpInfo> all_ops() noexcept { return kOps; }
+
+bool valid_hello_peer(std::string_view peer) noexcept {
+  if (peer.empty() || peer.size() > kMaxHelloPeerChars) return false;
+  for (const char ch : peer) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c > 0x7e) return false;
+  }
+  return true;
+}
 
 const OpInfo* find_op(std::string_view name) noexcept {
   for (const auto& op : kOps) {

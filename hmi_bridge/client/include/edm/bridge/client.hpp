@@ -50,6 +50,10 @@ struct ClientOptions {
   std::string host{"127.0.0.1"};
   std::uint16_t port{kDefaultPort};
   std::string token;
+  /// A relaying HMI (edmhmi serve): the end client's address as it saw it, sent as hello's
+  /// "peer" so edmplc throttles failed log-ins per browser (docs/protocol.md). Empty: not sent.
+  /// At most kMaxHelloPeerChars printable ASCII characters, else the hello is refused.
+  std::string peer;
   std::chrono::milliseconds timeout{5000};     // connect, hello, and default request timeout
   std::chrono::milliseconds keepalive{20000};  // ping when idle this long (server read timeout)
   bool auto_reconnect{false};

@@ -63,6 +63,10 @@ bool parse_checksum(const Json& j, std::uint32_t& out) noexcept;
 
 /// {"id": id, "op": op, ...params}. params must be an object or null.
 Json make_request(std::int64_t id, std::string_view op, const Json& params = Json::object());
+/// hello's parameters: {"protocol": kProtocolVersion, "token": token[, "peer": peer]}. `peer`
+/// (a relaying HMI's end client, e.g. "192.0.2.7:51234") is left out when empty; the server
+/// refuses one that is not valid_hello_peer() with bad_request.
+Json hello_params(std::string_view token, std::string_view peer = {});
 /// {"id": id, "ok": true, ...body}. body must be an object or null; id null is left out.
 Json make_reply(const Json& id, const Json& body = Json::object());
 /// {"id": id, "ok": false, "error": {"code", "message"[, "details"]}}.

@@ -25,6 +25,11 @@ inline constexpr int kMinRateHz = 1;
 inline constexpr int kMaxRateHz = 100;
 /// Most blocks one program may have (the same bound check_program() enforces).
 inline constexpr std::size_t kMaxProgramBlocks = 1'000'000;
+/// hello's optional "peer" (docs/protocol.md): the end client's address as a relaying HMI (edmhmi
+/// serve) saw it, 1 to kMaxHelloPeerChars printable ASCII characters.
+inline constexpr std::size_t kMaxHelloPeerChars = 64;
+/// True for a valid hello "peer": 1 to kMaxHelloPeerChars bytes, each printable ASCII (0x20-0x7e).
+bool valid_hello_peer(std::string_view peer) noexcept;
 
 /// Stable error codes (the `error.code` string of a failed reply).
 enum class ErrorCode : std::uint8_t {
@@ -37,8 +42,9 @@ enum class ErrorCode : std::uint8_t {
   kNotFound,      // no such variable / upload
   kTooLarge,      // a line over the limit, or a program over kMaxProgramBlocks
   kBusy,          // the resource is in use (job running, queue full, too many sessions)
+  kRetainFailed,  // the retained data could not be written: nothing changed (alarm 183)
 };
-inline constexpr int kErrorCodeCount = 9;
+inline constexpr int kErrorCodeCount = 10;
 
 std::string_view to_string(ErrorCode c) noexcept;
 bool error_code_from_string(std::string_view s, ErrorCode& out) noexcept;
