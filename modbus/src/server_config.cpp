@@ -1,12 +1,13 @@
 // The `modbus_server:` section (docs/modbus.md), read from the config file like `mqtt:`: the
 // runtime's parser only notes where it is.
 
+#include "edm/modbus/server_config.hpp"
+
 #include <map>
 #include <sstream>
 
 #include "edm/machining/bounded_read.hpp"
 #include "edm/machining/located_yaml.hpp"
-#include "edm/modbus/server.hpp"
 #include "edm/runtime/diagnostics.hpp"
 #include "edm/runtime/time.hpp"
 
@@ -16,7 +17,11 @@ namespace {
 
 namespace y = machining::yaml;
 
-constexpr std::size_t kMaxEntries = 4096;
+constexpr std::size_t kMaxEntries = 4096;  // MapRegisters indexes entries with int16
+constexpr std::int64_t kMaxClients = 64;
+constexpr std::chrono::milliseconds kMinFrameTimeout{10};
+constexpr std::chrono::milliseconds kMaxFrameTimeout{60000};
+constexpr std::chrono::milliseconds kMaxIdleTimeout{24 * 3600 * 1000};
 
 class SectionParser {
  public:
@@ -25,7 +30,8 @@ class SectionParser {
 
   void parse(const y::Value& v, ServerConfig& c) {
     c.loc = v.loc;
-    auto m = r_.map(v, {"bind", "port", "max_clients", "idle_timeout", "map"});
+    auto m = r_.map(v, {"bind", "port", "max_clients", "max_clients_per_address", "frame_timeout",
+                        "idle_timeout", "log_burst", "log_per_s", "map"});
     if (!m) {
       return;
     }
@@ -40,17 +46,37 @@ class SectionParser {
       }
     }
     if (const y::Field* f = m->find("max_clients")) {
-      if (auto p = r_.integer(f->value, 1, 64)) {
+      if (auto p = r_.integer(f->value, 1, kMaxClients)) {
         c.max_clients = static_cast<int>(*p);
       }
     }
-    if (const y::Field* f = m->find("idle_timeout")) {
-      if (auto s = r_.string(f->value)) {
-        const auto d = rt::parse_duration(*s);
-        if (!d.value || d.value->count() <= 0) {
-          r_.error(f->value, d.value ? "must be > 0" : d.error);
+    if (const y::Field* f = m->find("max_clients_per_address")) {
+      if (auto p = r_.integer(f->value, 1, kMaxClients)) {
+        if (*p > c.max_clients) {
+          r_.error(f->value, "must be at most max_clients (" + std::to_string(c.max_clients) + ")");
         } else {
-          c.idle_timeout = std::chrono::duration_cast<std::chrono::milliseconds>(*d.value);
+          c.max_clients_per_address = static_cast<int>(*p);
+        }
+      }
+    }
+    duration(*m, "frame_timeout", kMinFrameTimeout, kMaxFrameTimeout, c.frame_timeout);
+    duration(*m, "idle_timeout", kMinFrameTimeout, kMaxIdleTimeout, c.idle_timeout);
+    if (const y::Field* f = m->find("idle_timeout");
+        f != nullptr && c.idle_timeout < c.frame_timeout) {
+      r_.error(f->value,
+               "must be at least frame_timeout (" + rt::format_duration(c.frame_timeout) + ")");
+    }
+    if (const y::Field* f = m->find("log_burst")) {
+      if (auto p = r_.integer(f->value, 1, 1000)) {
+        c.log_burst = static_cast<int>(*p);
+      }
+    }
+    if (const y::Field* f = m->find("log_per_s")) {
+      if (auto x = r_.real(f->value)) {
+        if (!(*x > 0.0 && *x <= 1000.0)) {
+          r_.error(f->value, "must be a number in (0, 1000] (log lines a second per address)");
+        } else {
+          c.log_per_s = *x;
         }
       }
     }
@@ -72,6 +98,31 @@ class SectionParser {
   }
 
  private:
+  // A duration key in [min, max], with its unit ("250ms", "1s").
+  void duration(const y::MapView& m, const char* key, std::chrono::milliseconds min,
+                std::chrono::milliseconds max, std::chrono::milliseconds& out) {
+    const y::Field* f = m.find(key);
+    if (f == nullptr) {
+      return;
+    }
+    auto s = r_.string(f->value);
+    if (!s) {
+      return;
+    }
+    const auto d = rt::parse_duration(*s);
+    if (!d.value) {
+      r_.error(f->value, d.error);
+      return;
+    }
+    const auto v = std::chrono::duration_cast<std::chrono::milliseconds>(*d.value);
+    if (*d.value < min || *d.value > max) {
+      r_.error(f->value,
+               "must be from " + rt::format_duration(min) + " to " + rt::format_duration(max));
+      return;
+    }
+    out = v;
+  }
+
   bool entry(const y::Value& v, ServerEntry& e) {
     e.loc = v.loc;
     auto m =

@@ -110,6 +110,7 @@ programs:
 modbus_server:
   port: PORT
   max_clients: 4
+  max_clients_per_address: 4
   map:
     - {table: holding_register, address: 0, var: p.g.k, type: float32, writable: true}
     - {table: holding_register, address: 2, var: p.g.out, type: int16, scale: 0.01}
@@ -183,8 +184,9 @@ TEST(ModbusServer, HostileInputGetsExceptionsOrIsClosedAndNeverCrashesIt) {
   {
     Socket s(port);
     ASSERT_TRUE(s.connected());
-    // Functions it does not serve: 01 (diagnostics 0x08, read/write multiple 0x17, MEI 0x2B).
-    for (const int code : {0x08, 0x17, 0x2B, 0x7F, 0x00}) {
+    // Functions it does not serve: 01 (diagnostics 0x08, read/write multiple 0x17, MEI 0x2B),
+    // with the function byte | 0x80 for codes from 0x80 too (0x83: 83 01, never 03 01).
+    for (const int code : {0x08, 0x17, 0x2B, 0x7F, 0x00, 0x80, 0x83, 0x90, 0xFF}) {
       const auto fc = static_cast<std::uint8_t>(code);
       ASSERT_TRUE(s.send(frame({fc, 0, 0, 0, 1})));
       EXPECT_EQ(exception_of(s.recv(), fc), 1) << int(fc);
@@ -227,15 +229,18 @@ TEST(ModbusServer, HostileInputGetsExceptionsOrIsClosedAndNeverCrashesIt) {
     EXPECT_TRUE(s.recv().empty());
   }
   {
-    // Many clients: four are served, the rest closed at once; then the four leave.
+    // Many clients that say nothing yet: each one past the four slots takes the slot of the
+    // oldest, so the last four are served; then they leave.
     std::vector<std::unique_ptr<Socket>> many;
     for (int i = 0; i < 12; ++i) many.push_back(std::make_unique<Socket>(port));
     std::this_thread::sleep_for(300ms);
-    int served = 0;
-    for (auto& s : many) {
-      if (s->send(frame({3, 0, 2, 0, 1})) && s->recv().size() == 11) ++served;
+    std::vector<int> served;
+    for (int i = 0; i < 12; ++i) {
+      if (many[i]->send(frame({3, 0, 2, 0, 1})) && many[i]->recv().size() == 11) {
+        served.push_back(i);
+      }
     }
-    EXPECT_EQ(served, 4);
+    EXPECT_EQ(served, (std::vector<int>{8, 9, 10, 11}));
   }
   std::this_thread::sleep_for(300ms);
   const Mbpoll r = mbpoll(port, {"-t", "4", "-r", "2", "-c", "1", "127.0.0.1"});

@@ -1,68 +1,37 @@
 #pragma once
 // The Modbus TCP server of edmplc (`modbus_server:`, docs/modbus.md): configured variables as
 // coils, discrete inputs, input registers and holding registers, for an HMI panel or a SCADA
-// system. It runs on a thread of its own, never an RT one: a read takes the variable registry's
-// values (lock-free pin loads; parameters from their shadow copies), the same path as the
-// bridge's var.read; a write goes through VariableRegistry::write (validated, queued to the
-// owning task, applied at the start of its next cycle), and only to parameters the config marks
-// `writable: true`.
+// system. It runs on a thread of its own, never an RT one, and reaches the tasks only through
+// the variable registry (server_registers.hpp): lock-free pin loads, parameter shadow copies,
+// and writes queued to the owning task's bounded queue.
 //
-// Exceptions: 01 illegal function (any function but 1, 2, 3, 4, 5, 6, 15, 16); 02 illegal data
-// address (an address not mapped in that table, part of a 32-bit value written alone, or a
-// write to a value that is not writable); 03 illegal data value (a quantity outside the
-// protocol's limits, or a value the parameter's range refuses); 04 server device failure (the
-// variable could not be read); 06 server device busy (the task's write queue is full).
-// Frames are read by this server (MBAP checked: protocol 0, length 2..254, at most 260 bytes);
-// a malformed frame closes its connection. At most `max_clients` connections; more are closed
-// at once; a connection idle for `idle_timeout` is closed.
+// The protocol (server_pdu.hpp): functions 1-6, 15, 16; exception 01 for every other function
+// code, with the function byte | 0x80. Framing is this server's own: MBAP checked (protocol 0,
+// length 2..254, at most 260 bytes); a frame that is not Modbus TCP closes its connection; any
+// unit identifier is answered and echoed. Nothing waits on a client: sockets are non-blocking;
+// a frame begun must be complete within `frame_timeout`, a reply must be taken by the client
+// within it, a connection without a request for `idle_timeout` is closed, and who keeps a slot
+// when a new connection comes is server_slots.hpp's rule (`max_clients`, and at most
+// `max_clients_per_address` per peer address). The log names peers by address, every line
+// about one address rate-limited (`log_burst`, `log_per_s`; all addresses together ten times
+// that, as any local process can take any 127.x.y.z); names that reach it are escaped.
+// Memory: fixed per connection (a 260-byte frame and a 260-byte reply).
 //
-// Thread-safety: start()/stop() from one controlling thread; the server reads the registry from
-// its own thread (the registry is thread-safe for non-RT callers).
+// Thread-safety: start()/stop() from one controlling thread; counters() from any thread.
 
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <optional>
-#include <string>
+#include <memory>
 #include <thread>
 #include <vector>
 
-#include "edm/modbus/pin_map.hpp"
-#include "edm/runtime/config.hpp"
+#include "edm/modbus/server_config.hpp"
+#include "edm/modbus/server_registers.hpp"
+#include "edm/runtime/log_limiter.hpp"
 #include "edm/runtime/variables.hpp"
 
 namespace edm::modbus {
-
-/// One value of the register map.
-struct ServerEntry {
-  Table table{Table::kHoldingRegister};
-  std::uint16_t address{0};
-  std::string var;
-  Encoding enc;  // bits: kBool
-  bool writable{false};
-  std::string unit;  // the variable's, for the printed map
-  rt::SourceLoc loc;
-};
-
-struct ServerConfig {
-  std::string bind{"127.0.0.1"};
-  int port{1502};
-  int max_clients{4};
-  std::chrono::milliseconds idle_timeout{60000};
-  std::vector<ServerEntry> map;
-  rt::SourceLoc loc;
-};
-
-/// The `modbus_server:` section of cfg.path checked against `vars`; nullopt when absent. Throws
-/// rt::ConfigError listing every problem (file:line:col).
-std::optional<ServerConfig> load_server_config(const rt::Config& cfg,
-                                               const rt::VariableRegistry& vars);
-/// The same from text (tests).
-std::optional<ServerConfig> parse_server_text(const std::string& text, const std::string& path,
-                                              const rt::VariableRegistry& vars);
-
-/// The register map as a table (edmplc --modbus-map, docs/modbus.md).
-std::string format_register_map(const ServerConfig& c);
 
 class Server {
  public:
@@ -78,36 +47,66 @@ class Server {
   [[nodiscard]] int port() const noexcept { return bound_port_; }
 
   struct Counters {
-    std::uint64_t requests{0};
-    std::uint64_t exceptions{0};
-    std::uint64_t writes{0};
-    std::uint64_t refused_clients{0};
-    std::uint64_t bad_frames{0};
+    std::uint64_t requests{0};         // complete frames served
+    std::uint64_t exceptions{0};       // of them answered with an exception
+    std::uint64_t writes{0};           // values written to parameters
+    std::uint64_t accepted{0};         // connections accepted (admitted or not)
+    std::uint64_t refused_clients{0};  // closed at once: every slot serving a client
+    std::uint64_t evicted{0};          // closed to make room for a newer connection
+    std::uint64_t bad_frames{0};       // closed: not a Modbus TCP frame
+    std::uint64_t frame_timeouts{0};   // closed: a frame unfinished after frame_timeout
+    std::uint64_t stalled{0};          // closed: a reply not taken within frame_timeout
+    std::uint64_t idle_timeouts{0};    // closed: no request for idle_timeout
+    std::uint64_t open{0};             // connections now
+    std::uint64_t log_suppressed{0};   // log lines dropped by the per-address rate limit
   };
   [[nodiscard]] Counters counters() const noexcept;
 
  private:
   struct Client;
+  enum class Close : std::uint8_t;
+  using Clock = std::chrono::steady_clock;
+
   void run() noexcept;
-  // Handles one complete frame; false: close the connection.
-  bool handle(Client& c, const std::uint8_t* frame, std::size_t n) noexcept;
-  int read_values(Table t, std::uint16_t addr, std::uint16_t nb, std::vector<std::uint16_t>& out);
-  int write_values(Table t, std::uint16_t addr, std::uint16_t nb, const std::uint16_t* words);
-  // The entries covering [addr, addr+nb) of table t, or an exception code.
-  const ServerEntry* entry_at(Table t, std::uint32_t addr) const noexcept;
+  void accept_one(std::vector<std::unique_ptr<Client>>& clients, Clock::time_point now);
+  /// Reads, serves and writes what poll() reported, then checks the deadlines; a reason to
+  /// close, or kKeep.
+  Close service(Client& c, short revents, Clock::time_point now);
+  Close receive(Client& c, Clock::time_point now);
+  Close serve_buffered(Client& c, Clock::time_point now);
+  void serve_frame(Client& c, std::size_t total, Clock::time_point now);
+  [[nodiscard]] bool flush(Client& c) noexcept;
+  Close check_deadlines(const Client& c, Clock::time_point now) const noexcept;
+  [[nodiscard]] Clock::time_point deadline(const Client& c) const noexcept;
+  void close_client(std::vector<std::unique_ptr<Client>>& clients, std::size_t i, Close why,
+                    Clock::time_point now);
+  /// A line about `address`, through the per-address rate limit.
+  void log_about(int level, const std::string& address, const std::string& line);
 
   rt::VariableRegistry& vars_;
   ServerConfig config_;
-  std::vector<std::vector<int>> index_;  // per table: address → entry index (-1 = unmapped)
+  MapRegisters regs_;  // over config_.map
+  rt::LogRateLimiter limiter_;      // per peer address: log_burst, log_per_s
+  rt::LogRateLimiter all_limiter_;  // every address together: ten times that
   int listen_fd_{-1};
   int bound_port_{0};
   std::thread thread_;
   std::atomic<bool> stopping_{false};
+  // Accepting paused after EMFILE & co. (10 ms doubling to 1 s), so a full descriptor table
+  // does not spin the thread; one warning per episode.
+  Clock::time_point accept_resume_{};
+  std::chrono::milliseconds accept_backoff_{0};
   std::atomic<std::uint64_t> requests_{0};
   std::atomic<std::uint64_t> exceptions_{0};
   std::atomic<std::uint64_t> writes_{0};
+  std::atomic<std::uint64_t> accepted_{0};
   std::atomic<std::uint64_t> refused_{0};
+  std::atomic<std::uint64_t> evicted_{0};
   std::atomic<std::uint64_t> bad_frames_{0};
+  std::atomic<std::uint64_t> frame_timeouts_{0};
+  std::atomic<std::uint64_t> stalled_{0};
+  std::atomic<std::uint64_t> idle_timeouts_{0};
+  std::atomic<std::uint64_t> open_{0};
 };
 
 }  // namespace edm::modbus
