@@ -80,6 +80,8 @@ std::string_view to_string(AlarmCode c) noexcept {
       return "forces_released";
     case AlarmCode::kJobInterrupted:
       return "job_interrupted";
+    case AlarmCode::kRetainWriteFailed:
+      return "retain_write_failed";
   }
   return "?";
 }

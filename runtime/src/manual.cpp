@@ -124,17 +124,32 @@ ManualInfo ManualControl::info() const noexcept { return info_.load(); }
 
 std::uint64_t ManualControl::request(ManualRequest r) noexcept {
   const std::lock_guard<std::mutex> lock(writer_);
-  r.seq = ++next_seq_;
-  request_.store(r);
+  r.seq = next_seq_ + 1;
+  if (!queue_.push(r)) return 0;  // full: the RT side has not taken 16 requests
+  next_seq_ = r.seq;
+  newest_op_ = r.op;
   return r.seq;
 }
 
-bool ManualControl::rt_poll(ManualRequest& out, std::uint64_t& last_seq) const noexcept {
+ManualOp ManualControl::activity() const noexcept {
+  // The status first: a request taken after this load still counts as pending (conservative).
+  const ManualStatus st = status_.load();
+  const std::lock_guard<std::mutex> lock(writer_);
+  if (next_seq_ > st.seen_seq) {
+    return newest_op_ == ManualOp::kStop ? ManualOp::kNone : newest_op_;
+  }
+  return st.busy ? st.op : ManualOp::kNone;
+}
+
+bool ManualControl::rt_poll(ManualRequest& out, std::uint64_t& last_seq) noexcept {
   ManualRequest r;
-  if (!request_.try_load(r) || r.seq <= last_seq) return false;  // a torn read: next cycle
-  last_seq = r.seq;
-  out = r;
-  return true;
+  while (queue_.pop(r)) {
+    if (r.seq <= last_seq) continue;  // already seen (cannot happen with one consumer)
+    last_seq = r.seq;
+    out = r;
+    return true;
+  }
+  return false;
 }
 
 }  // namespace edm::rt

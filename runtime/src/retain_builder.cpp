@@ -143,6 +143,21 @@ class RetainBuilder {
     }
     rt_.retain_path_ = path;
     rt_.retain_ = std::make_unique<RetainStore>(path, rs.min_interval, std::move(vars));
+    // A write that fails (full disk, read-only directory, the file replaced by a directory) is
+    // alarm 183 until a write succeeds: retained data the runtime could not keep is never quiet.
+    rt_.retain_->set_write_listener([&machine = rt_.machine_, store = rt_.retain_.get()](bool ok) {
+      if (ok) {
+        machine.clear_alarm(AlarmCode::kRetainWriteFailed, "retain");
+        return;
+      }
+      Alarm a;
+      a.code = AlarmCode::kRetainWriteFailed;
+      a.severity = AlarmSeverity::kWarning;
+      a.source = "retain";
+      a.text = "the retain file could not be written: retained values are not kept";
+      a.value = static_cast<double>(store->write_failures());
+      machine.raise(a);
+    });
   }
 
   // The variable `n` names and its type in the retain file, or nullopt (reported).

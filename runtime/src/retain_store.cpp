@@ -69,6 +69,8 @@ bool RetainStore::write_locked() noexcept {
     write_retain_file_atomic(path_, map);
     written_ = current_;
     writes_.fetch_add(1, std::memory_order_relaxed);
+    failing_.store(false, std::memory_order_release);
+    if (write_listener_) write_listener_(true);
     if (failure_streak_ > 0) {
       spdlog::info("retain: writing '{}' works again after {} failed attempts", path_,
                    failure_streak_);
@@ -77,11 +79,16 @@ bool RetainStore::write_locked() noexcept {
     return true;
   } catch (const std::exception& e) {
     write_failures_.fetch_add(1, std::memory_order_relaxed);
+    failing_.store(true, std::memory_order_release);
     ++failure_streak_;
     // First failure, then every 100th: a full disk must be visible but not flood the log.
     if (failure_streak_ % 100 == 1) {
       spdlog::error("retain: write failed ({} in a row, retrying on change): {}", failure_streak_,
                     e.what());
+    }
+    try {
+      if (write_listener_) write_listener_(false);
+    } catch (...) {  // the listener raises an alarm (lock-free); nothing of it may escape
     }
     return false;
   }
@@ -111,19 +118,29 @@ bool RetainStore::poll(TimePoint now) noexcept {
   }
 }
 
-bool RetainStore::flush() noexcept {
+bool RetainStore::flush() noexcept { return sync() == SyncResult::kWritten; }
+
+RetainStore::SyncResult RetainStore::sync() noexcept {
   try {
     const std::lock_guard lock(mutex_);
     read_all_locked();
     if (written_ && *written_ == current_) {
-      return false;
+      return SyncResult::kUnchanged;
     }
-    return write_locked();
+    return write_locked() ? SyncResult::kWritten : SyncResult::kFailed;
   } catch (const std::exception& e) {
     write_failures_.fetch_add(1, std::memory_order_relaxed);
+    failing_.store(true, std::memory_order_release);
     spdlog::error("retain: flush of '{}' failed: {}", path_, e.what());
-    return false;
+    return SyncResult::kFailed;
   }
+}
+
+bool RetainStore::retains(std::string_view name) const noexcept {
+  for (const Variable& v : vars_) {
+    if (v.name == name) return true;
+  }
+  return false;
 }
 
 void RetainStore::start(Duration poll_period) {

@@ -305,27 +305,26 @@ TEST_F(Hardening, a_blank_line_keeps_a_session_alive_but_not_past_the_hello_dead
 // ---- 8. token guessing ------------------------------------------------------------------------
 
 TEST(HelloThrottleUnit, delays_double_per_failure_up_to_the_cap_and_are_forgotten) {
-  HelloThrottle t(/*max_peers=*/3);
+  HelloThrottle t(/*max_keys=*/3);
   const auto t0 = HelloThrottle::Clock::time_point{} + std::chrono::hours(1);
-  EXPECT_EQ(t.admit_at("a", t0), t0);
+  EXPECT_EQ(t.admit_at("a", "", t0), t0);
   std::chrono::milliseconds expect = HelloThrottle::kBaseDelay;
   auto now = t0;
   for (int i = 0; i < 12; ++i) {
-    EXPECT_EQ(t.on_failure("a", now), std::min(expect, HelloThrottle::kMaxDelay));
-    EXPECT_EQ(t.admit_at("a", now), now + std::min(expect, HelloThrottle::kMaxDelay));
-    now = t.admit_at("a", now);
+    EXPECT_EQ(t.on_failure("a", "", now), std::min(expect, HelloThrottle::kMaxDelay));
+    EXPECT_EQ(t.admit_at("a", "", now), now + std::min(expect, HelloThrottle::kMaxDelay));
+    now = t.admit_at("a", "", now);
     expect *= 2;
   }
-  EXPECT_EQ(t.admit_at("b", now), now) << "other addresses are not slowed";
-  t.on_success("a");
-  EXPECT_EQ(t.admit_at("a", now), now);
-  t.on_failure("a", now);
+  EXPECT_EQ(t.admit_at("b", "", now), now) << "other addresses are not slowed";
+  t.on_failure("a", "", now);
   const auto later = now + HelloThrottle::kForgetAfter + 1ms;
-  EXPECT_EQ(t.admit_at("a", later), later);
+  EXPECT_EQ(t.admit_at("a", "", later), later);
   for (const char* p : {"p", "q", "r", "s"}) {
-    t.on_failure(p, now);
+    t.on_failure(p, "", now);
   }
-  EXPECT_LE(t.peers(), 3u);
+  EXPECT_LE(t.keys(), 3u);
+  EXPECT_LE(t.addresses(), 3u);
 }
 
 TEST_F(Hardening, wrong_hellos_are_throttled_logged_and_a_right_token_still_gets_in) {

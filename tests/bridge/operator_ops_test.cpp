@@ -173,11 +173,11 @@ TEST_F(OperatorOps, ManualMotionOnlyWhenReadyAndIdle) {
   const Json st = wait_manual(r.body["seq"].get<std::uint64_t>());
   EXPECT_TRUE(st["result"]["ok"].get<bool>()) << st;
   EXPECT_NEAR(var("io.x_mm") - x0, -1.25, 0.0015);
-  // While one manual operation runs, another (not a jog) is busy.
+  // While one manual operation runs, another (not a continuous jog) is invalid_state.
   const Reply slow = op_.request("jog", {{"axis", "Y"}, {"velocity", 0.5}});
   ASSERT_TRUE(slow);
   wait_for_busy();
-  expect_error(op_.request("home", {{"axes", "Z"}}), ErrorCode::kBusy);
+  expect_error(op_.request("home", {{"axes", "Z"}}), ErrorCode::kInvalidState);
   expect_error(op_.request("cycle.start"), ErrorCode::kInvalidState);
   const Reply stop = op_.request("jog.stop");
   ASSERT_TRUE(stop);

@@ -119,11 +119,11 @@ TEST_F(Bridge, every_error_code_is_reachable) {
     EXPECT_EQ(*e.code(), ErrorCode::kUnauthorized);
   }
 
-  // busy: a job is active, so a program cannot be swapped in ...
+  // invalid_state: a job is active, so a program cannot be swapped in (the op-state table) ...
   const auto prog = line_program(10);
   ASSERT_EQ(rt_->job().load(prog), rt::LoadResult::kOk);
   ASSERT_TRUE(rt_->job().rt_begin());  // stands in for the RT job sequencer
-  expect_error(op.upload_program(prog), ErrorCode::kBusy);
+  expect_error(op.upload_program(prog), ErrorCode::kInvalidState);
   rt_->job().rt_finish(rt::JobOutcome::kAborted);
   EXPECT_TRUE(op.upload_program(prog));
   // ... and a full house refuses the next connection with busy.

@@ -10,6 +10,7 @@
 #include <ctime>
 
 #include "edm/bridge/auth.hpp"
+#include "edm/runtime/log_escape.hpp"
 
 namespace edm::bridge {
 
@@ -30,10 +31,32 @@ AuditLog::~AuditLog() {
   }
 }
 
-void AuditLog::record(std::uint64_t session, std::string_view role, std::string_view peer,
-                      std::string_view op, std::string_view detail, std::string_view outcome) {
-  spdlog::info("audit: session={} role={} peer={} op={}{}{} -> {}", session, role, peer, op,
-               detail.empty() ? "" : " ", detail, outcome);
+std::string AuditLog::format(const AuditEntry& e) {
+  std::string line = fmt::format("session={} role={} peer={}", e.session, e.role, e.peer);
+  if (!e.via.empty()) {
+    line += " via=";
+    rt::append_log_quoted(line, e.via);
+  }
+  line += " op=";
+  // Only known op names are audited; escaped all the same, so no input can end the line.
+  line += rt::is_printable_ascii(e.op) && e.op.find(' ') == std::string_view::npos
+              ? std::string(e.op.substr(0, rt::kLogQuoteMaxBytes))
+              : rt::log_quote(e.op);
+  if (!e.detail.empty()) {
+    line += ' ';
+    line += e.detail;
+  }
+  line += " -> ";
+  line += e.outcome;
+  return line;
+}
+
+void AuditLog::record(const AuditEntry& e, rt::LogRateLimiter& limiter) {
+  const std::string text = format(e);
+  std::uint64_t suppressed = 0;
+  if (limiter.admit(e.address, std::chrono::steady_clock::now(), suppressed)) {
+    spdlog::info("audit: {}{}", text, rt::suppressed_note(suppressed));
+  }
   if (fd_ < 0) {
     return;
   }
@@ -45,14 +68,16 @@ void AuditLog::record(std::uint64_t session, std::string_view role, std::string_
   ::gmtime_r(&t, &tm);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &tm);
-  const std::string line = fmt::format("{}.{:03d}Z session={} role={} peer={} op={}{}{} -> {}\n",
-                                       stamp, static_cast<int>(ms), session, role, peer, op,
-                                       detail.empty() ? "" : " ", detail, outcome);
+  const std::string line = fmt::format("{}.{:03d}Z {}\n", stamp, static_cast<int>(ms), text);
   // One write() per entry with O_APPEND: entries never interleave, and a crash loses at most
   // the entry being written.
-  if (::write(fd_, line.data(), line.size()) < 0) {
+  const bool failed = ::write(fd_, line.data(), line.size()) != static_cast<ssize_t>(line.size());
+  if (failed && !write_failed_) {  // once per episode: a full disk must not flood the log too
     spdlog::warn("bridge: audit file write failed: {}", std::strerror(errno));
+  } else if (!failed && write_failed_) {
+    spdlog::info("bridge: audit file writable again");
   }
+  write_failed_ = failed;
 }
 
 }  // namespace edm::bridge

@@ -9,7 +9,22 @@
 #include <string>
 #include <string_view>
 
+#include "edm/runtime/log_limiter.hpp"
+
 namespace edm::bridge {
+
+/// One audit entry. `via`, `op` and `detail` may hold client text: record() escapes op and via;
+/// `detail` must already be built from escaped parts (rt::log_quote), as ops.cpp's is.
+struct AuditEntry {
+  std::uint64_t session{0};
+  std::string_view role;
+  std::string_view peer;     // address:port (the server's, not the client's)
+  std::string_view address;  // the transport address, the log rate limit's key
+  std::string_view via;      // hello's relayed end client, "" when none
+  std::string_view op;
+  std::string_view detail;
+  std::string_view outcome;  // "ok" or the error code's name
+};
 
 class AuditLog {
  public:
@@ -20,12 +35,15 @@ class AuditLog {
   AuditLog(const AuditLog&) = delete;
   AuditLog& operator=(const AuditLog&) = delete;
 
-  /// One entry. `outcome` is "ok" or the error code's name.
-  void record(std::uint64_t session, std::string_view role, std::string_view peer,
-              std::string_view op, std::string_view detail, std::string_view outcome);
+  /// The entry's text, one line without a newline: "session=4 role=operator peer=… op=…".
+  [[nodiscard]] static std::string format(const AuditEntry& e);
+  /// Writes one entry to the file (every entry) and to the log (through `limiter`, keyed by the
+  /// entry's address: a flood of refused requests does not flood the log; the file keeps all).
+  void record(const AuditEntry& e, rt::LogRateLimiter& limiter);
 
  private:
   int fd_{-1};
+  bool write_failed_{false};
 };
 
 }  // namespace edm::bridge

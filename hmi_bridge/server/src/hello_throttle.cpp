@@ -4,53 +4,90 @@
 
 namespace edm::bridge {
 
+std::string HelloThrottle::key_of(const std::string& address, std::string_view peer) {
+  // A valid peer is printable ASCII, so the newline cannot occur in either part.
+  std::string k = address;
+  if (!peer.empty()) {
+    k.push_back('\n');
+    k.append(peer);
+  }
+  return k;
+}
+
+HelloThrottle::Clock::time_point HelloThrottle::aggregate_at(const std::string& address,
+                                                             Clock::time_point now) {
+  const auto it = addresses_.find(address);
+  if (it == addresses_.end()) return now;
+  const Address& a = it->second;
+  if (now - a.newest() > kForgetAfter) {
+    addresses_.erase(it);
+    return now;
+  }
+  if (a.count < kAggregateFailures) return now;
+  // Full: the oldest of the last kAggregateFailures must leave the window first.
+  return std::max(now, a.times[a.next] + kForgetAfter);
+}
+
 HelloThrottle::Clock::time_point HelloThrottle::admit_at(const std::string& address,
+                                                         std::string_view peer,
                                                          Clock::time_point now) {
-  const auto it = peers_.find(address);
-  if (it == peers_.end()) {
-    return now;
-  }
+  Clock::time_point at = aggregate_at(address, now);
+  const auto it = keys_.find(key_of(address, peer));
+  if (it == keys_.end()) return at;
   if (now - it->second.last_failure > kForgetAfter) {
-    peers_.erase(it);
-    return now;
+    keys_.erase(it);
+    return at;
   }
-  return it->second.admit_at;
+  return std::max(at, it->second.admit_at);
 }
 
 std::chrono::milliseconds HelloThrottle::on_failure(const std::string& address,
-                                                    Clock::time_point now) {
+                                                    std::string_view peer, Clock::time_point now) {
   ++failures_;
-  auto it = peers_.find(address);
-  if (it == peers_.end()) {
-    if (peers_.size() >= max_peers_) {
-      forget_stalest();
-    }
-    it = peers_.emplace(address, Peer{}).first;
+  const std::string k = key_of(address, peer);
+  auto it = keys_.find(k);
+  if (it == keys_.end()) {
+    if (keys_.size() >= max_keys_) forget_stalest(keys_);
+    it = keys_.emplace(k, Key{}).first;
   }
-  Peer& p = it->second;
-  if (p.failures > 0 && now - p.last_failure > kForgetAfter) {
-    p.failures = 0;
-  }
+  Key& p = it->second;
+  if (p.failures > 0 && now - p.last_failure > kForgetAfter) p.failures = 0;
   ++p.failures;
   p.last_failure = now;
   const int shift = static_cast<int>(std::min<std::uint32_t>(p.failures - 1, 16));
   const auto delay = std::min<std::chrono::milliseconds>(kBaseDelay * (1LL << shift), kMaxDelay);
   p.admit_at = now + delay;
-  return delay;
+
+  auto a = addresses_.find(address);
+  if (a == addresses_.end()) {
+    if (addresses_.size() >= max_keys_) forget_stalest(addresses_);
+    a = addresses_.emplace(address, Address{}).first;
+  } else if (now - a->second.newest() > kForgetAfter) {
+    a->second = Address{};
+  }
+  Address& ad = a->second;
+  ad.times[ad.next] = now;
+  ad.next = (ad.next + 1) % kAggregateFailures;
+  ad.count = std::min(ad.count + 1, kAggregateFailures);
+
+  const Clock::time_point at = std::max(p.admit_at, aggregate_at(address, now));
+  return std::chrono::ceil<std::chrono::milliseconds>(at - now);
 }
 
-void HelloThrottle::on_success(const std::string& address) { peers_.erase(address); }
-
-void HelloThrottle::forget_stalest() {
-  auto stalest = peers_.begin();
-  for (auto it = peers_.begin(); it != peers_.end(); ++it) {
-    if (it->second.last_failure < stalest->second.last_failure) {
-      stalest = it;
+template <class Map>
+void HelloThrottle::forget_stalest(Map& map) {
+  const auto last = [](const auto& v) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, Key>) {
+      return v.last_failure;
+    } else {
+      return v.newest();
     }
+  };
+  auto stalest = map.begin();
+  for (auto it = map.begin(); it != map.end(); ++it) {
+    if (last(it->second) < last(stalest->second)) stalest = it;
   }
-  if (stalest != peers_.end()) {
-    peers_.erase(stalest);
-  }
+  if (stalest != map.end()) map.erase(stalest);
 }
 
 }  // namespace edm::bridge

@@ -4,15 +4,15 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cmath>
-#include <set>
 #include <variant>
 
 #include "edm/bridge/machine_info.hpp"
+#include "edm/bridge/op_states.hpp"
 #include "edm/machining/program_check.hpp"
 #include "edm/runtime/stats_json.hpp"
 #include "ops_body.hpp"
 #include "ops_operator.hpp"
+#include "ops_vars.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge {
@@ -27,20 +27,17 @@ using ops::error;
 using ops::Error;
 using ops::field;
 
-ErrorCode var_error(rt::VarResult r) {
-  switch (r) {
-    case rt::VarResult::kNotFound:
-      return ErrorCode::kNotFound;
-    case rt::VarResult::kBusy:
-      return ErrorCode::kBusy;
-    case rt::VarResult::kInvalidState:
-      return ErrorCode::kInvalidState;  // e.g. a force refused in FAULT or ESTOP
-    default:
-      return ErrorCode::kBadRequest;
+/// hello's optional "peer" (a relaying HMI's end client): "" when absent, nullopt when invalid.
+std::optional<std::string> hello_peer(const Json& msg) {
+  const auto it = msg.find("peer");
+  if (it == msg.end()) return std::string();
+  if (!it->is_string() || !valid_hello_peer(it->get_ref<const std::string&>())) {
+    return std::nullopt;
   }
+  return it->get<std::string>();
 }
 
-Body op_hello(Session& s, const Json& msg) {
+Body op_hello(Session& s, const Json& msg, const std::string& via) {
   auto& srv = s.server();
   if (s.role_) {
     return error(ErrorCode::kInvalidState,
@@ -55,30 +52,26 @@ Body op_hello(Session& s, const Json& msg) {
   if (proto != nullptr && proto->get<std::int64_t>() == kProtocolVersion) {
     role = authenticate(srv.tokens, token, s.loopback());
   }
+  s.via_ = via;
   if (!role) {
     srv.counters.hello_failures.fetch_add(1, std::memory_order_relaxed);
-    const auto delay = srv.throttle.on_failure(s.peer_address(), SteadyClock::now());
+    const auto delay = srv.throttle.on_failure(s.peer_address(), via, SteadyClock::now());
     std::string why = proto == nullptr || proto->get<std::int64_t>() != kProtocolVersion
                           ? "protocol version " + std::to_string(kProtocolVersion) + " required"
                       : !srv.tokens.any() ? "only loopback clients are served without a token"
                                           : "bad token";
-    spdlog::warn(
-        "bridge: session {} ({}): hello refused: {} (next hello from this address in "
-        "{} ms)",
-        s.id(), s.peer(), why, delay.count());
+    s.log(spdlog::level::warn, "hello refused: {} (next hello from this {} in {} ms)", why,
+          via.empty() ? "address" : "peer", delay.count());
     return error(ErrorCode::kUnauthorized, std::move(why));
   }
-  srv.throttle.on_success(s.peer_address());
   if (!srv.admit(s, *role)) {
-    spdlog::info("bridge: session {} ({}): {} refused: every slot is taken", s.id(), s.peer(),
-                 to_string(*role));
+    s.log(spdlog::level::info, "{} refused: every slot is taken", to_string(*role));
     return error(ErrorCode::kBusy, "too many sessions (max " +
                                        std::to_string(srv.opt.max_sessions) + ", " +
                                        std::to_string(kOperatorReserve) + " kept for an operator)");
   }
   s.role_ = role;
-  spdlog::info("bridge: session {} ({}{}): hello as {}", s.id(), s.peer(),
-               s.loopback() ? "" : ", network", to_string(*role));
+  s.log(spdlog::level::info, "hello as {}{}", to_string(*role), s.loopback() ? "" : " (network)");
   return Json{{"role", std::string(to_string(*role))},
               {"protocol", kProtocolVersion},
               {"server", "edmplc"},
@@ -168,7 +161,8 @@ Body op_program_begin(Session& s, const Json& msg) {
   if (auto e = ops::read_upload_options(msg, u.slot, u.offsets_generation)) return *e;
   u.id = next_upload++;
   u.expected = n->get<std::size_t>();
-  u.blocks.reserve(u.expected);
+  // Grown as chunks arrive: a one-line begin of 1,000,000 blocks must not take 150 MB at once.
+  u.blocks.reserve(std::min<std::size_t>(u.expected, 4096));
   s.upload_ = std::move(u);
   return Json{{"upload", s.upload_->id}, {"blocks", s.upload_->expected}};
 }
@@ -194,14 +188,12 @@ Body op_program_chunk(Session& s, const Json& msg) {
                                              std::to_string(u.expected) + ")");
   }
   // Decode the whole chunk first: a bad chunk leaves the upload as it was (resend it).
-  std::vector<machining::MotionBlock> decoded(blocks->size());
+  std::vector<machining::MotionBlock> decoded;
   std::string why;
-  for (std::size_t i = 0; i < blocks->size(); ++i) {
-    if (!from_json((*blocks)[i], decoded[i], why)) {
-      const std::size_t index = u.blocks.size() + i;
-      return error(ErrorCode::kBadRequest, "block " + std::to_string(index) + ": " + why,
-                   Json{{"block", index}});
-    }
+  if (const auto bad = ops::decode_blocks(*blocks, decoded, why)) {
+    const std::size_t index = u.blocks.size() + *bad;
+    return error(ErrorCode::kBadRequest, "block " + std::to_string(index) + ": " + why,
+                 Json{{"block", index}});
   }
   for (const auto& b : decoded) {
     u.crc.update(b);
@@ -272,8 +264,8 @@ Body op_program_commit(Session& s, const Json& msg) {
   s.upload_.reset();
   srv.committed_offsets[static_cast<std::size_t>(slot)] = offsets;
   srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
-  spdlog::info("bridge: session {} committed {} of {} blocks (crc32 {})", s.id(),
-               slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n, format_checksum(got));
+  s.log(spdlog::level::info, "committed {} of {} blocks (crc32 {})",
+        slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n, format_checksum(got));
   return Json{{"blocks", n},
               {"slot", slot == rt::JobSlot::kMdi ? "mdi" : "main"},
               {"checksum", format_checksum(got)},
@@ -289,99 +281,6 @@ Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
                  std::string(op) + " is not allowed in " + std::string(to_string(before)));
   }
   return Json{{"state", std::string(to_string(m.state()))}};
-}
-
-Body op_var_list(Session& s, const Json& msg) {
-  std::string prefix;
-  if (auto it = msg.find("prefix"); it != msg.end()) {
-    if (!it->is_string()) {
-      return error(ErrorCode::kBadRequest, "'prefix' must be a string");
-    }
-    prefix = it->get<std::string>();
-  }
-  auto& reg = s.server().rt.variables();
-  const auto forced_list = reg.forced();
-  const std::set<std::string> forced(forced_list.begin(), forced_list.end());
-  Json vars = Json::array();
-  for (const auto& v : reg.all()) {
-    if (v.name.compare(0, prefix.size(), prefix) != 0) {
-      continue;
-    }
-    vars.push_back({{"name", v.name},
-                    {"kind", std::string(to_string(v.kind))},
-                    {"type", std::string(v.type_name())},
-                    {"unit", v.unit},
-                    {"task", v.owner != nullptr ? v.owner->name() : ""},
-                    {"forced", forced.count(v.name) > 0}});
-  }
-  return Json{{"vars", std::move(vars)}};
-}
-
-Body op_var_read(Session& s, const Json& msg) {
-  std::vector<std::string> names;
-  if (auto it = msg.find("names"); it != msg.end() && it->is_array() && !it->empty()) {
-    for (const auto& n : *it) {
-      if (!n.is_string()) {
-        return error(ErrorCode::kBadRequest, "'names' must be an array of strings");
-      }
-      names.push_back(n.get<std::string>());
-    }
-  } else if (auto n = msg.find("name"); n != msg.end() && n->is_string()) {
-    names.push_back(n->get<std::string>());
-  } else {
-    return error(ErrorCode::kBadRequest, "'name' (string) or 'names' (array) is required");
-  }
-  auto& reg = s.server().rt.variables();
-  Json values = Json::object();
-  for (const auto& name : names) {
-    const rt::Variable* v = reg.find(name);
-    if (v == nullptr) {
-      return error(ErrorCode::kNotFound, "no variable " + brief_name(name));
-    }
-    const auto value = reg.read(name);
-    values[name] = value && std::isfinite(*value) ? Json(*value) : Json(nullptr);
-  }
-  return Json{{"values", std::move(values)}};
-}
-
-Body op_var_write(Session& s, const Json& msg, bool force) {
-  const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
-  const Json* value =
-      field(msg, "value", [](const Json& j) { return j.is_number() || j.is_boolean(); });
-  if (name == nullptr ||
-      (value == nullptr && !(msg.contains("value") && msg["value"].is_string() && !force))) {
-    return error(ErrorCode::kBadRequest,
-                 "'name' (string) and 'value' (number or boolean; durations: \"2ms\") required");
-  }
-  auto& reg = s.server().rt.variables();
-  const auto& n = name->get_ref<const std::string&>();
-  rt::VarStatus st;
-  if (value == nullptr) {  // a duration parameter as text
-    const auto d = rt::parse_duration(msg["value"].get<std::string>());
-    if (!d.value) {
-      return error(ErrorCode::kBadRequest, "'value': " + d.error);
-    }
-    st = reg.write(n, rt::ParamValue::of_duration(*d.value));
-  } else {
-    const double x = value->is_boolean() ? (value->get<bool>() ? 1.0 : 0.0) : value->get<double>();
-    st = force ? reg.force(n, x) : reg.write(n, x);
-  }
-  if (!st) {
-    return error(var_error(st.result), st.message.empty() ? "refused" : st.message);
-  }
-  return Json{{"name", n}};
-}
-
-Body op_var_unforce(Session& s, const Json& msg) {
-  const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
-  if (name == nullptr) {
-    return error(ErrorCode::kBadRequest, "'name' (string) required");
-  }
-  const auto st = s.server().rt.variables().unforce(name->get<std::string>());
-  if (!st) {
-    return error(var_error(st.result), st.message.empty() ? "refused" : st.message);
-  }
-  return Json{{"name", *name}};
 }
 
 Body op_tasks_stats(Session& s) {
@@ -417,45 +316,6 @@ Body op_tasks_stats(Session& s) {
                    {"timeouts", st.timeouts},
                    {"programs_committed", st.programs_committed}};
   return doc;
-}
-
-Body op_trace_start(Session& s, const Json& msg) {
-  const Json* vars = field(msg, "vars", [](const Json& j) { return j.is_array() && !j.empty(); });
-  if (vars == nullptr) {
-    return error(ErrorCode::kBadRequest, "'vars' must be a non-empty array of pin names");
-  }
-  auto& reg = s.server().rt.variables();
-  std::vector<std::string> names;
-  for (const auto& v : *vars) {
-    if (!v.is_string()) {
-      return error(ErrorCode::kBadRequest, "'vars' must be an array of strings");
-    }
-    const auto& n = v.get_ref<const std::string&>();
-    if (std::find(names.begin(), names.end(), n) != names.end()) {
-      continue;  // a repeated name is traced once
-    }
-    if (names.size() == rt::kMaxTraceVarsPerTask) {
-      return error(ErrorCode::kTooLarge, "at most " + std::to_string(rt::kMaxTraceVarsPerTask) +
-                                             " distinct trace variables per session");
-    }
-    const rt::Variable* var = reg.find(n);
-    if (var == nullptr) {
-      return error(ErrorCode::kNotFound, "no variable " + brief_name(n));
-    }
-    if (!var->is_pin() || var->owner == nullptr) {
-      return error(ErrorCode::kBadRequest, brief_name(n) + " is a parameter; only pins are traced");
-    }
-    names.push_back(n);
-  }
-  s.trace_vars_ = names;
-  s.server().retrace();
-  return Json{{"vars", names}};
-}
-
-Body op_trace_stop(Session& s) {
-  s.trace_vars_.clear();
-  s.server().retrace();
-  return Json::object();
 }
 
 /// feed.override {percent: 0…150}: the machine's feed override (Machine::set_feed_override).
@@ -513,29 +373,11 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
   if (auto body = ops::dispatch_operator(s, op, msg)) {
     return *body;
   }
-  if (op == "var.list") {
-    return op_var_list(s, msg);
-  }
-  if (op == "var.read") {
-    return op_var_read(s, msg);
-  }
-  if (op == "var.write") {
-    return op_var_write(s, msg, false);
-  }
-  if (op == "var.force") {
-    return op_var_write(s, msg, true);
-  }
-  if (op == "var.unforce") {
-    return op_var_unforce(s, msg);
+  if (auto body = ops::dispatch_vars(s, op, msg)) {
+    return *body;
   }
   if (op == "tasks.stats") {
     return op_tasks_stats(s);
-  }
-  if (op == "trace.start") {
-    return op_trace_start(s, msg);
-  }
-  if (op == "trace.stop") {
-    return op_trace_stop(s);
   }
   if (op == "feed.override") {
     return op_feed_override(s, msg);
@@ -552,16 +394,27 @@ Body dispatch(Session& s, const std::string& op, const Json& msg) {
   return error(ErrorCode::kUnknownOp, "unknown op " + brief_name(op));
 }
 
-/// What an audit entry says about a request beyond its op: the variable and value, or the
-/// program's size. Short, and built from validated fields only.
+/// What an audit entry says about a request beyond its op: the variable and value, the frame,
+/// the program's checksum. Short, one line: every client-supplied part is escaped and cut.
 std::string audit_detail(const std::string& op, const Json& msg) {
   std::string d;
-  if (auto it = msg.find("name"); it != msg.end() && it->is_string()) {
-    d = "name=" + brief_name(it->get_ref<const std::string&>());
+  const auto add = [&d](std::string_view key, std::string_view text) {
+    if (!d.empty()) d += ' ';
+    d += key;
+    d += '=';
+    d += text;
+  };
+  for (const char* key : {"name", "frame", "axis", "axes", "target", "slot"}) {
+    if (auto it = msg.find(key); it != msg.end() && it->is_string()) {
+      add(key, brief_name(it->get_ref<const std::string&>()));
+    }
   }
-  if (auto it = msg.find("value"); it != msg.end() && (it->is_primitive())) {
-    std::string v = it->dump();
-    d += (d.empty() ? "" : " ") + ("value=" + v.substr(0, 32));
+  for (const char* key : {"value", "distance", "velocity", "percent", "x", "y", "z"}) {
+    if (auto it = msg.find(key); it != msg.end() && it->is_primitive()) {
+      // A number, boolean or null dumps as plain ASCII; a string is quoted and escaped.
+      add(key, it->is_string() ? brief_name(it->get_ref<const std::string&>())
+                               : it->dump().substr(0, 32));
+    }
   }
   if (op == "program.commit") {
     if (auto it = msg.find("checksum"); it != msg.end() && it->is_string()) {
@@ -569,6 +422,18 @@ std::string audit_detail(const std::string& op, const Json& msg) {
     }
   }
   return d;
+}
+
+/// The op-state table's refusal of this request (op_states.hpp), or nullopt: it may run now.
+std::optional<Body> refuse_in_state(Session& s, const ParsedRequest& req) {
+  const OpStateRule* rule = op_state_rule(req.op, req.msg);
+  if (rule == nullptr) return std::nullopt;
+  const OpState state = current_op_state(s.server().rt);
+  if (allowed_in(*rule, state)) return std::nullopt;
+  const std::string what =
+      rule->variant.empty() ? req.op : req.op + " (" + std::string(rule->variant) + ")";
+  return error(ErrorCode::kInvalidState,
+               what + " is not allowed in " + std::string(to_string(state)));
 }
 
 }  // namespace
@@ -580,28 +445,44 @@ OpResult run_op(Session& s, const ParsedRequest& req) {
   if (info == nullptr) {
     body = error(ErrorCode::kUnknownOp, "unknown op " + brief_name(req.op));
   } else if (req.op == "hello") {
-    if (!s.role_) {
-      const auto now = SteadyClock::now();
-      const auto when = s.server().throttle.admit_at(s.peer_address(), now);
-      if (when > now) {
-        r.retry_at = when;  // evaluated later: the failed-hello throttle of this address
-        return r;
+    const std::optional<std::string> via = hello_peer(req.msg);
+    if (!via) {
+      body = error(ErrorCode::kBadRequest, "'peer' must be 1 to " +
+                                               std::to_string(kMaxHelloPeerChars) +
+                                               " printable ASCII characters");
+    } else {
+      if (!s.role_) {
+        const auto now = SteadyClock::now();
+        const auto when = s.server().throttle.admit_at(s.peer_address(), *via, now);
+        if (when > now) {
+          r.retry_at = when;  // evaluated later: the failed-hello throttle
+          return r;
+        }
       }
+      body = op_hello(s, req.msg, *via);
     }
-    body = op_hello(s, req.msg);
     r.close_after = std::holds_alternative<Error>(body) && !s.role_;  // refused: session ends
   } else if (!s.role_) {
     body = error(ErrorCode::kUnauthorized, "hello first");
   } else if (info->operator_only && *s.role_ != Role::kOperator) {
     body = error(ErrorCode::kForbidden, "'" + req.op + "' needs the operator role");
+  } else if (auto refusal = refuse_in_state(s, req)) {
+    body = std::move(*refusal);
   } else {
     body = dispatch(s, req.op, req.msg);
   }
   const auto* e = std::get_if<Error>(&body);
   if (info != nullptr && info->operator_only && s.role_) {
-    s.server().audit.record(s.id(), to_string(*s.role_), s.peer(), req.op,
-                            audit_detail(req.op, req.msg),
-                            e != nullptr ? to_string(e->code) : "ok");
+    const std::string detail = audit_detail(req.op, req.msg);
+    s.server().audit.record({.session = s.id(),
+                             .role = to_string(*s.role_),
+                             .peer = s.peer(),
+                             .address = s.peer_address(),
+                             .via = s.via_,
+                             .op = req.op,
+                             .detail = detail,
+                             .outcome = e != nullptr ? to_string(e->code) : "ok"},
+                            s.server().log_limiter);
   }
   if (e != nullptr) {
     r.reply = make_error(req.id, e->code, e->message, e->details);

@@ -19,31 +19,30 @@ int axis_index(const std::string& a) {
   return -1;
 }
 
-/// Manual motion needs a machine that has it, READY, no job, and no other manual operation
-/// (a jog may replace a jog).
-std::optional<Body> manual_ready(rt::Runtime& rt, bool jog) {
-  const rt::ManualInfo info = rt.manual().info();
-  if (!info.available) {
+/// Manual motion needs a machine that has it. When it may run (READY, no job, no other manual
+/// operation) is the op-state table's (op_states.cpp), checked before any op runs.
+std::optional<Body> manual_available(rt::Runtime& rt) {
+  if (!rt.manual().info().available) {
     return error(ErrorCode::kInvalidState, "this machine has no manual motion (no EdmJob)");
-  }
-  const rt::MachineState st = rt.machine().state();
-  if (st != rt::MachineState::kReady || rt.job().active()) {
-    return error(ErrorCode::kInvalidState,
-                 "manual motion needs the machine READY with no job running (it is " +
-                     std::string(rt::to_string(st)) + ")");
-  }
-  const rt::ManualStatus ms = rt.manual().status();
-  if (ms.busy && !(jog && ms.mode == rt::ManualMode::kJog)) {
-    return error(ErrorCode::kBusy, "a manual operation is running (" +
-                                       std::string(rt::to_string(ms.mode)) +
-                                       "): wait for it or send jog.stop");
   }
   return std::nullopt;
 }
 
+/// Queues `r` for the RT side; the reply body with its seq, or busy when the queue is full.
+Body send_manual(rt::Runtime& rt, const rt::ManualRequest& r, Json body = Json::object()) {
+  const std::uint64_t seq = rt.manual().request(r);
+  if (seq == 0) {
+    return error(ErrorCode::kBusy, "the runtime has not taken the last " +
+                                       std::to_string(rt::ManualControl::kQueueCapacity) +
+                                       " manual requests; nothing was queued");
+  }
+  body["seq"] = seq;
+  return body;
+}
+
 Body op_home(Session& s, const Json& msg) {
   auto& rt = s.server().rt;
-  if (auto e = manual_ready(rt, false)) return *e;
+  if (auto e = manual_available(rt)) return *e;
   if (!rt.manual().info().home) {
     return error(ErrorCode::kInvalidState, "this machine has no reference switches wired");
   }
@@ -65,17 +64,16 @@ Body op_home(Session& s, const Json& msg) {
   rt::ManualRequest r;
   r.op = rt::ManualOp::kHome;
   r.axes = mask;
-  const std::uint64_t seq = rt.manual().request(r);
   std::string axes;
   for (int a = 0; a < 3; ++a) {
     if ((mask >> a & 1U) != 0) axes += kAxisNames[a];
   }
-  return Json{{"seq", seq}, {"axes", axes}};
+  return send_manual(rt, r, Json{{"axes", axes}});
 }
 
 Body op_jog(Session& s, const Json& msg) {
   auto& rt = s.server().rt;
-  if (auto e = manual_ready(rt, true)) return *e;
+  if (auto e = manual_available(rt)) return *e;
   const Json* axis = field(msg, "axis", [](const Json& j) { return j.is_string(); });
   const int a = axis != nullptr ? axis_index(axis->get<std::string>()) : -1;
   if (a < 0) return error(ErrorCode::kBadRequest, "'axis' must be \"X\", \"Y\" or \"Z\"");
@@ -105,18 +103,18 @@ Body op_jog(Session& s, const Json& msg) {
     r.op = rt::ManualOp::kJogVelocity;
     r.value = v;
   }
-  return Json{{"seq", rt.manual().request(r)}, {"deadman_ms", info.deadman_ms}};
+  return send_manual(rt, r, Json{{"deadman_ms", info.deadman_ms}});
 }
 
 Body op_jog_stop(Session& s) {
   rt::ManualRequest r;
   r.op = rt::ManualOp::kStop;
-  return Json{{"seq", s.server().rt.manual().request(r)}};
+  return send_manual(s.server().rt, r);
 }
 
 Body op_touch(Session& s, const Json& msg) {
   auto& rt = s.server().rt;
-  if (auto e = manual_ready(rt, false)) return *e;
+  if (auto e = manual_available(rt)) return *e;
   if (!rt.manual().info().touch) {
     return error(ErrorCode::kInvalidState, "this machine has no contact sensing wired");
   }
@@ -129,7 +127,7 @@ Body op_touch(Session& s, const Json& msg) {
   rt::ManualRequest r;
   r.op = rt::ManualOp::kTouch;
   r.target = target;
-  return Json{{"seq", rt.manual().request(r)}};
+  return send_manual(rt, r);
 }
 
 Json referenced_json(std::uint8_t mask) {
@@ -142,6 +140,7 @@ Body op_manual_status(Session& s) {
   Json out{{"mode", std::string(rt::to_string(st.mode))},
            {"busy", st.busy},
            {"seen_seq", st.seen_seq},
+           {"refused_seq", st.refused_seq},
            {"referenced", referenced_json(m.referenced())},
            {"may_run_programs", m.may_run_programs()}};
   const rt::ManualResult& r = st.result;
@@ -197,17 +196,25 @@ Body op_offset_set(Session& s, const Json& msg) {
   if (!v[0] && !v[1] && !v[2]) {
     return error(ErrorCode::kBadRequest, "give at least one of 'x', 'y', 'z'");
   }
-  const rt::MachineState st = rt.machine().state();
-  if (rt.job().active() || st == rt::MachineState::kRunning || st == rt::MachineState::kHold) {
-    return error(ErrorCode::kInvalidState, "work offsets are not changed while a job runs");
-  }
+  const rt::WorkFrame before = rt.work_offsets().get(*index);
   const rt::WorkFrame nf = rt.work_offsets().set(*index, v[0], v[1], v[2]);
-  if (rt.retain() != nullptr) rt.retain()->flush();  // on disk before the reply
-  spdlog::info("bridge: session {} set {} to X{} Y{} Z{}", s.id(),
-               rt::WorkOffsets::frame_name(*index), nf.x, nf.y, nf.z);
+  // On disk before the reply. A write that fails (the store raises alarm 183) undoes the change:
+  // the operator must never believe an offset is kept that the next start will not have.
+  if (rt.retain() != nullptr && rt.retain()->sync() == rt::RetainStore::SyncResult::kFailed) {
+    rt.work_offsets().set(*index, before.x, before.y, before.z);
+    s.log(spdlog::level::warn, "{} not set: the retain file could not be written",
+          rt::WorkOffsets::frame_name(*index));
+    return error(ErrorCode::kRetainFailed,
+                 "the work offset could not be retained (alarm 183: the retain file '" +
+                     rt.retain()->path() + "' could not be written); " +
+                     rt::WorkOffsets::frame_name(*index) + " is unchanged");
+  }
+  s.log(spdlog::level::info, "set {} to X{} Y{} Z{}", rt::WorkOffsets::frame_name(*index), nf.x,
+        nf.y, nf.z);
   Json out = frame_json(nf);
   out["frame"] = rt::WorkOffsets::frame_name(*index);
   out["generation"] = rt.work_offsets().generation();
+  out["retained"] = rt.retain() != nullptr;  // false: this run retains nothing (no retain file)
   return out;
 }
 
@@ -274,9 +281,6 @@ std::optional<Body> prepare_start(Session& s, const Json& msg) {
     if (!m.may_run_programs()) {
       return error(ErrorCode::kInvalidState,
                    "machine not referenced: home every axis first (edmhmi home)");
-    }
-    if (m.status().busy) {
-      return error(ErrorCode::kInvalidState, "a manual operation is running (jog.stop first)");
     }
     const auto& gen = srv.committed_offsets[static_cast<std::size_t>(o.slot)];
     if (gen && *gen != rt.work_offsets().generation()) {

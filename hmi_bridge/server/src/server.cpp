@@ -370,6 +370,14 @@ void Server::Impl::progress_tick() {
       }
     }
   }
+  if (const auto now = SteadyClock::now(); now >= next_log_sweep) {
+    // A flood of log lines that has stopped is summed up once it has been quiet for a while.
+    next_log_sweep = now + std::chrono::seconds(5);
+    log_limiter.sweep(
+        now, std::chrono::seconds(5), [](const std::string& address, std::uint64_t n) {
+          spdlog::info("bridge: {}: {} log lines about its sessions suppressed", address, n);
+        });
+  }
   progress_timer.expires_after(kProgressPeriod);
   progress_timer.async_wait([this](boost::system::error_code ec) {
     if (!ec) {

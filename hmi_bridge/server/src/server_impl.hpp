@@ -3,6 +3,8 @@
 // Everything here runs on the server's single io thread (one thread runs the io_context, so
 // handlers never run concurrently). Counters are atomics so stats() may be read from any thread.
 
+#include <spdlog/spdlog.h>
+
 #include <array>
 #include <atomic>
 #include <boost/asio/executor_work_guard.hpp>
@@ -28,6 +30,8 @@
 #include "edm/bridge/status_board.hpp"
 #include "edm/bridge/trace_tap.hpp"
 #include "edm/bridge/transport.hpp"
+#include "edm/runtime/log_escape.hpp"
+#include "edm/runtime/log_limiter.hpp"
 #include "edm/runtime/runtime.hpp"
 
 namespace boost::asio::ssl {
@@ -109,6 +113,9 @@ struct Server::Impl {
   TokenSet tokens;
   std::shared_ptr<asio::ssl::context> tls;  // null: plain TCP
   HelloThrottle throttle;
+  /// Log lines a client's requests cause, per transport address: 20 at once, then 1 a second;
+  /// the rest are counted and summed up (Session::log, the audit's log copy).
+  rt::LogRateLimiter log_limiter;
   AuditLog audit;
   std::vector<std::string> status_var_names;
   std::unique_ptr<StatusBoard> board;
@@ -132,6 +139,7 @@ struct Server::Impl {
   asio::steady_timer progress_timer{ioc};
   asio::steady_timer trace_timer{ioc};
   rt::JobProgress last_progress{};
+  SteadyClock::time_point next_log_sweep{};
   // Keyed by session id, so iteration is in age order (oldest first).
   std::map<std::uint64_t, std::weak_ptr<Session>> pending;   // no valid hello yet
   std::map<std::uint64_t, std::weak_ptr<Session>> sessions;  // authenticated
@@ -180,6 +188,22 @@ class Session : public std::enable_shared_from_this<Session> {
   [[nodiscard]] const std::string& peer_address() const { return address_; }
   [[nodiscard]] bool authenticated() const { return role_.has_value(); }
   [[nodiscard]] std::size_t queued_bytes() const { return queued_bytes_; }
+  /// "session N (address:port via "peer")": how the log names this session. The peer (hello's
+  /// relayed end client) is escaped.
+  [[nodiscard]] std::string log_name() const;
+  /// One log line about this session, "bridge: <log_name>: <message>", rate-limited per
+  /// transport address (the lines beyond are counted and reported with the next one). Every
+  /// client-supplied text in `args` must be escaped by the caller (rt::log_quoted).
+  template <class... Args>
+  void log(spdlog::level::level_enum level, fmt::format_string<Args...> format, Args&&... args) {
+    std::uint64_t suppressed = 0;
+    if (!spdlog::should_log(level) ||
+        !server_.log_limiter.admit(address_, SteadyClock::now(), suppressed)) {
+      return;
+    }
+    spdlog::log(level, "bridge: {}: {}{}", log_name(),
+                fmt::format(format, std::forward<Args>(args)...), rt::suppressed_note(suppressed));
+  }
 
  private:
   friend struct Ops;
@@ -231,6 +255,7 @@ class Session : public std::enable_shared_from_this<Session> {
 
  public:  // state the ops (ops.cpp) read and change
   std::optional<Role> role_;
+  std::string via_;  // hello's "peer" (validated, printable ASCII), "" when none
   bool sub_status_{false};
   bool sub_alarm_{false};
   bool sub_progress_{false};

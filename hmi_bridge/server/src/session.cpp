@@ -39,6 +39,16 @@ Session::Session(Server::Impl& server, std::unique_ptr<Transport> transport, std
   loopback_ = is_loopback_address(address_);
 }
 
+std::string Session::log_name() const {
+  std::string n = "session " + std::to_string(id_) + " (" + peer_;
+  if (!via_.empty()) {
+    n += " via=";
+    rt::append_log_quoted(n, via_);
+  }
+  n += ")";
+  return n;
+}
+
 void Session::start() {
   arm_hello_timer();
   transport_->async_handshake(
@@ -50,7 +60,7 @@ void Session::on_handshake(boost::system::error_code ec) {
     return;
   }
   if (ec) {
-    spdlog::info("bridge: session {} ({}): TLS handshake failed: {}", id_, peer_, ec.message());
+    log(spdlog::level::info, "TLS handshake failed: {}", ec.message());
     close();
     return;
   }
@@ -131,8 +141,8 @@ void Session::arm_read_timer() {
       return;
     }
     self->server_.counters.timeouts.fetch_add(1, std::memory_order_relaxed);
-    spdlog::info("bridge: session {} ({}): no request for {} ms, closing", self->id_, self->peer_,
-                 self->server_.opt.read_timeout.count());
+    self->log(spdlog::level::info, "no request for {} ms, closing",
+              self->server_.opt.read_timeout.count());
     self->close();
   });
 }
@@ -146,8 +156,8 @@ void Session::arm_hello_timer() {
       return;  // a hello that came in time and waits for the throttle is not timed out
     }
     self->server_.counters.hello_timeouts.fetch_add(1, std::memory_order_relaxed);
-    spdlog::info("bridge: session {} ({}): no valid hello within {} ms, closing", self->id_,
-                 self->peer_, self->server_.opt.hello_timeout.count());
+    self->log(spdlog::level::info, "no valid hello within {} ms, closing",
+              self->server_.opt.hello_timeout.count());
     self->close();
   });
 }
@@ -267,7 +277,8 @@ void Session::handle_line(std::string_view line) {
     try {
       r = run_op(*this, *req);
     } catch (const std::exception& e) {  // a bug or bad_alloc must not take the server down
-      spdlog::error("bridge: session {}: op '{}' failed: {}", id_, req->op, e.what());
+      log(spdlog::level::err, "op {} failed: {}", rt::log_quoted(req->op),
+          rt::log_quoted(e.what(), 256));
       r.reply = make_error(req->id, ErrorCode::kBadRequest, "internal error");
     }
   }
@@ -320,10 +331,8 @@ void Session::send_event(std::string_view name, Json body) {
       stalled_since_ = now;
     } else if (now - *stalled_since_ > server_.opt.stall_timeout) {
       server_.counters.slow_disconnects.fetch_add(1, std::memory_order_relaxed);
-      spdlog::warn(
-          "bridge: session {} ({}): not reading for {} ms ({} events dropped); "
-          "disconnecting",
-          id_, peer_, server_.opt.stall_timeout.count(), dropped_);
+      log(spdlog::level::warn, "not reading for {} ms ({} events dropped); disconnecting",
+          server_.opt.stall_timeout.count(), dropped_);
       // Posted: the caller is a broadcast loop, and closing takes the session out of the
       // server's registry.
       async_close();

@@ -67,6 +67,7 @@ enum class AlarmCode : std::uint16_t {
   kRetainCorrupt = 180,    // the retain file could not be read: set aside, defaults in use
   kForcesReleased = 181,   // a safe state released forced pins (value: how many)
   kJobInterrupted = 182,   // the retain file shows a job running at an unclean stop (value: depth)
+  kRetainWriteFailed = 183,  // warning: the retain file could not be written (value: failures)
 };
 
 std::string_view to_string(AlarmCode c) noexcept;

@@ -4,10 +4,16 @@
 // bridge to the block that moves the axes (programs::ManualMotion, a child of EdmJob), and that
 // block's state and results on their way back.
 //
-//   bridge (non-RT)  request()  ──Seqlock<ManualRequest>──▶  rt_poll()   ManualMotion (RT)
-//   bridge (non-RT)  status()   ◀──Seqlock<ManualStatus>───  rt_publish()
+//   bridge (non-RT)  request()  ──MpmcQueue<ManualRequest, 16>──▶  rt_poll()   ManualMotion (RT)
+//   bridge (non-RT)  status()   ◀──Seqlock<ManualStatus>──────────  rt_publish()
 //
-// Every request carries a sequence number; the RT side acts on each new one once. A continuous
+// Every request carries a sequence number and is queued, in order: the RT side takes every
+// request of a cycle, one after the other (a jog and a stop sent together both run), never only
+// the newest. A full queue refuses the request (request() returns 0), so nothing is answered ok
+// and then lost. What the manual motion is doing or is about to do — the newest request the RT
+// side has not taken yet, else its published status — is activity(): the bridge judges a new
+// request by it (docs/protocol.md "Op states"), so a touch sent in the same write as a jog is
+// refused, not silently dropped. A continuous
 // jog is kept alive by sending it again (any new request counts): the RT side stops the axis
 // when it has seen no request for `deadman` (its own clock: the cycle release at which it saw
 // the last one), so a client that dies, hangs or loses its network never keeps an axis moving.
@@ -17,9 +23,9 @@
 // axis's coordinates mean nothing yet, LinuxCNC does the same), and the following-error model
 // restarts from the actual position when the epoch moves.
 //
-// Thread-safety: request() from any non-RT thread (serialised by a mutex the RT side never
-// takes); rt_poll()/rt_publish()/set_referenced()/bump_position_epoch() from the one RT thread
-// that runs ManualMotion; status(), info(), referenced(), position_epoch() from any thread.
+// Thread-safety: request() and activity() from any non-RT thread (serialised by a mutex the RT
+// side never takes); rt_poll()/rt_publish()/set_referenced()/bump_position_epoch() from the one RT
+// thread that runs ManualMotion; status(), info(), referenced(), position_epoch() from any thread.
 // attach() at configure time only.
 
 #include <atomic>
@@ -27,6 +33,7 @@
 #include <mutex>
 #include <string_view>
 
+#include "edm/runtime/mpmc_queue.hpp"
 #include "edm/runtime/seqlock.hpp"
 #include "edm/runtime/time.hpp"
 
@@ -84,7 +91,9 @@ struct ManualResult {
 struct ManualStatus {
   ManualMode mode{ManualMode::kIdle};
   bool busy{false};
-  std::uint64_t seen_seq{0};  // the newest request the RT side has taken
+  ManualOp op{ManualOp::kNone};  // the operation running (kNone when idle)
+  std::uint64_t seen_seq{0};     // the newest request the RT side has taken
+  std::uint64_t refused_seq{0};  // the newest request it refused because another one ran
   ManualResult result{};
 };
 
@@ -111,11 +120,21 @@ class ManualControl {
   void attach(const ManualInfo& info, std::uint8_t referenced_at_start) noexcept;
   [[nodiscard]] ManualInfo info() const noexcept;
 
-  /// Non-RT, any thread. Queues `r` (its seq is assigned here) and returns the seq.
+  /// Requests queued and not yet taken by the RT side, at most.
+  static constexpr std::size_t kQueueCapacity = 16;
+
+  /// Non-RT, any thread. Queues `r` (its seq is assigned here) and returns the seq; 0 when the
+  /// queue is full (the RT side is not taking requests: refuse the operator's request).
   std::uint64_t request(ManualRequest r) noexcept;
 
-  /// RT: the newest request if it is newer than `last_seq` (updated); false otherwise.
-  bool rt_poll(ManualRequest& out, std::uint64_t& last_seq) const noexcept;
+  /// The manual operation running or about to run, as a new request must be judged: the op of
+  /// the newest request the RT side has not taken yet, else status().op. A pending kStop counts
+  /// as idle (kNone): the queue is ordered, so what is sent after a stop runs after it.
+  /// Non-RT, any thread.
+  [[nodiscard]] ManualOp activity() const noexcept;
+
+  /// RT: the oldest queued request newer than `last_seq` (updated); false when none is queued.
+  bool rt_poll(ManualRequest& out, std::uint64_t& last_seq) noexcept;
   /// RT: publishes the block's state.
   void rt_publish(const ManualStatus& s) noexcept { status_.store(s); }
   /// Any thread.
@@ -142,9 +161,10 @@ class ManualControl {
   void bump_position_epoch() noexcept { position_epoch_.fetch_add(1, std::memory_order_acq_rel); }
 
  private:
-  std::mutex writer_;  // serialises request() callers; never taken by the RT side
+  mutable std::mutex writer_;  // serialises request() and activity(); never taken by the RT side
   std::uint64_t next_seq_{0};
-  Seqlock<ManualRequest> request_;
+  ManualOp newest_op_{ManualOp::kNone};  // the op of request next_seq_ (guarded by writer_)
+  MpmcQueue<ManualRequest, kQueueCapacity> queue_;
   Seqlock<ManualStatus> status_;
   Seqlock<ManualInfo> info_;
   std::atomic<std::uint8_t> referenced_{0x7};

@@ -134,8 +134,10 @@ std::size_t remove_stale_retain_temps(const std::string& path) noexcept;
 /// Owns the retain file of one runtime and the non-RT thread that keeps it up to date.
 /// Writes when a value changed, at most once per `min_interval` (so a counter that changes every
 /// cycle costs one fsync per interval, not one per cycle), and on stop().
-/// Thread-safety: poll() and flush() are serialised by an internal mutex and may be called from
-/// any non-RT thread, also while the background thread runs; start()/stop() from one owner
+/// A failed write is logged, counted, reported to the write listener (the runtime raises alarm
+/// 183, retain_write_failed) and retried at the next poll while the values differ.
+/// Thread-safety: poll(), flush() and sync() are serialised by an internal mutex and may be called
+/// from any non-RT thread, also while the background thread runs; start()/stop() from one owner
 /// thread; writes()/write_failures() from anywhere. Nothing is RT-safe.
 class RetainStore {
  public:
@@ -171,6 +173,24 @@ class RetainStore {
   /// Writes now, ignoring min_interval, if anything changed since the last write (or nothing was
   /// written yet). Returns true if it wrote. Failures as in poll().
   bool flush() noexcept;
+
+  /// What sync() did: kWritten (it wrote every value), kUnchanged (the file already held them),
+  /// kFailed (the write failed or was refused: the file holds older values, or none).
+  enum class SyncResult : std::uint8_t { kWritten, kUnchanged, kFailed };
+  /// flush() that says whether the file now holds every current value: for an operation that
+  /// must not report success for data it did not keep (offset.set).
+  SyncResult sync() noexcept;
+
+  /// Called after every write attempt with its outcome (true: written), on the writing thread
+  /// and under the store's lock: keep it short (the runtime raises or clears an alarm) and never
+  /// call the store from it. Set before start().
+  void set_write_listener(std::function<void(bool ok)> listener) {
+    write_listener_ = std::move(listener);
+  }
+  /// True from a failed write attempt until the next successful one. Any thread.
+  [[nodiscard]] bool failing() const noexcept { return failing_.load(std::memory_order_acquire); }
+  /// Whether `name` is one of the store's variables. Any thread (the list is fixed).
+  [[nodiscard]] bool retains(std::string_view name) const noexcept;
 
   /// Removes stale temp files, forgets the time of the last attempt (poll() calls made before may
   /// have used another time line), then starts a thread calling poll(steady clock) right away and
@@ -209,6 +229,8 @@ class RetainStore {
 
   std::atomic<std::uint64_t> writes_{0};
   std::atomic<std::uint64_t> write_failures_{0};
+  std::atomic<bool> failing_{false};
+  std::function<void(bool ok)> write_listener_;
 
   std::mutex thread_mutex_;
   std::condition_variable wake_;
