@@ -67,6 +67,7 @@ struct ServeArgs {
   std::string tls_cert;       // --tls-cert, else $EDM_WEB_TLS_CERT: HTTPS when set (with the key)
   std::string tls_key;        // --tls-key, else $EDM_WEB_TLS_KEY
   bool insecure_http{false};  // --insecure-http: plain HTTP anywhere, even when the bridge is TLS
+  std::vector<std::string> allow_hosts;  // --allow-host NAME[:PORT] (+ $EDM_WEB_ALLOW_HOSTS)
 };
 
 /// Set by SIGINT / SIGTERM; loops poll it.

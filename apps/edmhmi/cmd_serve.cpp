@@ -1,12 +1,15 @@
-// edmhmi serve [--listen HOST:PORT] [--web-root DIR] [--tls-cert F --tls-key F] — the operator's
-// screen in a browser (docs/web.md): serves the built page and a WebSocket (HTTPS/WSS with a
-// certificate), owns one bridge session to edmplc and the job, relays commands for logged-in
-// browsers.
+// edmhmi serve [--listen HOST:PORT] [--web-root DIR] [--tls-cert F --tls-key F] [--allow-host N]…
+// — the operator's screen in a browser (docs/web.md): serves the built page and a WebSocket
+// (HTTPS/WSS with a certificate), owns one bridge session to edmplc and the job, relays commands
+// for logged-in browsers. It serves the page before edmplc is there and waits for it (and again
+// after edmplc restarts), saying so on the page.
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 
 #include "cli.hpp"
 #include "edm/hmi/web_http.hpp"
@@ -81,6 +84,24 @@ bool plain_http_allowed(const ServeArgs& args, const edm::hmi::ConnectionSetting
   return true;
 }
 
+/// --allow-host's names, then $EDM_WEB_ALLOW_HOSTS's (separated by commas or white space).
+std::vector<std::string> allowed_names(const ServeArgs& args) {
+  std::vector<std::string> names = args.allow_hosts;
+  if (const char* env = std::getenv("EDM_WEB_ALLOW_HOSTS")) {
+    std::string word;
+    for (const char* p = env;; ++p) {
+      if (*p == '\0' || *p == ',' || *p == ' ' || *p == '\t') {
+        if (!word.empty()) names.push_back(word);
+        word.clear();
+        if (*p == '\0') break;
+      } else {
+        word.push_back(*p);
+      }
+    }
+  }
+  return names;
+}
+
 }  // namespace
 
 int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& settings) {
@@ -105,6 +126,12 @@ int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& setting
   } else if (!plain_http_allowed(args, settings, endpoint)) {
     return kExitBadInput;
   }
+  std::optional<edm::hmi::HostAllowList> hosts;
+  try {
+    hosts.emplace(endpoint.address(), allowed_names(args), tls != nullptr);
+  } catch (const std::invalid_argument& e) {
+    return usage(e.what());
+  }
   if (!std::filesystem::is_regular_file(std::filesystem::path(web_root) / "index.html")) {
     std::fprintf(stderr,
                  "edmhmi serve: %s/index.html missing: build the page (./edm build, or "
@@ -114,32 +141,33 @@ int cmd_serve(const ServeArgs& args, const edm::hmi::ConnectionSettings& setting
   }
 
   edm::bridge::Client client;
-  if (!connect(client, settings, /*auto_reconnect=*/true)) return kExitFailure;
   boost::asio::io_context ioc;
   edm::hmi::WebHub hub(ioc, client, settings);
-  try {
-    hub.start();
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "edmhmi serve: %s\n", e.what());
-    return kExitFailure;
-  }
   std::shared_ptr<edm::hmi::WebListener> listener;
   try {
-    listener = std::make_shared<edm::hmi::WebListener>(ioc, endpoint, web_root, hub, tls);
+    listener = std::make_shared<edm::hmi::WebListener>(ioc, endpoint, web_root, hub,
+                                                       std::move(*hosts), tls);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "edmhmi serve: cannot listen on %s: %s\n", listen.c_str(), e.what());
     return kExitFailure;
   }
   listener->run();
+  hub.start();  // connects to edmplc in the background, for as long as it takes
   boost::asio::signal_set signals(ioc, SIGINT, SIGTERM);
   signals.async_wait([&ioc](boost::system::error_code, int) { ioc.stop(); });
   const auto ep = listener->local_endpoint();
-  std::printf("edmhmi serve: listening on %s://%s:%u/ (edmplc at %s:%u as %s, page %s)\n",
+  std::printf("edmhmi serve: listening on %s://%s:%u/ (edmplc at %s:%u, page %s)\n",
               tls ? "https" : "http", ep.address().to_string().c_str(), unsigned{ep.port()},
-              settings.host.c_str(), unsigned{settings.port},
-              std::string(edm::bridge::to_string(client.role())).c_str(), web_root.c_str());
+              settings.host.c_str(), unsigned{settings.port}, web_root.c_str());
   std::fflush(stdout);
-  ioc.run();
+  for (;;) {  // a handler that throws ends its own connection, never the server
+    try {
+      ioc.run();
+      break;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "edmhmi serve: a handler failed: %s\n", e.what());
+    }
+  }
   hub.stop();
   client.close();
   // The job is edmplc's: stopping the web server leaves it running.

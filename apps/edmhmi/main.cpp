@@ -152,6 +152,9 @@ int run(int argc, char** argv) {
                 "the PEM private key of --tls-cert (else $EDM_WEB_TLS_KEY)");
   s->add_flag("--insecure-http", serve.insecure_http,
               "allow plain HTTP on any address even when the bridge uses TLS (tokens in clear)");
+  s->add_option("--allow-host", serve.allow_hosts,
+                "a name the page is reached by, NAME or NAME:PORT (repeatable; also "
+                "$EDM_WEB_ALLOW_HOSTS)");
 
   FleetArgs fleet;
   add_fleet_command(app, fleet);

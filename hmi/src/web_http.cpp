@@ -37,12 +37,6 @@ void fail(beast::error_code ec, const char* what) {
   std::fprintf(stderr, "edmhmi serve: %s: %s\n", what, ec.message().c_str());
 }
 
-/// The host part of an Origin ("http://h:p" → "h:p").
-std::string_view origin_host(std::string_view origin) {
-  const auto p = origin.find("://");
-  return p == std::string_view::npos ? origin : origin.substr(p + 3);
-}
-
 using TlsStream = beast::ssl_stream<beast::tcp_stream>;
 
 /// One connection: plain HTTP (`beast::tcp_stream`) or HTTPS (`TlsStream`, handshake first).
@@ -51,9 +45,13 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   static constexpr bool kTls = std::is_same_v<Stream, TlsStream>;
 
  public:
-  HttpSession(tcp::socket socket, const std::filesystem::path& root, WebHub& hub,
-              asio::ssl::context* tls)
-      : stream_(make_stream(std::move(socket), tls)), root_(root), hub_(hub) {}
+  HttpSession(tcp::socket socket, std::shared_ptr<WebListener::Shared> shared,
+              asio::ssl::context* tls, std::string peer, ConnectionCounter::Slot slot)
+      : local_(local_address(socket)),
+        stream_(make_stream(std::move(socket), tls)),
+        shared_(std::move(shared)),
+        peer_(std::move(peer)),
+        slot_(std::move(slot)) {}
 
   void run() {
     asio::dispatch(stream_.get_executor(), [self = this->shared_from_this()] {
@@ -71,6 +69,12 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
   }
 
  private:
+  static asio::ip::address local_address(const tcp::socket& socket) {
+    beast::error_code ec;
+    const auto ep = socket.local_endpoint(ec);
+    return ec ? asio::ip::address() : ep.address();
+  }
+
   static Stream make_stream(tcp::socket socket, asio::ssl::context* tls) {
     if constexpr (kTls) {
       return Stream(std::move(socket), *tls);
@@ -92,20 +96,34 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     if (ec == http::error::header_limit || ec == http::error::body_limit) {
       return send(simple(http::status::payload_too_large, "request too large\n"), true);
     }
+    if (ec && ec != http::error::end_of_stream &&
+        ec.category() == beast::error_code(http::error::bad_method).category()) {
+      return send(simple(http::status::bad_request, "bad request\n"), true);  // not logged
+    }
     if (ec) return fail(ec, "http read");
     http::request<http::string_body> req = parser_->release();
+    // DNS rebinding: a foreign name gets nothing of the page, nor the socket.
+    const auto host = req[http::field::host];
+    if (req.count(http::field::host) != 1 ||
+        !shared_->hosts.allows_host(std::string_view(host.data(), host.size()), local_)) {
+      return send(simple(http::status::misdirected_request, "host not allowed\n"), true);
+    }
     if (beast::websocket::is_upgrade(req)) {
       if (req.target() != "/ws")
         return send(simple(http::status::not_found, "no such socket\n"), true);
-      const auto origin_sv = req[http::field::origin];
-      const auto host_sv = req[http::field::host];
-      const std::string origin(origin_sv.data(), origin_sv.size());
-      const std::string host(host_sv.data(), host_sv.size());
-      if (!origin.empty() && origin_host(origin) != host) {
+      const auto origin = req[http::field::origin];
+      if (req.count(http::field::origin) != 1 ||
+          !shared_->hosts.allows_origin(std::string_view(origin.data(), origin.size()),
+                                        std::string_view(host.data(), host.size()), local_)) {
         return send(simple(http::status::forbidden, "cross-origin WebSocket refused\n"), true);
       }
+      ConnectionCounter::Slot socket = shared_->sockets->acquire("");
+      if (!socket) {
+        return send(simple(http::status::service_unavailable, "too many sockets\n"), true);
+      }
       beast::get_lowest_layer(stream_).expires_never();
-      return start_web_socket(std::move(stream_), std::move(req), hub_);
+      return start_web_socket(std::move(stream_), std::move(req), shared_->hub,
+                              WebPeer{peer_, std::move(slot_), std::move(socket)});
     }
     handle(req);
   }
@@ -128,7 +146,8 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
       return send(std::move(res), !req.keep_alive());
     }
     const std::string target(req.target());
-    const std::optional<std::filesystem::path> file = resolve_static_path(root_, target);
+    const std::optional<std::filesystem::path> file =
+        resolve_static_path(shared_->web_root, target);
     if (!file) return send(simple(http::status::bad_request, "bad path\n"), true);
     std::error_code fec;
     const auto size = std::filesystem::file_size(*file, fec);
@@ -181,20 +200,29 @@ class HttpSession : public std::enable_shared_from_this<HttpSession<Stream>> {
     do_read();
   }
 
+  asio::ip::address local_;  // the address the client dialled (web_hosts.hpp)
   Stream stream_;
   beast::flat_buffer buffer_{kMaxHttpHeaderBytes + kMaxHttpBodyBytes};
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<http::response<http::string_body>> res_;
-  const std::filesystem::path& root_;
-  WebHub& hub_;
+  std::shared_ptr<WebListener::Shared> shared_;
+  std::string peer_;
+  ConnectionCounter::Slot slot_;
 };
 
 }  // namespace
 
 WebListener::WebListener(asio::io_context& ioc, const tcp::endpoint& endpoint,
-                         std::filesystem::path web_root, WebHub& hub,
+                         std::filesystem::path web_root, WebHub& hub, HostAllowList hosts,
                          std::shared_ptr<asio::ssl::context> tls)
-    : ioc_(ioc), acceptor_(ioc), web_root_(std::move(web_root)), hub_(hub), tls_(std::move(tls)) {
+    : ioc_(ioc),
+      acceptor_(ioc),
+      accept_timer_(ioc),
+      shared_(std::make_shared<Shared>(Shared{
+          std::move(web_root), hub, std::move(hosts),
+          std::make_shared<ConnectionCounter>(kMaxWebConnections, kMaxWebConnectionsPerAddress),
+          std::make_shared<ConnectionCounter>(kMaxWebSockets, kMaxWebSockets)})),
+      tls_(std::move(tls)) {
   acceptor_.open(endpoint.protocol());
   acceptor_.set_option(asio::socket_base::reuse_address(true));
   acceptor_.bind(endpoint);
@@ -206,21 +234,45 @@ void WebListener::run() { do_accept(); }
 tcp::endpoint WebListener::local_endpoint() const { return acceptor_.local_endpoint(); }
 
 void WebListener::do_accept() {
-  acceptor_.async_accept(asio::make_strand(ioc_),
-                         [self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
-                           if (ec) {
-                             fail(ec, "accept");
-                           } else if (self->tls_) {
-                             std::make_shared<HttpSession<TlsStream>>(
-                                 std::move(socket), self->web_root_, self->hub_, self->tls_.get())
-                                 ->run();
-                           } else {
-                             std::make_shared<HttpSession<beast::tcp_stream>>(
-                                 std::move(socket), self->web_root_, self->hub_, nullptr)
-                                 ->run();
-                           }
-                           if (self->acceptor_.is_open()) self->do_accept();
-                         });
+  acceptor_.async_accept(asio::make_strand(ioc_), [self = shared_from_this()](beast::error_code ec,
+                                                                              tcp::socket socket) {
+    if (ec) return self->on_accept_error(ec);
+    if (const auto n = self->accept_backoff_.succeed(); n > 0) {
+      std::fprintf(stderr, "edmhmi serve: accepting again after %llu failed accepts\n",
+                   static_cast<unsigned long long>(n));
+    }
+    beast::error_code pec;
+    const auto remote = socket.remote_endpoint(pec);
+    std::string peer = pec ? std::string("?") : remote.address().to_string();
+    // Over the caps: the connection is dropped before anything is read from it.
+    if (ConnectionCounter::Slot slot = self->shared_->connections->acquire(peer)) {
+      if (self->tls_) {
+        std::make_shared<HttpSession<TlsStream>>(std::move(socket), self->shared_, self->tls_.get(),
+                                                 std::move(peer), std::move(slot))
+            ->run();
+      } else {
+        std::make_shared<HttpSession<beast::tcp_stream>>(std::move(socket), self->shared_, nullptr,
+                                                         std::move(peer), std::move(slot))
+            ->run();
+      }
+    }
+    if (self->acceptor_.is_open()) self->do_accept();
+  });
+}
+
+// Out of descriptors (EMFILE/ENFILE), out of memory, or a network error: accept again later,
+// backing off to 1 s, and log once per episode rather than once per failure (issue 31: it spun
+// at 70-85 % CPU writing "Too many open files" without end).
+void WebListener::on_accept_error(const boost::system::error_code& ec) {
+  if (ec == asio::error::operation_aborted || !acceptor_.is_open()) return;
+  ++accept_errors_;
+  bool first = false;
+  const auto delay = accept_backoff_.fail(&first);
+  if (first) std::fprintf(stderr, "edmhmi serve: accept: %s; backing off\n", ec.message().c_str());
+  accept_timer_.expires_after(delay);
+  accept_timer_.async_wait([self = shared_from_this()](boost::system::error_code e) {
+    if (!e) self->do_accept();
+  });
 }
 
 }  // namespace edm::hmi

@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string_view>
-
-#include "edm/hmi/web_capabilities.hpp"
 
 namespace edm::hmi {
 
@@ -14,66 +13,6 @@ namespace {
 
 using bridge::Json;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// The page's chart series and the variables that may feed them: an exact name, or "*suffix"
-/// for the first pin whose name ends so (programs and blocks are named by each config).
-struct SeriesWish {
-  std::string_view key;
-  std::array<std::string_view, 2> candidates;
-};
-constexpr std::array<SeriesWish, 11> kSeriesWishes{{
-    {"z", {"io.z_mm", ""}},
-    {"depth", {"io.depth_mm", ""}},
-    {"depth_est", {"*.drill.depth_reached_mm", "*.depth_reached_mm"}},
-    {"td", {"*.drill.td.td_us", "*.td.td_us"}},
-    {"tdr", {"*.drill.tdr_us", "*.tdr_us"}},
-    {"feed", {"*.drill.gap.vz_mm_s", "io.vz_cmd"}},
-    {"short", {"io.ratio_short", ""}},
-    {"arc_t", {"io.ratio_transient_arc", ""}},
-    {"arc_s", {"io.ratio_stable_arc", ""}},
-    {"x", {"io.x_mm", ""}},
-    {"y", {"io.y_mm", ""}},
-}};
-
-bool matches(std::string_view name, std::string_view wish) {
-  if (wish.empty()) return false;
-  if (wish.front() == '*') return name.ends_with(wish.substr(1));
-  return name == wish;
-}
-
-/// Picks each series' variable among the pins of one task (the task of io.z_mm, else the first
-/// matching pin's), so one trace event carries a whole row.
-std::vector<WebSeries> choose_series(const Json& var_list) {
-  struct Pin {
-    std::string name, task;
-  };
-  std::vector<Pin> pins;
-  if (var_list.contains("vars") && var_list["vars"].is_array()) {
-    for (const Json& v : var_list["vars"]) {
-      const std::string kind = v.value("kind", std::string());
-      if (kind != "input" && kind != "output") continue;
-      pins.push_back({v.value("name", std::string()), v.value("task", std::string())});
-    }
-  }
-  std::string task;
-  for (const Pin& p : pins) {
-    if (p.name == "io.z_mm") task = p.task;
-  }
-  std::vector<WebSeries> out;
-  for (const SeriesWish& w : kSeriesWishes) {
-    for (std::string_view c : w.candidates) {
-      const auto it = std::find_if(pins.begin(), pins.end(), [&](const Pin& p) {
-        return matches(p.name, c) && (task.empty() || p.task == task);
-      });
-      if (it != pins.end()) {
-        if (task.empty()) task = it->task;
-        out.push_back({std::string(w.key), it->name});
-        break;
-      }
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -84,64 +23,25 @@ WebHub::WebHub(boost::asio::io_context& ioc, bridge::Client& client, ConnectionS
       job_(client),
       manual_(client),
       timer_(ioc) {
+  bridge_text_ = Json{{"t", "bridge"},
+                      {"up", false},
+                      {"message", "waiting for edmplc at " + settings_.host + ":" +
+                                      std::to_string(settings_.port)}}
+                     .dump();
   for (Worker& w : workers_) w.thread = std::thread([this, &w] { worker_loop(w); });
 }
 
 WebHub::~WebHub() { stop(); }
 
-void WebHub::start() {
-  std::string error;
-  if (!job_.refresh_machine(error)) throw bridge::ClientError(error);
-  const Json info = job_.machine_info_raw();
-  Json caps;
-  if (info.contains("ops")) {
-    caps = capabilities_json(info, nullptr);
-  } else {  // an edmplc before issue 21
-    try {
-      const std::vector<std::string> known = probe_ops(
-          settings_.host, settings_.port, operator_function_ops(), std::chrono::seconds(3));
-      caps = capabilities_json(info, &known);
-    } catch (const std::exception& e) {
-      caps = capabilities_json(info, nullptr);
-      caps["error"] = e.what();
-    }
-  }
-  if (std::string why; !job_.refresh_offsets(why)) throw bridge::ClientError(why);
-  const bridge::Reply vars = client_.request("var.list");
-  if (!vars) throw bridge::ClientError("var.list: " + vars.message, vars.code);
-  std::vector<WebSeries> series = choose_series(vars.body);
-  const Json manual_info = caps.value("manual", Json(nullptr));
-  const bool has_manual_status = caps.value("manual_status", false);
-  const bool has_offsets = caps.value("work_coordinates", false);
-  {
-    std::lock_guard lock(mutex_);
-    caps_ = std::move(caps);
-    series_ = series;
-    row_.assign(series_.size(), kNaN);
-  }
-  client_.set_event_handler([this](const Json& ev) { on_event(ev); });
-  client_.set_connection_handler([this](bool up) {
-    std::lock_guard lock(mutex_);
-    bridge_up_ = up;
-    bridge_changed_ = true;
-  });
-  if (const bridge::Reply r = client_.subscribe({"status", "alarm", "progress"}, kFrameHz); !r) {
-    throw bridge::ClientError("subscribe: " + r.message, r.code);
-  }
-  manual_.start(manual_info, has_manual_status, has_offsets);
-  if (!series.empty()) {
-    std::vector<std::string> names;
-    for (const WebSeries& s : series) names.push_back(s.var);
-    if (const bridge::Reply r = client_.trace_start(names); !r) {
-      throw bridge::ClientError("trace.start: " + r.message, r.code);
-    }
-  }
-  arm_timer();
-}
-
 void WebHub::stop() {
   if (stopped_) return;
   stopped_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    link_stopping_ = true;
+  }
+  link_cv_.notify_all();
+  if (link_thread_.joinable()) link_thread_.join();
   manual_.stop();  // a held jog is stopped
   for (Worker& w : workers_) {
     {
@@ -167,6 +67,29 @@ void WebHub::detach(const WebSink* sink) {
     const auto s = w.lock();
     return !s || s.get() == sink;
   });
+}
+
+void WebHub::watch(const std::shared_ptr<WebSink>& sink) {
+  std::erase_if(watched_, [](const std::weak_ptr<WebSink>& w) { return w.expired(); });
+  watched_.push_back(sink);
+}
+
+void WebHub::broadcast_all(const std::string& message) {
+  const auto shared = std::make_shared<const std::string>(message);
+  std::erase_if(watched_, [](const std::weak_ptr<WebSink>& w) { return w.expired(); });
+  for (const auto& w : watched_) {
+    if (const auto s = w.lock()) s->send(shared);
+  }
+}
+
+bool WebHub::ready() const {
+  std::lock_guard lock(mutex_);
+  return ready_;
+}
+
+std::string WebHub::bridge_message() const {
+  std::lock_guard lock(mutex_);
+  return bridge_text_;
 }
 
 void WebHub::broadcast(const std::string& message) {
@@ -198,14 +121,21 @@ void WebHub::worker_loop(Worker& w) {
       job = std::move(w.queue.front());
       w.queue.pop_front();
     }
-    job();
+    try {
+      job();
+    } catch (const std::exception& e) {  // never out of a worker: that would end the process
+      std::fprintf(stderr, "edmhmi serve: a worker's task failed: %s\n", e.what());
+    } catch (...) {
+      std::fprintf(stderr, "edmhmi serve: a worker's task failed\n");
+    }
   }
 }
 
-bridge::Role WebHub::authenticate(const std::string& token) {
+bridge::Role WebHub::authenticate(const std::string& token, const std::string& peer) {
   bridge::Client probe;
   bridge::ClientOptions o = client_options(settings_);
   o.token = token;
+  o.peer = peer;
   o.timeout = std::chrono::seconds(15);  // edmplc delays a hello after wrong ones (up to 10 s)
   const bridge::Role theirs = probe.connect(o);  // throws on a refused token
   probe.close();
@@ -245,7 +175,7 @@ void WebHub::acknowledge_alarms(std::uint64_t seq) {
     for (Json& a : alarms_) {
       if (a.value("seq", std::uint64_t{0}) <= seq) a["acked"] = true;
     }
-    msg = Json{{"t", "alarms"}, {"alarms", alarms_json_locked()}}.dump();
+    msg = page_text(Json{{"t", "alarms"}, {"alarms", alarms_json_locked()}});
   }
   broadcast(msg);
 }
@@ -268,6 +198,16 @@ void WebHub::count_drop() {
 void WebHub::count_slow_disconnect() {
   std::lock_guard lock(mutex_);
   ++counters_.slow_disconnects;
+}
+
+void WebHub::count_reply_overflow() {
+  std::lock_guard lock(mutex_);
+  ++counters_.reply_overflows;
+}
+
+void WebHub::count_login_failure() {
+  std::lock_guard lock(mutex_);
+  ++counters_.login_failures;
 }
 
 void WebHub::on_event(const Json& ev) {

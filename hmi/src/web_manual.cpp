@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "edm/hmi/manual.hpp"
 #include "edm/hmi/work_offsets.hpp"
@@ -56,13 +57,23 @@ WebManual::~WebManual() { stop(); }
 void WebManual::start(const Json& manual_info, bool has_manual_status, bool has_offsets) {
   {
     std::lock_guard lock(mutex_);
-    if (started_) return;
-    started_ = true;
     if (const auto d = number(manual_info, "deadman_ms"); d && *d > 0.0) deadman_ms_ = *d;
     has_status_ = has_manual_status;
     has_offsets_ = has_offsets;
+    offsets_stale_ = true;
+    if (started_) return;  // edmplc again (restarted): the same thread follows it
+    started_ = true;
   }
-  thread_ = std::thread([this] { run(); });
+  thread_ = std::thread([this] {
+    for (;;) {  // run() returns when stopping; an odd reply from edmplc never ends the process
+      try {
+        run();
+        return;
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "edmhmi serve: manual follower: %s\n", e.what());
+      }
+    }
+  });
 }
 
 void WebManual::stop() {

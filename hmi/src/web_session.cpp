@@ -7,9 +7,10 @@
 #include <boost/beast/websocket.hpp>
 #include <boost/beast/websocket/ssl.hpp>
 #include <cstdio>
-#include <deque>
-#include <set>
 #include <string_view>
+
+#include "edm/hmi/web_command.hpp"
+#include "edm/hmi/web_outbox.hpp"
 
 namespace edm::hmi {
 
@@ -21,27 +22,19 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-/// Commands a viewer may send: none of them changes the machine or the job.
-const std::set<std::string, std::less<>> kViewerCommands{
-    "check", "stats", "var.list", "var.read", "job", "offset.get", "manual.status"};
-/// Machine commands relayed as they are.
-const std::set<std::string, std::less<>> kMachineOps{"cycle.hold", "cycle.resume", "cycle.stop",
-                                                     "estop", "reset"};
-/// Manual commands relayed with the fields edmplc checks (values, ranges, the machine's state).
-const std::set<std::string, std::less<>> kManualOps{"home", "jog", "jog.stop"};
-/// Quick commands on the machine lane; the rest (interpretation, uploads) on the program lane.
-const std::set<std::string, std::less<>> kMachineLane{
-    "start", "feed.override", "home", "jog", "jog.stop", "jog.hold", "touch", "offset.set"};
-
-Json reply_json(const bridge::Reply& r) { return page_reply(r); }
-
-Json bad_request(const std::string& message) {
-  return {{"ok", false}, {"code", "bad_request"}, {"message", message}};
-}
+/// How often a log-in that waits (for edmplc, or behind another log-in of its address) looks
+/// again, and how long it may wait in all: then the socket is closed ("try again later") and the
+/// page, which keeps its token, opens a new one.
+constexpr auto kLoginRetry = std::chrono::milliseconds(250);
+constexpr auto kLoginWait = std::chrono::seconds(30);
 
 std::uint64_t next_session_id() {
   static std::atomic<std::uint64_t> next{1};
   return next++;
+}
+
+WebHub::Lane hub_lane(PageLane lane) {
+  return lane == PageLane::kMachine ? WebHub::Lane::kMachine : WebHub::Lane::kProgram;
 }
 
 /// `Stream`: beast::tcp_stream (WS) or beast::ssl_stream<beast::tcp_stream> (WSS), after the HTTP
@@ -52,14 +45,18 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   using std::enable_shared_from_this<WsSession<Stream>>::weak_from_this;
 
  public:
-  WsSession(Stream stream, WebHub& hub)
+  WsSession(Stream stream, WebHub& hub, WebPeer peer)
       : ws_(std::move(stream)),
         hub_(hub),
         hub_alive_(hub.alive_token()),
-        login_timer_(ws_.get_executor()) {}
+        peer_(std::move(peer)),
+        login_timer_(ws_.get_executor()),
+        retry_timer_(ws_.get_executor()),
+        outbox_(hub.queued_bytes()) {}
 
   ~WsSession() override {
     if (hub_alive_.expired()) return;  // shutdown: the hub went first (edmhmi serve's order)
+    if (checking_) hub_.login_throttle().on_abandon(peer_.address);
     hub_.manual().drop(id_);
     hub_.detach(this);
   }
@@ -76,250 +73,244 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
     login_timer_.expires_after(kLoginTimeout);
     login_timer_.async_wait([weak = weak_from_this()](beast::error_code ec) {
       const auto self = weak.lock();
-      if (ec || !self || self->role_ || self->closing_) return;
+      if (ec || !self || self->role_ || self->login_asked_ || self->closing_) return;
       // No log-in in time: a client that may not answer a close handshake either.
-      self->closing_ = true;
-      beast::get_lowest_layer(self->ws_).close();
+      self->hard_close();
     });
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
-      self->do_read();
+      self->guarded([&] {
+        self->hub_.watch(self);
+        self->send_reply(self->hub_.bridge_message());  // "waiting for edmplc …" or up
+        self->do_read();
+      });
     });
   }
 
   void send(std::shared_ptr<const std::string> message) override {
-    if (closing_ || close_reason_) return;
-    if (queue_.size() >= kMaxQueued) {
-      hub_.count_drop();
-      ++dropped_;
-      if (!stall_since_) stall_since_ = Clock::now();
-      if (Clock::now() - *stall_since_ > kStallTimeout) {
-        hub_.count_slow_disconnect();
-        closing_ = true;
-        beast::get_lowest_layer(ws_).close();  // a stalled writer: no close handshake
-      }
-      return;
-    }
-    stall_since_.reset();
-    queue_.push_back(std::move(message));
-    if (queue_.size() == 1) do_write();
+    push(std::move(message), WebOutbox::Kind::kFrame);
   }
 
  private:
+  /// Runs a handler's body; whatever it throws ends this socket only.
+  template <class F>
+  void guarded(F&& f) {
+    try {
+      f();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "edmhmi serve: socket %llu closed: %s\n",
+                   static_cast<unsigned long long>(id_), e.what());
+      hard_close();
+    } catch (...) {
+      hard_close();
+    }
+  }
+
+  void push(std::shared_ptr<const std::string> message, WebOutbox::Kind kind) {
+    if (closing_ || close_reason_) return;
+    switch (outbox_.push(std::move(message), kind)) {
+      case WebOutbox::Push::kStartWrite:
+        stall_since_.reset();
+        return do_write();
+      case WebOutbox::Push::kQueued:
+        stall_since_.reset();
+        return;
+      case WebOutbox::Push::kDropped:
+        hub_.count_drop();
+        if (!stall_since_) stall_since_ = Clock::now();
+        if (Clock::now() - *stall_since_ > kStallTimeout) {
+          hub_.count_slow_disconnect();
+          hard_close();  // a stalled writer: no close handshake
+        }
+        return;
+      case WebOutbox::Push::kOverflow:  // asks, and does not read what it asked for
+        hub_.count_reply_overflow();
+        hub_.count_slow_disconnect();
+        return hard_close();
+    }
+  }
+
+  void send_reply(std::string text) {
+    push(std::make_shared<const std::string>(std::move(text)), WebOutbox::Kind::kReply);
+  }
+  void send_json(const Json& j) {
+    if (!j.is_null()) send_reply(page_text(j));
+  }
+
   void do_read() {
+    if (closing_) return;
     ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->on_read(ec);
+      self->guarded([&] { self->on_read(ec); });
     });
   }
 
   void on_read(beast::error_code ec) {
     if (ec) {  // closed, timed out or too large: the session ends, and a jog it held stops now
+      closing_ = true;
+      retry_timer_.cancel();  // a log-in that waits is given up
       hub_.manual().drop(id_);
       return;
     }
+    if (!ws_.got_text()) {
+      return close(websocket::close_code::unknown_data, "text messages only");
+    }
+    if (login_asked_ && !role_) {  // nothing but the log-in until it is answered
+      return close(websocket::close_code::policy_error, "wait for the log-in's answer");
+    }
     const std::string text = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
-    const Json msg = Json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (!msg.is_object() || !msg.contains("t") || !msg["t"].is_string()) {
-      send_json({{"t", "error"}, {"message", "not a JSON object with \"t\""}});
-    } else if (!role_) {
-      return on_login(msg);  // reading resumes once the token is checked
-    } else if (msg["t"] == "cmd") {
-      on_command(msg);
-    } else if (msg["t"] == "held") {  // the jog button is still down (no reply)
-      if (*role_ == bridge::Role::kOperator) hub_.manual().held(id_);
-    } else {
-      send_json({{"t", "error"}, {"message", "unknown message type"}});
+    if (buffer_.capacity() > 64 * 1024) buffer_.shrink_to_fit();  // a 2 MiB upload is not kept
+    PageAction a = page_action(text, role_);
+    switch (a.kind) {
+      case PageAction::Kind::kReply:
+        send_json(a.reply);
+        break;
+      case PageAction::Kind::kClose:
+        send_json(a.reply);
+        return close(websocket::close_code::policy_error, "log in first");
+      case PageAction::Kind::kLogin:
+        on_login(std::move(a.token));  // reading goes on: a socket closed meanwhile is seen
+        break;
+      case PageAction::Kind::kHeld:
+        if (*role_ == bridge::Role::kOperator) hub_.manual().held(id_);
+        break;
+      case PageAction::Kind::kRun:
+        run_command(std::move(a.command));
+        break;
     }
     do_read();
   }
 
-  void on_login(const Json& msg) {
-    if (msg["t"] != "login" || !msg.contains("token") || !msg["token"].is_string()) {
-      return close(websocket::close_code::policy_error, "log in first");
+  void on_login(std::string token) {
+    login_asked_ = true;
+    login_timer_.cancel();
+    login_deadline_ = Clock::now() + kLoginWait;
+    token_ = std::move(token);
+    try_login();
+  }
+
+  /// Checks the token when edmplc is there and the throttle of this address admits it; else
+  /// looks again later (the socket meanwhile knows edmplc's state from the hub).
+  void try_login() {
+    if (closing_ || close_reason_) return;
+    const auto now = Clock::now();
+    if (now > login_deadline_) {
+      return close(websocket::close_code::try_again_later,
+                   hub_.ready() ? "log-in throttled" : "edmplc is not there");
     }
-    const std::string token = msg["token"].get<std::string>();
+    std::optional<Clock::time_point> when;
+    if (hub_.ready()) when = hub_.login_throttle().admit_at(peer_.address, now);
+    if (!when || *when > now) {
+      retry_timer_.expires_at(when ? *when : now + kLoginRetry);
+      retry_timer_.async_wait([weak = weak_from_this()](beast::error_code ec) {
+        if (const auto self = weak.lock(); self && !ec) self->guarded([&] { self->try_login(); });
+      });
+      return;
+    }
+    hub_.login_throttle().begin(peer_.address);
+    checking_ = true;
     // The session holds no read or write while the token is checked: the work keeps it alive.
-    const bool queued =
-        hub_.post_work(WebHub::Lane::kLogin, [self = shared_from_this(), token, &hub = hub_] {
+    const bool queued = hub_.post_work(
+        WebHub::Lane::kLogin,
+        [self = shared_from_this(), token = token_, peer = peer_.address, &hub = hub_] {
           std::optional<bridge::Role> role;
+          std::optional<bridge::ErrorCode> code;
           std::string why;
           try {
-            role = hub.authenticate(token);
+            role = hub.authenticate(token, peer);
+          } catch (const bridge::ClientError& e) {
+            why = e.what();
+            code = e.code();
           } catch (const std::exception& e) {
             why = e.what();
           }
-          asio::post(hub.io(), [self, role, why] {
-            if (!role) {
-              self->send_json({{"t", "login_failed"}, {"message", why}});
-              return self->close(websocket::close_code::policy_error, "log-in refused");
-            }
-            self->role_ = role;
-            self->login_timer_.cancel();
-            self->hub_.attach(self);
-            self->send(std::make_shared<const std::string>(self->hub_.welcome(*role)));
-            self->do_read();
+          asio::post(hub.io(), [self, role, code, why] {
+            self->guarded([&] { self->on_login_checked(role, code, why); });
           });
         });
-    if (!queued) close(websocket::close_code::try_again_later, "server busy");
+    if (!queued) {
+      checking_ = false;
+      hub_.login_throttle().on_abandon(peer_.address);
+      close(websocket::close_code::try_again_later, "server busy");
+    }
   }
 
-  void on_command(const Json& msg) {
-    const Json id = msg.value("id", Json(nullptr));
-    const std::string op = msg.value("op", std::string());
-    auto refuse = [&](std::string_view code, std::string_view message) {
-      send_json({{"t", "reply"}, {"id", id}, {"ok", false}, {"code", code}, {"message", message}});
-    };
-    if (*role_ != bridge::Role::kOperator && !kViewerCommands.contains(op)) {
-      return refuse("forbidden", "'" + op + "' needs the operator role");
+  void on_login_checked(std::optional<bridge::Role> role, std::optional<bridge::ErrorCode> code,
+                        const std::string& why) {
+    checking_ = false;
+    if (hub_alive_.expired()) return;
+    // The throttle learns the outcome even when the socket closed meanwhile: closing does not
+    // dodge it.
+    LoginThrottle& throttle = hub_.login_throttle();
+    if (role) {
+      throttle.on_success(peer_.address);
+      if (closing_) return;
+      token_.clear();
+      role_ = role;
+      hub_.attach(shared_from_this());
+      return send_reply(hub_.welcome(*role));
     }
-    if (op == "ack") {
-      hub_.acknowledge_alarms(msg.value("seq", std::uint64_t{0}));
-      return send_json({{"t", "reply"}, {"id", id}, {"ok", true}});
+    if (code == bridge::ErrorCode::kUnauthorized) {
+      const auto delay = throttle.on_failure(peer_.address, Clock::now());
+      hub_.count_login_failure();
+      send_json({{"t", "login_failed"},
+                 {"message", why},
+                 {"retry_after_ms", static_cast<std::int64_t>(delay.count())}});
+      return close(websocket::close_code::policy_error, "log-in refused");
     }
-    if (op == "jog.release") {  // at once, never behind a queue
-      hub_.manual().release(id_);
-      return send_json({{"t", "reply"}, {"id", id}, {"ok", true}});
+    throttle.on_abandon(peer_.address);
+    if (closing_) return;
+    if (!code) {  // edmplc did not answer (it went away): again, a little later
+      retry_timer_.expires_after(kLoginRetry);
+      retry_timer_.async_wait([weak = weak_from_this()](beast::error_code ec) {
+        if (const auto self = weak.lock(); self && !ec) self->guarded([&] { self->try_login(); });
+      });
+      return;
     }
-    if (op == "manual.status" || op == "offset.get") {  // what the hub follows anyway
-      const Json body =
-          op == "manual.status" ? hub_.manual().manual_json() : hub_.manual().offsets_json();
-      return send_json({{"t", "reply"}, {"id", id}, {"ok", !body.is_null()}, {"body", body}});
+    send_json({{"t", "login_failed"}, {"message", why}});
+    close(websocket::close_code::try_again_later, "log-in not checked");
+  }
+
+  void run_command(PageCommand cmd) {
+    const PageLane lane = page_op_info(cmd.op).lane;
+    if (lane == PageLane::kInline) return send_json(run_page_command(hub_, cmd, id_));
+    if (in_flight_ >= kMaxInFlight) {
+      return send_json(page_refusal(cmd.id, "busy", "too many commands in progress"));
     }
-    if (in_flight_ >= kMaxInFlight) return refuse("busy", "too many commands in progress");
     ++in_flight_;
-    const WebHub::Lane lane = kMachineOps.contains(op) || kMachineLane.contains(op)
-                                  ? WebHub::Lane::kMachine
-                                  : WebHub::Lane::kProgram;
-    const std::uint64_t owner = id_;
-    const bool queued =
-        hub_.post_work(lane, [weak = weak_from_this(), msg, id, op, owner, &hub = hub_] {
-          Json out = run_command(hub, op, msg, owner);
-          out["t"] = "reply";
-          out["id"] = id;
-          out["op"] = op;
-          const bool job_changed =
-              (op == "upload" || op == "start" || op == "start_from") && out.value("ok", false);
+    const Json id = cmd.id;
+    const bool queued = hub_.post_work(
+        hub_lane(lane), [weak = weak_from_this(), cmd = std::move(cmd), owner = id_, &hub = hub_] {
+          Json out = run_page_command(hub, cmd, owner);
+          const bool ok = out.is_object() && out.contains("ok") && out["ok"] == true;
+          const bool job_changed = ok && (cmd.op == PageOp::kUpload || cmd.op == PageOp::kStart ||
+                                          cmd.op == PageOp::kStartFrom);
           asio::post(hub.io(), [weak, out = std::move(out), job_changed, &hub] {
-            if (job_changed) hub.broadcast_job();
             if (const auto self = weak.lock()) {
-              --self->in_flight_;
-              self->send_json(out);
+              self->guarded([&] {
+                if (job_changed) hub.broadcast_job();
+                --self->in_flight_;
+                self->send_json(out);
+              });
             }
           });
         });
     if (!queued) {
       --in_flight_;
-      refuse("busy", "server busy");
+      send_json(page_refusal(id, "busy", "server busy"));
     }
-  }
-
-  /// On the worker thread: the blocking part of a command.
-  static Json run_command(WebHub& hub, const std::string& op, const Json& msg,
-                          std::uint64_t owner) {  // owner: this browser, for a held jog
-    const std::string name = msg.value("name", std::string("program.nc"));
-    if (op == "check" || op == "upload") {
-      if (!msg.contains("text") || !msg["text"].is_string()) {
-        return {{"ok", false}, {"code", "bad_request"}, {"message", "text missing"}};
-      }
-      const std::string& text = msg["text"].get_ref<const std::string&>();
-      return op == "check" ? hub.job().check(text, name) : hub.job().upload(text, name);
-    }
-    if (op == "start") return reply_json(hub.job().start(msg.value("dry_run", false) == true));
-    if (op == "start_from") {
-      if (!msg.contains("line") || !msg["line"].is_number_integer()) {
-        return bad_request("'line' must be a G-code line number");
-      }
-      std::optional<double> depth;
-      if (msg.contains("depth_done") && !msg["depth_done"].is_null()) {
-        if (!msg["depth_done"].is_number()) return bad_request("'depth_done' must be mm");
-        depth = msg["depth_done"].get<double>();
-      }
-      return hub.job().start_from(msg["line"].get<std::int32_t>(), depth,
-                                  msg.value("dry_run", false) == true);
-    }
-    if (op == "mdi") {
-      if (!msg.contains("line") || !msg["line"].is_string()) return bad_request("'line' missing");
-      const std::string& line = msg["line"].get_ref<const std::string&>();
-      if (line.size() > 1024 || line.find_first_of("\r\n") != std::string::npos) {
-        return bad_request("an MDI command is one line of at most 1024 bytes");
-      }
-      return hub.job().mdi(line);
-    }
-    if (kManualOps.contains(op)) {
-      Json params = Json::object();
-      for (const char* k : {"axes", "axis", "distance"}) {
-        if (msg.contains(k)) params[k] = msg[k];
-      }
-      if (op == "jog.stop") hub.manual().release_any();
-      return reply_json(hub.client().request(op, params));
-    }
-    if (op == "jog.hold") {  // continuous: the hub refreshes it while "held" comes
-      if (!msg.contains("axis") || !msg["axis"].is_string() || !msg.contains("velocity") ||
-          !msg["velocity"].is_number()) {
-        return bad_request("jog.hold needs 'axis' and 'velocity' (mm/s)");
-      }
-      return hub.manual().hold(owner, msg["axis"].get<std::string>(),
-                               msg["velocity"].get<double>());
-    }
-    if (op == "touch") {
-      if (!msg.contains("target") || !msg["target"].is_string()) {
-        return bad_request("'target' missing");
-      }
-      std::string set;
-      if (msg.contains("set") && msg["set"].is_string()) set = msg["set"].get<std::string>();
-      return hub.manual().touch(msg["target"].get<std::string>(), set);
-    }
-    if (op == "offset.set") {
-      Json params = Json::object();
-      for (const char* k : {"frame", "x", "y", "z"}) {
-        if (msg.contains(k)) params[k] = msg[k];
-      }
-      return hub.manual().offset_set(params);
-    }
-    if (op == "job") return {{"ok", true}, {"body", hub.job().snapshot()}};
-    if (kMachineOps.contains(op)) return reply_json(hub.client().request(op));
-    if (op == "feed.override") {  // edmplc checks the value (0..150) and the role
-      Json params = Json::object();
-      if (msg.contains("percent")) params["percent"] = msg["percent"];
-      return reply_json(hub.client().request(op, params));
-    }
-    if (op == "stats") {
-      Json r = reply_json(hub.client().request("tasks.stats"));
-      const WebHub::Counters c = hub.counters();
-      r["web"] = {{"frames", c.frames},
-                  {"browsers", c.browsers},
-                  {"frames_dropped", c.frames_dropped},
-                  {"slow_disconnects", c.slow_disconnects}};
-      return r;
-    }
-    if (op == "var.list" || op == "var.read" || op == "var.write" || op == "var.force" ||
-        op == "var.unforce") {
-      Json params = Json::object();
-      for (const char* k : {"prefix", "names", "name", "value"}) {
-        if (msg.contains(k)) params[k] = msg[k];
-      }
-      return reply_json(hub.client().request(op, params));
-    }
-    return {{"ok", false}, {"code", "unknown_op"}, {"message", "unknown command '" + op + "'"}};
-  }
-
-  void send_json(const Json& j) {
-    send(std::make_shared<const std::string>(
-        j.dump(-1, ' ', false, Json::error_handler_t::replace)));
   }
 
   void do_write() {
     ws_.text(true);
-    ws_.async_write(asio::buffer(*queue_.front()),
+    ws_.async_write(asio::buffer(outbox_.front()),
                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
                       if (ec) {
                         self->closing_ = true;
-                        self->queue_.clear();
+                        self->outbox_.clear();
                         return;
                       }
-                      self->queue_.pop_front();
-                      if (!self->queue_.empty()) {
+                      if (self->outbox_.pop()) {
                         self->do_write();
                       } else if (self->close_reason_) {
                         self->do_close();
@@ -331,7 +322,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   void close(websocket::close_code code, const char* reason) {
     if (closing_ || close_reason_) return;
     close_reason_ = websocket::close_reason(code, reason);
-    if (queue_.empty()) do_close();
+    if (outbox_.empty()) do_close();
   }
 
   void do_close() {
@@ -339,17 +330,28 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
     ws_.async_close(*close_reason_, [self = shared_from_this()](beast::error_code) {});
   }
 
+  /// Drops the TCP connection at once (no close handshake to wait for).
+  void hard_close() {
+    closing_ = true;
+    retry_timer_.cancel();
+    beast::get_lowest_layer(ws_).close();
+  }
+
   websocket::stream<Stream> ws_;
   WebHub& hub_;
   std::weak_ptr<const bool> hub_alive_;  // WebHub::alive_token()
-  asio::steady_timer login_timer_;
+  WebPeer peer_;
+  asio::steady_timer login_timer_, retry_timer_;
   beast::flat_buffer buffer_;
-  std::deque<std::shared_ptr<const std::string>> queue_;
+  WebOutbox outbox_;
   std::optional<bridge::Role> role_;
+  std::string token_;  // while the log-in waits
   std::optional<Clock::time_point> stall_since_;
   std::optional<websocket::close_reason> close_reason_;
-  std::uint64_t dropped_{0};
+  Clock::time_point login_deadline_{};
   int in_flight_{0};
+  bool login_asked_{false};
+  bool checking_{false};  // a log-in of this socket is being checked (the throttle knows)
   bool closing_{false};
   const std::uint64_t id_{next_session_id()};  // the owner of a jog this browser holds
 };
@@ -357,13 +359,17 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
 }  // namespace
 
 void start_web_socket(beast::tcp_stream stream,
-                      beast::http::request<beast::http::string_body> request, WebHub& hub) {
-  std::make_shared<WsSession<beast::tcp_stream>>(std::move(stream), hub)->run(std::move(request));
+                      beast::http::request<beast::http::string_body> request, WebHub& hub,
+                      WebPeer peer) {
+  std::make_shared<WsSession<beast::tcp_stream>>(std::move(stream), hub, std::move(peer))
+      ->run(std::move(request));
 }
 
 void start_web_socket(beast::ssl_stream<beast::tcp_stream> stream,
-                      beast::http::request<beast::http::string_body> request, WebHub& hub) {
-  std::make_shared<WsSession<beast::ssl_stream<beast::tcp_stream>>>(std::move(stream), hub)
+                      beast::http::request<beast::http::string_body> request, WebHub& hub,
+                      WebPeer peer) {
+  std::make_shared<WsSession<beast::ssl_stream<beast::tcp_stream>>>(std::move(stream), hub,
+                                                                    std::move(peer))
       ->run(std::move(request));
 }
 

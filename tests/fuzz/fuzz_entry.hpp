@@ -24,6 +24,8 @@ int config_one_input(const std::uint8_t* data, std::size_t size);
 int retain_one_input(const std::uint8_t* data, std::size_t size);
 /// Bridge protocol (hmi_bridge/): the bytes as the lines a client sends.
 int protocol_one_input(const std::uint8_t* data, std::size_t size);
+/// The page's WebSocket handler (hmi/): the bytes as a browser's messages, cut at 0xFF.
+int page_one_input(const std::uint8_t* data, std::size_t size);
 
 /// Ends the process with a message when an invariant of the code under test is broken.
 [[noreturn]] inline void fail(const char* file, int line, const char* what) {

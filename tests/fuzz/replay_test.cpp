@@ -69,8 +69,13 @@ TEST(FuzzReplay, protocol_seeds_and_regressions_run_clean) {
   EXPECT_GT(replay("protocol", protocol_one_input), 0u);
 }
 
+TEST(FuzzReplay, page_seeds_and_regressions_run_clean) {
+  EXPECT_GT(replay("page", page_one_input), 0u);
+}
+
 TEST(FuzzReplay, empty_input_runs_clean_everywhere) {
-  for (Entry entry : {gcode_one_input, config_one_input, retain_one_input, protocol_one_input}) {
+  for (Entry entry : {gcode_one_input, config_one_input, retain_one_input, protocol_one_input,
+                      page_one_input}) {
     EXPECT_EQ(entry(nullptr, 0), 0);
   }
 }

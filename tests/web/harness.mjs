@@ -35,7 +35,7 @@ export function freePort() {
 }
 
 /** Resolves with the first match of `re` in the child's output, rejects on exit or timeout. */
-function waitForOutput(child, re, what, timeoutMs = 20000) {
+export function waitForOutput(child, re, what, timeoutMs = 20000) {
   return new Promise((res, rej) => {
     let seen = '';
     const timer = setTimeout(() => rej(new Error(`${what}: no '${re}' within ${timeoutMs} ms:\n${seen}`)), timeoutMs);
@@ -50,7 +50,8 @@ function waitForOutput(child, re, what, timeoutMs = 20000) {
   });
 }
 
-export async function startStack({ speed = String(SPEED) } = {}) {
+/** A private directory with an operator and a viewer token and drill-sim's config using them. */
+export function makeMachine() {
   const dir = mkdtempSync(join(tmpdir(), 'edm-web-'));
   const op = join(dir, 'operator.token');
   const vw = join(dir, 'viewer.token');
@@ -67,22 +68,46 @@ export async function startStack({ speed = String(SPEED) } = {}) {
   const withDeadman = withTokens.replace('manual: {}', `manual: {deadman: ${DEADMAN_MS}ms}`);
   if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob manual: {}');
   writeFileSync(config, withDeadman);
-  const bridgePort = await freePort();
-  const procs = [];
-  const plc = spawn(join(BUILD, 'bin/edmplc'), ['--config', config, '--clock', 'virtual',
-    '--speed', speed, '--bridge-port', String(bridgePort), '--state-dir', join(dir, 'state')],
+  return { dir, tokens, op, vw, config, procs: [] };
+}
+
+/** Starts edmplc of `stack` on `stack.bridgePort` and waits until its bridge listens. */
+export async function startPlc(stack, { speed = String(SPEED) } = {}) {
+  const plc = spawn(join(BUILD, 'bin/edmplc'), ['--config', stack.config, '--clock', 'virtual',
+    '--speed', speed, '--bridge-port', String(stack.bridgePort), '--state-dir', join(stack.dir, 'state')],
   { stdio: ['ignore', 'pipe', 'pipe'] });
-  procs.push(plc);
-  const stack = { dir, tokens, procs, plc, bridgePort };
+  stack.procs.push(plc);
+  stack.plc = plc;
+  await waitForOutput(plc, /bridge: listening on/, 'edmplc');
+  return plc;
+}
+
+/** Starts `edmhmi serve` for `stack` (`args` after `serve`; `nofile`: its descriptor limit) and
+ *  waits until it listens; resolves {child, url, port, stderr()}. */
+export async function startServe(stack, { args = [], nofile = 0, env = {} } = {}) {
+  const argv = ['--port', String(stack.bridgePort), '--token-file', stack.op,
+    'serve', '--listen', '127.0.0.1:0', '--web-root', join(BUILD, 'web'), ...args];
+  const bin = join(BUILD, 'bin/edmhmi');
+  const child = nofile > 0
+    ? spawn('sh', ['-c', `ulimit -n ${nofile} && exec "$0" "$@"`, bin, ...argv],
+      { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, ...env } })
+    : spawn(bin, argv, { stdio: ['ignore', 'pipe', 'pipe'], env: { ...process.env, ...env } });
+  stack.procs.push(child);
+  let err = '';
+  child.stderr.on('data', (d) => { err += d.toString(); });
+  const m = await waitForOutput(child, /listening on (http:\/\/[0-9.:]+\/)/, 'edmhmi serve');
+  const url = m[1];
+  return { child, url, port: Number(new URL(url).port), stderr: () => err };
+}
+
+export async function startStack({ speed = String(SPEED) } = {}) {
+  const stack = makeMachine();
+  stack.bridgePort = await freePort();
   try {
-    await waitForOutput(plc, /bridge: listening on/, 'edmplc');
-    const serve = spawn(join(BUILD, 'bin/edmhmi'), ['--port', String(bridgePort), '--token-file', op,
-      'serve', '--listen', '127.0.0.1:0', '--web-root', join(BUILD, 'web')],
-    { stdio: ['ignore', 'pipe', 'pipe'] });
-    procs.push(serve);
-    stack.serve = serve;
-    const m = await waitForOutput(serve, /listening on (http:\/\/[0-9.:]+\/)/, 'edmhmi serve');
-    stack.url = m[1];
+    await startPlc(stack, { speed });
+    const serve = await startServe(stack);
+    stack.serve = serve.child;
+    stack.url = serve.url;
   } catch (e) {
     stopStack(stack);
     throw e;

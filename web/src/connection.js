@@ -3,7 +3,7 @@
 // sessionStorage so a reload logs in again; closing the tab forgets it.
 export class Connection {
   constructor(handlers) {
-    this.handlers = handlers; // {welcome, frame, alarms, job, loginFailed, state}
+    this.handlers = handlers; // {welcome, frame, alarms, job, loginFailed, state, bridge}
     this.nextId = 1;
     this.pending = new Map();
     this.ws = null;
@@ -64,6 +64,7 @@ export class Connection {
         if (p) { this.pending.delete(m.id); p.resolve(m); }
         break;
       }
+      case 'bridge': this.handlers.bridge(m); break; // edmplc there or not (waiting for it)
       case 'frame': this.handlers.frame(m); break;
       case 'alarms': this.handlers.alarms(m.alarms); break;
       case 'job': this.handlers.job(m.job); break;

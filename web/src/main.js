@@ -37,6 +37,14 @@ function confirmDialog(text) {
 
 const conn = new Connection({
   state: (s) => { $('conn').textContent = s; },
+  // "waiting for edmplc at H:P": before a log-in the log-in screen says why nothing comes.
+  bridge: (m) => {
+    $('conn').textContent = m.up ? 'online' : m.message;
+    if (ui.role === null && !m.up) {
+      $('login').hidden = false;
+      $('login-error').textContent = m.message;
+    }
+  },
   loginFailed: (message) => {
     $('app').hidden = true;
     $('login').hidden = false;

@@ -62,7 +62,8 @@ class WebManual {
   WebManual& operator=(const WebManual&) = delete;
 
   /// From machine.info: the dead-man (manual.deadman_ms) and whether manual.status and
-  /// offset.get exist; then starts the follower thread. Call once.
+  /// offset.get exist; the first call starts the follower thread, a later one (edmplc again,
+  /// after a restart) updates them.
   void start(const bridge::Json& manual_info, bool has_manual_status, bool has_offsets);
   void stop();  // joins the thread; a held jog is stopped first. Idempotent.
 
