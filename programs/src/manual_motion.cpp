@@ -179,6 +179,7 @@ void ManualMotion::end_operation(bool ok, ManualError e, double t_s) noexcept {
   status_.result.error = e;
   status_.result.t_s = t_s;
   status_.busy = false;
+  status_.op = ManualOp::kNone;
   status_.mode = ManualMode::kIdle;
 }
 
@@ -278,10 +279,13 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
     return;
   }
   if (step_ != Step::kIdle) {
-    // Another request while busy: only a jog replaces a jog (a new speed or axis); anything
-    // else is refused (the bridge refuses it first; this is the RT side's own guard).
-    if (!(step_ == Step::kJog &&
-          (r.op == ManualOp::kJogVelocity || r.op == ManualOp::kJogDistance))) {
+    // Another request while busy: only a continuous jog replaces a continuous jog (a new speed
+    // or axis); anything else is refused, and says so (refused_seq). The bridge refuses it
+    // first (hmi_bridge op_states.cpp: the same rule); this is the RT side's own guard.
+    const bool replaces = r.op == ManualOp::kJogVelocity && req_.op == ManualOp::kJogVelocity &&
+                          (step_ == Step::kJog || step_ == Step::kInPosition);
+    if (!replaces) {
+      status_.refused_seq = r.seq;
       return;
     }
   }
@@ -374,6 +378,7 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
   }
   if (step_ != Step::kIdle) {
     status_.busy = true;
+    status_.op = r.op;
     active.set(true);
   }
 }
@@ -464,31 +469,35 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
   pos_set_z.set(false);
   if (manual_ == nullptr) return rt::BlockStatus::kOk;
 
+  const bool ready = enable.get() || job_op_;
+  if (!ready && step_ != Step::kIdle) finish(false, ManualError::kInterrupted, ctx);
+  // Every request queued since the last cycle, in order: none is lost to a newer one.
   rt::ManualRequest r;
-  const bool fresh = manual_->rt_poll(r, last_seq_);
-  if (fresh) status_.seen_seq = r.seq;
-  if (job_op_ && fresh && r.op != ManualOp::kStop && r.op != ManualOp::kNone) {
-    // The job's touch owns the axes: the operator's request is answered, the touch runs on.
-    status_.result = {};
-    status_.result.seq = r.seq;
-    status_.result.op = r.op;
-    status_.result.target = r.target;
-    status_.result.error = ManualError::kInterrupted;
-    status_.result.t_s = rt::to_seconds(ctx.release);
-  }
-  if (!enable.get() && !job_op_) {
-    if (step_ != Step::kIdle) finish(false, ManualError::kInterrupted, ctx);
-    // A request made while not READY is answered at once.
-    if (fresh && r.op != ManualOp::kStop && r.op != ManualOp::kNone) {
+  while (manual_->rt_poll(r, last_seq_)) {
+    status_.seen_seq = r.seq;
+    if (r.op == ManualOp::kNone || (r.op == ManualOp::kStop && !ready)) continue;
+    if (job_op_) {
+      if (r.op == ManualOp::kStop) continue;
+      // The job's touch owns the axes: the operator's request is answered, the touch runs on.
+      status_.result = {};
+      status_.result.seq = r.seq;
+      status_.result.op = r.op;
+      status_.result.target = r.target;
+      status_.result.error = ManualError::kInterrupted;
+      status_.result.t_s = rt::to_seconds(ctx.release);
+    } else if (!ready) {  // a request made while not READY is answered at once
       req_ = r;
       finish(false, ManualError::kInterrupted, ctx);
+    } else {
+      start(r, ctx);
     }
+  }
+  if (!ready) {
     referenced.set(manual_->referenced());
     mode.set(0);
     manual_->rt_publish(status_);
     return rt::BlockStatus::kOk;
   }
-  if (fresh && !job_op_) start(r, ctx);
 
   const double dt = dt_s_;
   switch (step_) {
