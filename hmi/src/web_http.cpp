@@ -5,6 +5,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket/rfc6455.hpp>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -31,7 +32,26 @@ constexpr const char* kCsp =
 void fail(beast::error_code ec, const char* what) {
   if (ec == asio::error::operation_aborted || ec == beast::error::timeout ||
       ec == http::error::end_of_stream || ec == asio::error::eof ||
+      ec == asio::error::connection_reset || ec == asio::error::broken_pipe ||  // peers leaving:
+      ec == asio::error::not_connected ||          // never a log line any client can ask for
       ec == asio::ssl::error::stream_truncated) {  // a browser closing TLS without close_notify
+    return;
+  }
+  // At most 10 lines a second (the I/O thread's): failing handshakes cannot flood the log.
+  static auto window = std::chrono::steady_clock::now();
+  static int lines = 0;
+  static unsigned long long suppressed = 0;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - window >= std::chrono::seconds(1)) {
+    if (suppressed > 0) {
+      std::fprintf(stderr, "edmhmi serve: %llu more connection errors not logged\n", suppressed);
+    }
+    window = now;
+    lines = 0;
+    suppressed = 0;
+  }
+  if (++lines > 10) {
+    ++suppressed;
     return;
   }
   std::fprintf(stderr, "edmhmi serve: %s: %s\n", what, ec.message().c_str());
