@@ -105,9 +105,9 @@ class Message:
 
 
 class Subscriber:
-    """paho-mqtt on spBv1.0/# (re-subscribes after a broker restart)."""
+    """paho-mqtt on `topics` (spBv1.0/#; re-subscribes after a broker restart)."""
 
-    def __init__(self, port, tls_ca=None, username=None, password=None):
+    def __init__(self, port, tls_ca=None, username=None, password=None, topics=("spBv1.0/#",)):
         self.messages = []
         self.lock = threading.Lock()
         self.client = mqtt.Client(client_id="test-sub-%d" % os.getpid(), clean_session=True)
@@ -116,7 +116,7 @@ class Subscriber:
         if tls_ca:
             # A client context: the broker's certificate chains to tls_ca and names the host.
             self.client.tls_set(ca_certs=tls_ca, tls_version=ssl.PROTOCOL_TLS_CLIENT)
-        self.client.on_connect = lambda c, u, f, rc: c.subscribe("spBv1.0/#", qos=1)
+        self.client.on_connect = lambda c, u, f, rc: c.subscribe([(t, 1) for t in topics])
         self.client.on_message = self._on_message
         self.client.reconnect_delay_set(0.1, 0.5)
         self.client.connect("127.0.0.1", port, keepalive=5)
@@ -142,8 +142,9 @@ class Subscriber:
                 count, type_, timeout, len(found), [m.topic for m in self.all()][-20:]))
         return found
 
-    def publish(self, topic, payload):
-        self.client.publish(topic, payload.SerializeToString(), qos=1).wait_for_publish()
+    def publish(self, topic, payload, retain=False):
+        data = payload if isinstance(payload, bytes) else payload.SerializeToString()
+        self.client.publish(topic, data, qos=1, retain=retain).wait_for_publish()
 
     def stop(self):
         self.client.loop_stop()
@@ -158,9 +159,22 @@ def command(name, value, datatype):
     m.datatype = datatype
     if datatype == sparkplug_b_pb2.Boolean:
         m.boolean_value = bool(value)
+    elif datatype in (sparkplug_b_pb2.Int64, sparkplug_b_pb2.UInt64):
+        m.long_value = int(value) % (1 << 64)  # Int64: two's complement
     else:
         m.double_value = float(value)
     return p
+
+
+def memory_kib(pid):
+    """(VmRSS, VmHWM) of a process in KiB, from /proc."""
+    out = {}
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            key, _, rest = line.partition(":")
+            if key in ("VmRSS", "VmHWM"):
+                out[key] = int(rest.split()[0])
+    return out["VmRSS"], out["VmHWM"]
 
 
 def write_config(workdir, port, commands="false", store=1000, wave_deadband="0.1", extra=""):

@@ -181,7 +181,24 @@ class Commands(MqttCase):
         time.sleep(0.3)
         levels = [m.value("level") for m in self.sub.all("DDATA") if m.value("level") is not None]
         self.assertEqual(levels[-1], 6.0)
-        self.assertIn("mqtt audit: DCMD p.level.k=3", self.plc.text())
+        self.assertIn('mqtt audit: DCMD "p.level.k"=3 (Double) from broker 127.0.0.1:%d: written'
+                      % self.broker.port, self.plc.text())
+
+    def test_int64_max_is_refused_before_conversion(self):
+        """Issue 31 item 13: a listed parameter, an Int64 of 2^63-1 (gap.kg took 9.2e18)."""
+        self.start_plc(commands="true")
+        self.sub.wait("DBIRTH")
+        time.sleep(0.3)
+        self.sub.publish(DCMD, rig.command("p.level.k", (1 << 63) - 1, pb.Int64))
+        self.assertTrue(rig.wait_until(lambda: self.refused() >= 1, 5), self.refused())
+        time.sleep(0.3)
+        self.assertEqual([m.value("level_k") for m in self.sub.all("DDATA")
+                          if m.value("level_k") is not None], [])
+        ranges = [m.value("Commands/out_of_range") for m in self.sub.all()
+                  if m.type in ("NBIRTH", "NDATA")]
+        self.assertEqual(max(v for v in ranges if v is not None), 1)
+        self.assertIn("'p.level.k' is LREAL: an Int64 of 9223372036854775807 is not exact as "
+                      "LREAL", self.plc.text())
 
     def test_rebirth_request_republishes_births(self):
         self.start_plc()
@@ -190,6 +207,74 @@ class Commands(MqttCase):
         again = self.sub.wait("NBIRTH", after=1, timeout=5)[0]
         self.assertEqual(again.seq, 0)
         self.sub.wait("DBIRTH", after=1, timeout=5)
+
+
+class Flood(MqttCase):
+    """Issue 31 items 11 and 12 through a real broker: 30 DCMDs of 8 MB, a 100k-metric DCMD, a
+    1000-metric one, forged names and malformed payloads, with commands off (the default). The
+    log stays a handful of short lines, edmplc's memory flat, its task on time; the counters say
+    what was dropped."""
+
+    def setUp(self):
+        self.dir = rig.tmpdir()
+        self.broker = rig.Broker(self.dir).start()
+        # Not on the commands themselves: this subscriber need not read 240 MB.
+        self.sub = rig.Subscriber(self.broker.port, topics=[
+            "spBv1.0/%s/%s/%s/#" % (GROUP, t, NODE) for t in ("NBIRTH", "NDATA", "DBIRTH")])
+        self.plc = None
+
+    def counter(self, name):
+        vals = [m.value(name) for m in self.sub.all() if m.type in ("NBIRTH", "NDATA")]
+        return max([v for v in vals if v is not None] or [0])
+
+    def test_huge_and_hostile_commands_cost_a_few_log_lines(self):
+        stats = os.path.join(self.dir, "stats.json")
+        self.plc = rig.Plc(rig.write_config(self.dir, self.broker.port), self.dir, real=True,
+                           args=["--stats-out", stats])
+        self.sub.wait("DBIRTH")
+        time.sleep(0.5)
+        log_before = len(self.plc.text())
+        rss_before, _ = rig.memory_kib(self.plc.proc.pid)
+        big = b"x" * (8 << 20)
+        for _ in range(30):
+            self.sub.publish(DCMD, big)
+        hundred_k = pb.Payload()
+        for i in range(100000):
+            m = hundred_k.metrics.add()
+            m.name, m.datatype, m.double_value = "p.level.k", pb.Double, float(i)
+        self.sub.publish(DCMD, hundred_k)  # 2.4 MB: over the size limit
+        many = pb.Payload()
+        for i in range(1000):
+            many.metrics.add()  # 2 kB, over the metric limit
+        self.sub.publish(DCMD, many)
+        self.sub.publish(NCMD, b"\x0a\xff\xff")  # not protobuf
+        forged = "p.level.k\n[2025-01-01 00:00:00.000] [info] mqtt audit: DCMD cnc.estop=1"
+        for i in range(200):
+            self.sub.publish(DCMD, rig.command(forged, i, pb.Double))
+        self.assertTrue(rig.wait_until(lambda: self.counter("Commands/dropped") >= 33 and
+                                       self.counter("Commands/refused") >= 200, 30),
+                        (self.counter("Commands/dropped"), self.counter("Commands/refused")))
+        _, hwm = rig.memory_kib(self.plc.proc.pid)
+        self.assertEqual(self.plc.stop(), 0)
+        added = self.plc.text()[log_before:]
+        lines = [l for l in added.splitlines() if "mqtt" in l]
+        sys.stderr.write("flood: %d mqtt log lines, %d bytes, RSS %d -> peak %d KiB\n"
+                         % (len(lines), len(added), rss_before, hwm))
+        # Each kind told once (size, metric count, framing), the audit's burst of 20, and the
+        # summaries at the stop: 8 MB names would have made 240 MB of log, 100k metrics 100k lines.
+        self.assertLessEqual(len(lines), 30, "\n".join(lines))
+        self.assertLess(len(added), 16 << 10)
+        self.assertTrue(all(len(l) < 1024 for l in lines))
+        self.assertEqual(sum("dropped a DCMD of 8388608 bytes unread" in l for l in lines), 1)
+        self.assertEqual(sum("dropped a DCMD of 1000 metrics unread" in l for l in lines), 1)
+        # The forged audit line is inside the quotes of a refusal, never a line of its own.
+        self.assertFalse([l for l in added.splitlines() if l.startswith("[2025-01-01")])
+        self.assertTrue(any('"p.level.k\\x0a[2025-01-01' in l for l in lines), lines[:3])
+        # Memory: libmosquitto reads one message at a time; nothing is kept or decoded.
+        self.assertLess(hwm - rss_before, 48 << 10, (rss_before, hwm))
+        with open(stats) as f:
+            tasks = json.load(f)["tasks"]
+        self.assertEqual([t["overruns"] for t in tasks], [0] * len(tasks), tasks)
 
 
 class Fleet(MqttCase):
@@ -240,6 +325,9 @@ class BadConfig(unittest.TestCase):
         ("interval: 1us", "mqtt.interval: must be between"),
         ("tls: {ca_file: /nonexistent/ca.pem}", "cannot read the CA file"),
         ("password_file: /nonexistent/pw", "cannot read the password file"),
+        ("limits: {max_payload_bytes: 100}", "mqtt.limits.max_payload_bytes"),
+        ("limits: {max_metrics: 0}", "mqtt.limits.max_metrics"),
+        ("limits: {max_bytes: 1}", "unknown key 'max_bytes'"),
         # Files that exist (written by the test next to bad.yaml: relative to the config's folder).
         ("password_file: edm.pass", "mqtt.password_file: password_file needs a username"),
         ("password_file: empty.pass", "mqtt.password_file: the password file is empty"),

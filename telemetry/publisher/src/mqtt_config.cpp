@@ -84,7 +84,7 @@ class SectionParser {
     c.loc = v.loc;
     auto m = r_.map(v, {"broker", "group", "node", "device", "client_id", "interval", "heartbeat",
                         "keepalive", "deadband", "metrics", "store_forward", "username",
-                        "password_file", "tls", "commands"});
+                        "password_file", "tls", "commands", "limits"});
     if (!m) return;
     if (const y::Field* f = r_.require(*m, "broker")) broker(f->value, c);
     if (const y::Field* f = r_.require(*m, "group")) c.group = id(f->value).value_or("");
@@ -122,6 +122,7 @@ class SectionParser {
     }
     if (const y::Field* f = m->find("tls")) tls(f->value, c);
     if (const y::Field* f = m->find("commands")) commands(f->value, c);
+    if (const y::Field* f = m->find("limits")) limits(f->value, c);
   }
 
  private:
@@ -208,6 +209,20 @@ class SectionParser {
       if (auto s = r_.choice(f->value, {"true", "false"})) t.verify_hostname = *s == "true";
     }
     c.tls = t;
+  }
+
+  void limits(const y::Value& v, MqttConfig& c) {
+    auto m = r_.map(v, {"max_payload_bytes", "max_metrics"});
+    if (!m) return;
+    if (const y::Field* f = m->find("max_payload_bytes")) {
+      if (auto n = r_.integer(f->value, 1024, 16 << 20)) {
+        c.limits.max_payload_bytes = static_cast<std::size_t>(*n);
+      }
+    }
+    if (const y::Field* f = m->find("max_metrics")) {
+      if (auto n = r_.integer(f->value, 1, 65536))
+        c.limits.max_metrics = static_cast<std::size_t>(*n);
+    }
   }
 
   void commands(const y::Value& v, MqttConfig& c) {

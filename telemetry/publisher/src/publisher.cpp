@@ -6,10 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "edm/runtime/cycle_observer.hpp"
 #include "edm/runtime/seqlock.hpp"
+#include "edm/telemetry/command_gate.hpp"
+#include "edm/telemetry/command_intake.hpp"
 
 namespace edm::telemetry {
 
@@ -104,7 +107,8 @@ sp::Value typed(sp::DataType t, double x) {
 }  // namespace
 
 struct Publisher::Impl {
-  Impl(rt::Runtime& r, MqttConfig c) : rt(r), cfg(std::move(c)) {
+  Impl(rt::Runtime& r, MqttConfig c)
+      : rt(r), cfg(std::move(c)), gate(rt.variables(), cfg.commands_enabled, cfg.writable) {
     std::vector<rt::PinRef> pins;
     std::vector<sp::MetricDef> defs = {
         {"state", sp::DataType::kString, 0.0},
@@ -154,33 +158,32 @@ struct Publisher::Impl {
     o.heartbeat = cfg.heartbeat;
     o.log = [](const std::string& line) { spdlog::info("{}", line); };
     o.warn = [](const std::string& line) { spdlog::warn("{}", line); };
+    // Commands: libmosquitto's thread only offers them to the intake (bounded); this thread
+    // screens, decodes and logs them (quoted, rate-limited) and the gate writes what it may.
+    IntakeOptions in;
+    in.ncmd_topic = sp::Topic{cfg.group, sp::MessageType::kNCmd, cfg.node, ""}.str();
+    in.dcmd_topic = sp::Topic{cfg.group, sp::MessageType::kDCmd, cfg.node, cfg.device}.str();
+    in.broker = cfg.host + ":" + std::to_string(cfg.port);
+    in.limits = cfg.limits;
+    in.info = [](const std::string& line) { spdlog::info("{}", line); };
+    in.warn = [](const std::string& line) { spdlog::warn("{}", line); };
+    intake = std::make_unique<CommandIntake>(
+        std::move(in), [this](sp::MessageType /*type*/, const sp::Metric& m, std::string& why) {
+          return gate.apply(m, why);
+        });
     node = std::make_unique<sp::EdgeNode>(
-        std::move(o), [this](sp::MessageType t, const sp::Metric& m, std::string& why) {
-          return on_command(t, m, why);
+        std::move(o), [this](std::string_view topic, std::string_view payload, bool retained) {
+          intake->offer(topic, payload, retained);
         });
   }
 
-  bool on_command(sp::MessageType type, const sp::Metric& m, std::string& why) {
-    if (!cfg.commands_enabled) {
-      why = "commands are off (mqtt.commands.enabled: false)";
-      return false;
-    }
-    if (std::find(cfg.writable.begin(), cfg.writable.end(), m.name) == cfg.writable.end()) {
-      why = "'" + m.name + "' is not in mqtt.commands.writable";
-      return false;
-    }
-    const auto x = sp::as_double(m.value);
-    if (!x) {
-      why = "the value must be a number or a boolean";
-      return false;
-    }
-    // The operator's var.write path of the bridge: the registry checks the type and range,
-    // validates on the block's shadow parameters and queues the write to the owning task.
-    const rt::VarStatus st = rt.variables().write(m.name, *x);
-    spdlog::info("mqtt audit: {} {}={} from broker {}:{}: {}", sp::to_string(type), m.name, *x,
-                 cfg.host, cfg.port, st ? "written" : "refused: " + st.message);
-    if (!st) why = st.message.empty() ? "refused" : st.message;
-    return static_cast<bool>(st);
+  // Commands first, so a rebirth request or a write is in this tick's births and counters.
+  void step() {
+    if (intake->process(CommandIntake::Clock::now())) node->request_rebirth();
+    node->set_command_counters(
+        {intake->accepted(), intake->refused(), intake->dropped(), intake->out_of_range()});
+    const auto values = sample();
+    node->tick(values, sp::now_ms());
   }
 
   std::vector<sp::Value> sample() {
@@ -227,14 +230,13 @@ struct Publisher::Impl {
 
   void run() {
     while (true) {
-      const auto values = sample();
-      node->tick(values, sp::now_ms());
+      step();
       std::unique_lock lock(mu);
       if (cv.wait_for(lock, cfg.interval, [this] { return stopping; })) break;
     }
     // One last look, so a state change right before the stop (e.g. the safe state) goes out.
-    const auto values = sample();
-    node->tick(values, sp::now_ms());
+    step();
+    intake->finish(CommandIntake::Clock::now());
     node->stop();
   }
 
@@ -245,8 +247,10 @@ struct Publisher::Impl {
 
   rt::Runtime& rt;
   MqttConfig cfg;
+  CommandGate gate;
   std::vector<Source> sources;
   std::unique_ptr<SnapshotObserver> observer;
+  std::unique_ptr<CommandIntake> intake;  // before node: it outlives libmosquitto's thread
   std::unique_ptr<sp::EdgeNode> node;
   std::thread thread;
   std::mutex mu;

@@ -16,6 +16,8 @@ constexpr std::string_view kQueued = "Store Forward/queued";
 constexpr std::string_view kDropped = "Store Forward/dropped";
 constexpr std::string_view kAccepted = "Commands/accepted";
 constexpr std::string_view kRefused = "Commands/refused";
+constexpr std::string_view kCmdDropped = "Commands/dropped";
+constexpr std::string_view kOutOfRange = "Commands/out_of_range";
 constexpr std::string_view kUptime = "Node Info/uptime_s";
 
 void lib_init() {
@@ -51,7 +53,7 @@ Metric metric(std::string_view name, DataType type, Value v, std::uint64_t t_ms)
 
 }  // namespace
 
-EdgeNode::EdgeNode(EdgeNodeOptions options, CommandHandler on_command)
+EdgeNode::EdgeNode(EdgeNodeOptions options, CommandSink on_command)
     : opt_(std::move(options)), on_command_(std::move(on_command)) {
   for (const auto* id : {&opt_.group, &opt_.node, &opt_.device}) {
     if (!valid_id(*id)) {
@@ -280,10 +282,12 @@ void EdgeNode::restart_network_thread() {
 
 void EdgeNode::on_message_cb(mosquitto* /*m*/, void* self_ptr, const mosquitto_message* msg) {
   auto* self = static_cast<EdgeNode*>(self_ptr);
-  std::lock_guard lock(self->mu_);
-  if (self->inbox_.size() >= 256) return;  // a command flood is dropped here, not queued forever
-  self->inbox_.emplace_back(msg->topic, std::string(static_cast<const char*>(msg->payload),
-                                                    static_cast<std::size_t>(msg->payloadlen)));
+  if (!self->on_command_) return;
+  // Network thread: the sink looks at the size and copies what it bounds; it never decodes.
+  const std::string_view payload(
+      static_cast<const char*>(msg->payload),
+      msg->payloadlen > 0 ? static_cast<std::size_t>(msg->payloadlen) : 0);
+  self->on_command_(msg->topic != nullptr ? msg->topic : "", payload, msg->retain);
 }
 
 bool EdgeNode::publish(const Topic& topic, Payload& p) {
@@ -305,8 +309,10 @@ std::vector<Metric> EdgeNode::node_counters(std::uint64_t t_ms) const {
       std::chrono::steady_clock::now() - started_at_);
   return {metric(kQueued, DataType::kUInt64, static_cast<std::uint64_t>(store_.size()), t_ms),
           metric(kDropped, DataType::kUInt64, dropped_.load(), t_ms),
-          metric(kAccepted, DataType::kUInt64, accepted_.load(), t_ms),
-          metric(kRefused, DataType::kUInt64, refused_.load(), t_ms),
+          metric(kAccepted, DataType::kUInt64, cmd_accepted_.load(), t_ms),
+          metric(kRefused, DataType::kUInt64, cmd_refused_.load(), t_ms),
+          metric(kCmdDropped, DataType::kUInt64, cmd_dropped_.load(), t_ms),
+          metric(kOutOfRange, DataType::kUInt64, cmd_out_of_range_.load(), t_ms),
           metric(kUptime, DataType::kUInt64, static_cast<std::uint64_t>(up.count()), t_ms)};
 }
 
@@ -369,37 +375,6 @@ void EdgeNode::store(Payload p) {
   queued_.store(store_.size(), std::memory_order_relaxed);
 }
 
-void EdgeNode::handle_commands() {
-  std::deque<std::pair<std::string, std::string>> inbox;
-  {
-    std::lock_guard lock(mu_);
-    inbox.swap(inbox_);
-  }
-  for (const auto& [topic, bytes] : inbox) {
-    const auto t = parse_topic(topic);
-    const auto p = decode(bytes);
-    if (!t || !p) {
-      refused_.fetch_add(1, std::memory_order_relaxed);
-      log("mqtt: refused a command on " + topic + ": not a Sparkplug B payload");
-      continue;
-    }
-    for (const Metric& m : p->metrics) {
-      if (t->type == MessageType::kNCmd && m.name == kRebirth) {
-        if (as_double(m.value).value_or(0.0) != 0.0) {
-          std::lock_guard lock(mu_);
-          need_birth_ = connected_;
-        }
-        continue;
-      }
-      std::string why = "commands are off (mqtt.commands.enabled)";
-      const bool ok = on_command_ && on_command_(t->type, m, why);
-      (ok ? accepted_ : refused_).fetch_add(1, std::memory_order_relaxed);
-      log(std::string("mqtt: ") + std::string(to_string(t->type)) + " " + m.name + " = " +
-          to_text(m.value) + (ok ? ": accepted" : ": refused: " + why));
-    }
-  }
-}
-
 void EdgeNode::publish_node_data(std::uint64_t t_ms, bool force) {
   std::vector<Metric> counters = node_counters(t_ms);
   std::vector<Value> now;
@@ -418,7 +393,6 @@ void EdgeNode::publish_node_data(std::uint64_t t_ms, bool force) {
 
 void EdgeNode::tick(std::span<const Value> values, std::uint64_t t_ms) {
   if (!started_) return;
-  handle_commands();
   bool connected = false;
   bool birth = false;
   bool tls_failed = false;
@@ -504,6 +478,18 @@ void EdgeNode::stop() {
   mosquitto_loop_stop(mosq_, !connected);
 }
 
+void EdgeNode::request_rebirth() {
+  std::lock_guard lock(mu_);
+  need_birth_ = connected_;
+}
+
+void EdgeNode::set_command_counters(const CommandCounters& c) noexcept {
+  cmd_accepted_.store(c.accepted, std::memory_order_relaxed);
+  cmd_refused_.store(c.refused, std::memory_order_relaxed);
+  cmd_dropped_.store(c.dropped, std::memory_order_relaxed);
+  cmd_out_of_range_.store(c.out_of_range, std::memory_order_relaxed);
+}
+
 EdgeNodeStats EdgeNode::stats() const {
   EdgeNodeStats s;
   {
@@ -518,8 +504,10 @@ EdgeNodeStats EdgeNode::stats() const {
   s.queued = queued_.load();
   s.dropped = dropped_.load();
   s.replayed = replayed_.load();
-  s.commands_accepted = accepted_.load();
-  s.commands_refused = refused_.load();
+  s.commands_accepted = cmd_accepted_.load();
+  s.commands_refused = cmd_refused_.load();
+  s.commands_dropped = cmd_dropped_.load();
+  s.commands_out_of_range = cmd_out_of_range_.load();
   return s;
 }
 

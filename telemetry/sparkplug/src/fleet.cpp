@@ -20,6 +20,16 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
+// For the terminal table: control characters (a metric's text may carry escape sequences that
+// rewrite the screen) shown as '?'. Display only; logs quote and escape instead.
+std::string printable(std::string s) {
+  for (char& c : s) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b < 0x20 || b == 0x7F) c = '?';
+  }
+  return s;
+}
+
 nlohmann::json to_json(const Value& v) {
   if (std::holds_alternative<std::monostate>(v)) return nullptr;
   if (const auto* b = std::get_if<bool>(&v)) return *b;
@@ -54,6 +64,29 @@ std::string FleetMachine::job() const {
   return s;
 }
 
+void FleetTable::apply(std::map<std::string, Value>& into, const Payload& from, bool clear) {
+  if (clear) {
+    kept_ -= into.size();
+    into.clear();
+  }
+  for (const Metric& m : from.metrics) {
+    if (m.historical || m.name.empty()) continue;
+    Value v = m.value;
+    if (auto* s = std::get_if<std::string>(&v); s && s->size() > limits_.max_string_bytes) {
+      s->resize(limits_.max_string_bytes);
+    }
+    const auto it = into.find(m.name);
+    if (it != into.end()) {
+      it->second = std::move(v);
+    } else if (m.name.size() <= limits_.max_name_bytes && kept_ < limits_.max_metrics) {
+      into.emplace(m.name, std::move(v));
+      ++kept_;
+    } else {
+      ++ignored_metrics_;
+    }
+  }
+}
+
 void FleetTable::on_message(std::string_view topic, std::string_view payload,
                             std::uint64_t now_ms) {
   const auto t = parse_topic(topic);
@@ -61,17 +94,26 @@ void FleetTable::on_message(std::string_view topic, std::string_view payload,
       t->type == MessageType::kDCmd) {
     return;
   }
-  const auto p = decode(payload);
-  if (!p) return;
+  if (std::max({t->group.size(), t->node.size(), t->device.size()}) > limits_.max_id_bytes) {
+    ++ignored_messages_;
+    return;
+  }
+  std::optional<Payload> p;
+  if (screen_payload(payload, limits_.payload).verdict == Screen::kOk) p = decode(payload);
   const auto key = std::make_pair(t->group, t->node);
-  Node& n = nodes_[key];
+  auto node_it = nodes_.find(key);
+  if (!p || (node_it == nodes_.end() && nodes_.size() >= limits_.max_nodes)) {
+    ++ignored_messages_;
+    return;
+  }
+  if (node_it == nodes_.end()) node_it = nodes_.emplace(key, Node{}).first;
+  Node& n = node_it->second;
+  if (!t->device.empty() && n.devices.count(t->device) == 0 &&
+      n.devices.size() >= limits_.max_devices_per_node) {
+    ++ignored_messages_;
+    return;
+  }
   n.last_seen_ms = now_ms;
-  const auto apply = [](std::map<std::string, Value>& into, const Payload& from, bool clear) {
-    if (clear) into.clear();
-    for (const Metric& m : from.metrics) {
-      if (!m.historical && !m.name.empty()) into[m.name] = m.value;
-    }
-  };
   if (t->type == MessageType::kNDeath) {
     const Metric* bd = p->find(kBdSeq);
     const auto bdseq = bd ? as_double(bd->value) : std::nullopt;
@@ -172,9 +214,10 @@ std::string render_text(const std::vector<FleetMachine>& machines, std::uint64_t
     if (alarms.empty() || alarms == "-") alarms = m.text("alarms/count") == "0" ? "none" : alarms;
     const double age_s =
         now_ms >= m.last_seen_ms ? static_cast<double>(now_ms - m.last_seen_ms) / 1000.0 : 0.0;
-    std::snprintf(line, sizeof line, "%-32s %-7s %-10s %-28s %-24s %s s ago\n", name.c_str(),
-                  m.online ? "yes" : (m.born ? "no" : "?"), m.text("state").c_str(),
-                  m.job().c_str(), alarms.c_str(), fixed(age_s, 1).c_str());
+    std::snprintf(line, sizeof line, "%-32s %-7s %-10s %-28s %-24s %s s ago\n",
+                  printable(name).c_str(), m.online ? "yes" : (m.born ? "no" : "?"),
+                  printable(m.text("state")).c_str(), printable(m.job()).c_str(),
+                  printable(alarms).c_str(), fixed(age_s, 1).c_str());
     out += line;
   }
   if (machines.empty()) out += "(no machine heard on the broker)\n";
@@ -204,7 +247,8 @@ std::string render_json(const std::vector<FleetMachine>& machines, std::uint64_t
          {"metrics", std::move(metrics)},
          {"node_metrics", std::move(node)}});
   }
-  return arr.dump(2) + "\n";
+  // Metric strings are not checked UTF-8 (proto2): invalid bytes become U+FFFD, never a throw.
+  return arr.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 FleetWatcher::FleetWatcher(FleetOptions options) : opt_(std::move(options)) {}

@@ -109,6 +109,45 @@ Value get_value(const pb::Payload::Metric& m) {
   return std::monostate{};
 }
 
+// Whether a decoded metric's value is in the wire field its datatype names, within its range.
+bool value_fits(const pb::Payload::Metric& m) {
+  if (m.is_null()) return true;
+  using M = pb::Payload::Metric;
+  const auto as_i32 = [&] { return static_cast<std::int32_t>(m.int_value()); };
+  switch (m.datatype()) {
+    case pb::Int8:
+      return m.value_case() == M::kIntValue && as_i32() >= -128 && as_i32() <= 127;
+    case pb::Int16:
+      return m.value_case() == M::kIntValue && as_i32() >= -32768 && as_i32() <= 32767;
+    case pb::Int32:
+    case pb::UInt32:
+      return m.value_case() == M::kIntValue;
+    case pb::UInt8:
+      return m.value_case() == M::kIntValue && m.int_value() <= 0xFFu;
+    case pb::UInt16:
+      return m.value_case() == M::kIntValue && m.int_value() <= 0xFFFFu;
+    case pb::Int64:
+    case pb::UInt64:
+    case pb::DateTime:
+      return m.value_case() == M::kLongValue;
+    case pb::Float:
+      return m.value_case() == M::kFloatValue;
+    case pb::Double:
+      return m.value_case() == M::kDoubleValue;
+    case pb::Boolean:
+      return m.value_case() == M::kBooleanValue;
+    case pb::String:
+    case pb::Text:
+    case pb::UUID:
+      return m.value_case() == M::kStringValue;
+    case pb::Bytes:
+    case pb::File:
+      return m.value_case() == M::kBytesValue;
+    default:  // Unknown, DataSet, Template, PropertySet…: no scalar value here
+      return false;
+  }
+}
+
 }  // namespace
 
 std::string_view to_string(MessageType t) noexcept {
@@ -238,6 +277,8 @@ std::optional<Payload> decode(std::string_view bytes) {
     m.timestamp = pm.timestamp();
     m.historical = pm.is_historical();
     m.transient = pm.is_transient();
+    if (pm.has_alias()) m.alias = pm.alias();
+    m.value_ok = value_fits(pm);
     p.metrics.push_back(std::move(m));
   }
   return p;

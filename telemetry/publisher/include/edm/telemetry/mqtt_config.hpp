@@ -14,6 +14,7 @@
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/variables.hpp"
 #include "edm/sparkplug/edge_node.hpp"
+#include "edm/sparkplug/inbound.hpp"
 
 namespace edm::telemetry {
 
@@ -41,6 +42,7 @@ struct MqttConfig {
   std::string username;
   std::string password;  // read from password_file
   std::optional<sparkplug::TlsOptions> tls;
+  sparkplug::InboundLimits limits;  // what one NCMD/DCMD may be (mqtt.limits)
   bool commands_enabled{false};
   std::vector<std::string> writable;  // parameters NCMD/DCMD may write when enabled
   rt::SourceLoc loc;

@@ -1,18 +1,19 @@
 #pragma once
 // A Sparkplug B edge node with one device over MQTT (libmosquitto): births, deaths (NDEATH is the
 // MQTT Last Will, carrying bdSeq), seq 0..255, report by exception with per-metric deadbands,
-// bounded store and forward while the broker is away, TLS and username/password, NCMD/DCMD
-// handed to a caller's handler (the node itself only acts on "Node Control/Rebirth").
+// bounded store and forward while the broker is away, TLS and username/password. NCMD/DCMD go to
+// the owner's command sink as they arrive; the owner screens and decodes them on its own thread
+// (edmplc: telemetry's CommandIntake) and answers a rebirth with request_rebirth().
 // docs/mqtt.md describes the topics and the behaviour.
 //
 // Threads: libmosquitto's network thread (mosquitto_loop_start) connects, reconnects and
-// receives; it only records what happened (connected, commands, why a connect failed) under a
-// mutex. That thread ends for good after a TLS error (libmosquitto's loop treats it as fatal):
-// tick() starts it again, 1 s doubling to reconnect_max_s, like libmosquitto's own reconnects.
-// Everything that publishes runs on the owner's thread in tick(): births after a (re)connect,
-// replays, data and command handling, so seq numbers are assigned in one place. start(), tick()
-// and stop() from one owner thread; stats() from any thread. Never on an RT thread (allocates,
-// locks, syscalls).
+// receives; it only records what happened (connected, why a connect failed) under a mutex and
+// hands commands to the sink (which must be quick and bounded: a size check and a copy). That
+// thread ends for good after a TLS error (libmosquitto's loop treats it as fatal): tick() starts it
+// again, 1 s doubling to reconnect_max_s, like libmosquitto's own reconnects. Everything that
+// publishes runs on the owner's thread in tick(): births after a (re)connect or a rebirth request,
+// replays and data, so seq numbers are assigned in one place. start(), tick() and stop() from one
+// owner thread; stats() from any thread. Never on an RT thread (allocates, locks, syscalls).
 
 #include <atomic>
 #include <chrono>
@@ -25,6 +26,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "edm/sparkplug/sparkplug.hpp"
@@ -79,9 +81,18 @@ struct EdgeNodeOptions {
   std::function<void(const std::string&)> warn;
 };
 
-/// A command's metric: accept (true) or refuse (false, `why` says why). Called from tick().
-using CommandHandler =
-    std::function<bool(MessageType type, const Metric& metric, std::string& why)>;
+/// An NCMD/DCMD as it arrives (topic, payload, the MQTT retain flag), on libmosquitto's network
+/// thread: the sink must not block, decode or keep more than it bounds.
+using CommandSink =
+    std::function<void(std::string_view topic, std::string_view payload, bool retained)>;
+
+/// The owner's command counters, published in NBIRTH/NDATA (Commands/…).
+struct CommandCounters {
+  std::uint64_t accepted{0};
+  std::uint64_t refused{0};
+  std::uint64_t dropped{0};       // dropped unread (limits, framing, topic, retained)
+  std::uint64_t out_of_range{0};  // refused for their value's type or range
+};
 
 struct EdgeNodeStats {
   bool connected{false};
@@ -95,12 +106,15 @@ struct EdgeNodeStats {
   std::uint64_t replayed{0};   // stored payloads published after a reconnect
   std::uint64_t commands_accepted{0};
   std::uint64_t commands_refused{0};
+  std::uint64_t commands_dropped{0};
+  std::uint64_t commands_out_of_range{0};
 };
 
 class EdgeNode {
  public:
-  /// Throws EdgeNodeError on bad options (ids, TLS files, capacity).
-  EdgeNode(EdgeNodeOptions options, CommandHandler on_command);
+  /// Throws EdgeNodeError on bad options (ids, TLS files, capacity). Without a sink, commands
+  /// (Rebirth too) are ignored.
+  EdgeNode(EdgeNodeOptions options, CommandSink on_command);
   ~EdgeNode();
   EdgeNode(const EdgeNode&) = delete;
   EdgeNode& operator=(const EdgeNode&) = delete;
@@ -108,13 +122,18 @@ class EdgeNode {
   /// Registers the will (NDEATH, bdSeq) and starts connecting in the background (a broker that
   /// is not there yet is retried). Throws EdgeNodeError when libmosquitto refuses the setup.
   void start();
-  /// One step: births after a (re)connect, then stored data, then commands, then the device
+  /// One step: births after a (re)connect or a rebirth request, then stored data, then the device
   /// values that changed beyond their deadband (one DDATA), then the node's NDATA when due.
   /// `values` in the order of options.device_metrics; `t_ms` their capture time.
   void tick(std::span<const Value> values, std::uint64_t t_ms);
   /// Publishes DDEATH and NDEATH (a clean stop: the broker then drops the will), disconnects and
   /// joins the network thread. Idempotent.
   void stop();
+
+  /// Births again at the next tick (Node Control/Rebirth). Thread-safe.
+  void request_rebirth();
+  /// The counters the next NBIRTH/NDATA carry. Thread-safe.
+  void set_command_counters(const CommandCounters& c) noexcept;
 
   [[nodiscard]] EdgeNodeStats stats() const;
   [[nodiscard]] const EdgeNodeOptions& options() const noexcept { return opt_; }
@@ -129,7 +148,6 @@ class EdgeNode {
   bool publish(const Topic& topic, Payload& p);  // assigns seq unless NDEATH
   void publish_births(std::span<const Value> values, std::uint64_t t_ms);
   void replay_store();
-  void handle_commands();
   void publish_node_data(std::uint64_t t_ms, bool force);
   void store(Payload p);
   void log(const std::string& line) const;
@@ -141,7 +159,7 @@ class EdgeNode {
   [[nodiscard]] std::vector<Metric> node_counters(std::uint64_t t_ms) const;
 
   EdgeNodeOptions opt_;
-  CommandHandler on_command_;
+  CommandSink on_command_;
   mosquitto* mosq_{nullptr};
   bool started_{false};
   Topic ncmd_;
@@ -154,7 +172,6 @@ class EdgeNode {
   bool will_used_{false};  // the current will went out in a CONNECT: the next one needs a new bdSeq
   std::uint64_t bdseq_{0};
   std::uint64_t connects_{0};
-  std::deque<std::pair<std::string, std::string>> inbox_;  // (topic, payload) of NCMD/DCMD
   std::vector<std::string> failures_;  // connect failures warned about since the last connect
   bool conn_refused_{false};           // the broker refused the CONNECT being closed now
   bool tls_failed_{false};             // a TLS error ended libmosquitto's network thread
@@ -172,7 +189,9 @@ class EdgeNode {
   int restart_delay_s_{0};
 
   std::atomic<std::uint64_t> births_{0}, published_{0}, stored_{0}, dropped_{0}, replayed_{0},
-      accepted_{0}, refused_{0}, queued_{0};
+      queued_{0};
+  std::atomic<std::uint64_t> cmd_accepted_{0}, cmd_refused_{0}, cmd_dropped_{0},
+      cmd_out_of_range_{0};
 };
 
 }  // namespace edm::sparkplug

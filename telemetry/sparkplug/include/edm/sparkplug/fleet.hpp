@@ -2,6 +2,9 @@
 // The fleet as a Sparkplug host application sees it (`edmhmi fleet`, docs/mqtt.md): every node and
 // device heard on `spBv1.0/#`, rebuilt from births, data and deaths. A node heard from without its
 // birth (the view joined late) is asked for one with NCMD "Node Control/Rebirth".
+// Anyone who may publish on the broker can feed the view: payloads are screened before they are
+// decoded (inbound.hpp, FleetLimits), and the table is bounded in nodes, devices and metrics
+// (what does not fit is ignored and counted); the terminal table shows no control characters.
 // FleetTable: thread-compatible, no I/O. FleetWatcher: its own libmosquitto network thread;
 // machines() from any thread.
 
@@ -17,6 +20,7 @@
 #include <vector>
 
 #include "edm/sparkplug/edge_node.hpp"
+#include "edm/sparkplug/inbound.hpp"
 #include "edm/sparkplug/sparkplug.hpp"
 
 struct mosquitto;
@@ -42,14 +46,31 @@ struct FleetMachine {
   [[nodiscard]] std::string job() const;
 };
 
+/// What the view keeps of what it hears.
+struct FleetLimits {
+  InboundLimits payload{1 << 20, 4096};  // a birth of a large node still fits
+  std::size_t max_nodes{4096};
+  std::size_t max_id_bytes{128};  // group, node and device ids (a topic may be 64 KiB)
+  std::size_t max_devices_per_node{256};
+  std::size_t max_metrics{100000};     // metric values kept, all machines together
+  std::size_t max_name_bytes{256};     // a longer metric name is not kept
+  std::size_t max_string_bytes{1024};  // a longer string value is cut
+};
+
 class FleetTable {
  public:
+  explicit FleetTable(FleetLimits limits = {}) : limits_(limits) {}
   /// Applies one message (anything that is not Sparkplug B is ignored).
   void on_message(std::string_view topic, std::string_view payload, std::uint64_t now_ms);
   /// Every machine, sorted by group, node, device.
   [[nodiscard]] std::vector<FleetMachine> machines() const;
   /// Nodes (group, node) heard from without a birth since the last call.
   std::vector<std::pair<std::string, std::string>> take_rebirth_requests();
+  /// Messages ignored whole (screened out, undecodable, no room for their node or device) and
+  /// metric values not kept (no room, name too long).
+  [[nodiscard]] std::uint64_t ignored_messages() const noexcept { return ignored_messages_; }
+  [[nodiscard]] std::uint64_t ignored_metrics() const noexcept { return ignored_metrics_; }
+  [[nodiscard]] std::size_t metrics_kept() const noexcept { return kept_; }
 
  private:
   struct Node {
@@ -62,6 +83,12 @@ class FleetTable {
     std::map<std::string, Value> metrics;
     std::map<std::string, FleetMachine> devices;  // by device id
   };
+  void apply(std::map<std::string, Value>& into, const Payload& from, bool clear);
+
+  FleetLimits limits_;
+  std::size_t kept_{0};  // metric values in all the maps
+  std::uint64_t ignored_messages_{0};
+  std::uint64_t ignored_metrics_{0};
   std::map<std::pair<std::string, std::string>, Node> nodes_;
   std::set<std::pair<std::string, std::string>> rebirth_;
   std::set<std::pair<std::string, std::string>> asked_;

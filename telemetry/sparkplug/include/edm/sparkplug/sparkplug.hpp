@@ -74,6 +74,11 @@ struct Metric {
   std::uint64_t timestamp{0};  // ms since the epoch (UTC)
   bool historical{false};
   bool transient{false};
+  // Decoded only (encode() ignores them):
+  std::optional<std::uint64_t> alias;  // edmplc defines no aliases
+  /// The value came in the wire field its datatype names and fits that datatype (an Int8 in
+  /// [-128, 127], …), or is_null. False for an unknown or unmodelled datatype (DataSet, …).
+  bool value_ok{true};
 };
 
 struct Payload {
@@ -86,7 +91,8 @@ struct Payload {
 
 /// Protobuf bytes of a payload (values converted to the metric's datatype's wire field).
 std::string encode(const Payload& p);
-/// The payload of protobuf bytes; nullopt when they do not parse.
+/// The payload of protobuf bytes; nullopt when they do not parse. Bytes from the broker pass
+/// screen_payload() (inbound.hpp) first.
 std::optional<Payload> decode(std::string_view bytes);
 
 /// The value as a double (booleans 0/1); nullopt for strings and nulls.
