@@ -42,7 +42,9 @@ constexpr std::array kBlockRegistrars{&edm::blocks::register_builtin_blocks,
 constexpr std::array kDriverRegistrars{&edm::rt::register_runtime_drivers,
                                        &edm::sim::register_sim_driver};
 
-// Adds the table of each type the registrars register, from a default instance of it.
+// Adds the table of each type the registrars register, from a default instance of it. A
+// runtime-writable number without a bounded range (or a default outside it) is an error: the
+// table would document a parameter any writer could set to anything (issue 31).
 template <class Base, std::size_t N>
 void add_tables(const std::array<void (*)(edm::rt::TypeRegistry<Base>&), N>& registrars,
                 std::map<std::string, std::string>& tables, std::vector<std::string>& errors) {
@@ -54,7 +56,13 @@ void add_tables(const std::array<void (*)(edm::rt::TypeRegistry<Base>&), N>& reg
     if (tables.contains(name)) {
       errors.push_back("'" + name + "' is both a block and a driver type: one marker cannot tell");
     }
-    tables[name] = edm::paramdoc::param_table(*registry.create(name));
+    const auto block = registry.create(name);
+    tables[name] = edm::paramdoc::param_table(*block);
+    edm::rt::SpecAudit audit;
+    block->visit_params(audit);
+    for (const edm::rt::ParamError& p : audit.problems) {
+      errors.push_back("'" + name + "' parameter '" + p.field + "' " + p.message);
+    }
   }
 }
 

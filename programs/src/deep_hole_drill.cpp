@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/machine.hpp"
 
 namespace edm::programs {
@@ -18,10 +19,11 @@ constexpr double kMaxApproachSpeed = blocks::GapControllerPParams{}.v_feed_max_m
 }  // namespace
 
 void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
+  namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
   v.param("depth_default_mm", depth_default_mm,
           {.unit = "mm",
            .description = "target hole depth while the depth_mm input is 0",
-           .range = rt::kPositive});
+           .range = r::kPositiveLengthMm});
   v.param("approach_speed_mm_s", approach_speed_mm_s,
           {.unit = "mm/s",
            .description = "feed down until the first sparks (at most the gap feed limit)",
@@ -40,28 +42,29 @@ void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
   v.param("touch_cycles", touch_cycles,
           {.unit = "cycles",
            .description = "consecutive cycles with sparks that count as touching the work",
-           .range = rt::at_least(1)});
+           .range = r::kCycles});
   v.param("retract_speed_mm_s", retract_speed_mm_s,
-          {.unit = "mm/s", .description = "upward speed of the retract", .range = rt::kPositive});
+          {.unit = "mm/s", .description = "upward speed of the retract", .range = r::kSpeedMmS});
   v.param("clearance_mm", clearance_mm,
           {.unit = "mm",
            .description = "retract to the touch height plus this",
-           .range = rt::kNonNegative});
+           .range = r::kLengthMm});
+  // Up to 1e7 cycles: 1000 s at the 10 kHz task, 10^4 s at 1 kHz.
   v.param("breakthrough_cycles", breakthrough_cycles,
           {.unit = "cycles",
            .description = "cycles without ignition that mean breakthrough of a through hole",
-           .range = rt::at_least(1)});
+           .range = rt::closed(1.0, 1.0e7)});
   v.param("breakthrough_min_mm", breakthrough_min_mm,
           {.unit = "mm",
            .description = "no breakthrough is detected above this depth",
-           .range = rt::kNonNegative});
+           .range = r::kLengthMm});
   v.param("overtravel_mm", overtravel_mm,
-          {.unit = "mm", .description = "feed on after breakthrough", .range = rt::kNonNegative});
+          {.unit = "mm", .description = "feed on after breakthrough", .range = r::kLengthMm});
   shorts.visit(v);
   v.param("short_backoff_mm", short_backoff_mm,
           {.unit = "mm",
            .description = "Z backs off this far on alarm 150, generator off, then holds",
-           .range = rt::kNonNegative});
+           .range = r::kLengthMm});
 }
 
 DeepHoleDrill::DeepHoleDrill()

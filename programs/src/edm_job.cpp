@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/machine.hpp"
 
 namespace edm::programs {
@@ -21,21 +22,23 @@ constexpr std::int64_t kStillCycles = 5;
 }  // namespace
 
 void EdmJobParams::visit(rt::ParamVisitor& v) {
+  namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
   v.param("rapid_speed_mm_s", rapid_speed_mm_s,
-          {.unit = "mm/s", .description = "speed of rapids", .range = rt::kPositive});
+          {.unit = "mm/s", .description = "speed of rapids", .range = r::kSpeedMmS});
   v.param("feed_default_mm_s", feed_default_mm_s,
           {.unit = "mm/s",
            .description = "feed of linear moves and arcs whose block has none",
-           .range = rt::kPositive});
+           .range = r::kSpeedMmS});
+  // An electrode radius plus a side gap: up to 1 m (a die-sinking electrode of 2 m).
   v.param("orbit_radius_offset_mm", orbit_radius_offset_mm,
           {.unit = "mm",
            .description = "orbit offset = final radius - this (electrode radius + finishing side "
                           "gap)",
-           .range = rt::kPositive});
+           .range = rt::open_closed(0.0, 1000.0)});
   v.param("polarity_settle", polarity_settle,
           {.unit = "s",
            .description = "generator-off wait when a condition changes the polarity",
-           .range = rt::kNonNegative});
+           .range = r::kSettleS});
   v.param("probe_depth", probe_depth,
           {.description = "measure a blind hole's depth by touch (bottom and surface) and drill "
                           "the rest from the measurement"});

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/machining/machine_tables.hpp"
 #include "edm/runtime/machine.hpp"
 
@@ -28,60 +29,70 @@ int axis_of(char c) noexcept { return c == 'X' ? 0 : c == 'Y' ? 1 : c == 'Z' ? 2
 }  // namespace
 
 void ManualMotionParams::visit(rt::ParamVisitor& v) {
+  namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
   v.param("jog_v_max_mm_s", jog_v_max_mm_s,
-          {.unit = "mm/s", .description = "fastest continuous jog", .range = rt::kPositive});
+          {.unit = "mm/s", .description = "fastest continuous jog", .range = r::kSpeedMmS});
   v.param("accel_mm_s2", accel_mm_s2,
-          {.unit = "mm/s2", .description = "acceleration of manual moves", .range = rt::kPositive});
+          {.unit = "mm/s2", .description = "acceleration of manual moves", .range = r::kAccelMmS2});
   v.param("kp_per_s", kp_per_s,
           {.unit = "1/s",
            .description = "position gain that keeps the axis on its manual reference",
-           .range = rt::kNonNegative});
+           .range = r::kLoopGainPerS});
+  // A dead-man time up to 1 min: longer is no dead-man.
   v.param("deadman", deadman,
           {.unit = "s",
            .description = "a continuous jog not refreshed for this long stops (dead-man)",
-           .range = rt::kPositive});
+           .range = rt::open_closed(0.0, 60.0)});
   v.param("home_order", home_order,
           {.description = "the order in which the axes are referenced (X, Y, Z each at most once)",
            .load_time_only = true});
   v.param(
       "home_search_mm_s", home_search_mm_s,
-      {.unit = "mm/s", .description = "speed toward the reference switch", .range = rt::kPositive});
+      {.unit = "mm/s", .description = "speed toward the reference switch", .range = r::kSpeedMmS});
   v.param("home_latch_mm_s", home_latch_mm_s,
           {.unit = "mm/s",
            .description = "slow speed onto the switch where the position is set",
-           .range = rt::kPositive});
+           .range = r::kSpeedMmS});
   v.param("home_back_off_mm", home_back_off_mm,
           {.unit = "mm",
            .description = "back-off from the switch before the slow latch",
-           .range = rt::kPositive});
+           .range = r::kPositiveLengthMm});
   v.param("home_search_max_mm", home_search_max_mm,
           {.unit = "mm",
            .description = "longest search for the switch (else the homing fails)",
-           .range = rt::kPositive});
+           .range = r::kPositiveLengthMm});
   v.param("home_x_mm", home_x_mm,
-          {.unit = "mm", .description = "machine X of the X reference switch"});
+          {.unit = "mm",
+           .description = "machine X of the X reference switch",
+           .range = r::kPositionMm});
   v.param("home_y_mm", home_y_mm,
-          {.unit = "mm", .description = "machine Y of the Y reference switch"});
+          {.unit = "mm",
+           .description = "machine Y of the Y reference switch",
+           .range = r::kPositionMm});
   v.param("home_z_mm", home_z_mm,
-          {.unit = "mm", .description = "machine Z of the Z reference switch"});
+          {.unit = "mm",
+           .description = "machine Z of the Z reference switch",
+           .range = r::kPositionMm});
   v.param("touch_fast_mm_s", touch_fast_mm_s,
           {.unit = "mm/s",
            .description = "first approach toward the work in touch mode",
-           .range = rt::kPositive});
+           .range = r::kSpeedMmS});
   v.param("touch_slow_mm_s", touch_slow_mm_s,
           {.unit = "mm/s",
            .description = "second approach: the touch is where it makes contact",
-           .range = rt::kPositive});
+           .range = r::kSpeedMmS});
   v.param("touch_max_mm", touch_max_mm,
           {.unit = "mm",
            .description = "longest approach without contact (else no contact)",
-           .range = rt::kPositive});
-  v.param("touch_back_off_mm", touch_back_off_mm,
-          {.unit = "mm", .description = "back-off after each contact", .range = rt::kPositive});
+           .range = r::kPositiveLengthMm});
+  v.param(
+      "touch_back_off_mm", touch_back_off_mm,
+      {.unit = "mm", .description = "back-off after each contact", .range = r::kPositiveLengthMm});
+  // An electrode diameter up to 1 m.
   v.param("electrode_d_mm", electrode_d_mm,
           {.unit = "mm",
            .description = "electrode diameter: an edge lies one radius beyond the axis at contact",
-           .range = rt::kNonNegative});
+           .range = rt::closed(0.0, 1000.0)});
   v.param("reference_required", reference_required,
           {.description = "programs are refused until every axis is referenced",
            .load_time_only = true});

@@ -15,7 +15,7 @@ void ShortLimits::visit(rt::ParamVisitor& v) {
   v.param("short_retracts_window", short_retracts_window,
           {.unit = "s",
            .description = "the time over which short retracts are counted",
-           .range = rt::kPositive});
+           .range = rt::open_closed(0.0, 3600.0)});
 }
 
 }  // namespace edm::programs

@@ -31,7 +31,7 @@ double ParamValue::as_double() const noexcept {
     case ParamType::kReal:
       return r;
     case ParamType::kDuration:
-      return static_cast<double>(i) * 1e-9;
+      return static_cast<double>(i) / 1e9;  // exact for whole seconds: 60 s is 60, not 60.00…01
     case ParamType::kString:
       return 0.0;
   }
@@ -78,18 +78,43 @@ bool write_param(const ParamRef& ref, const ParamValue& v) noexcept {
 }
 
 namespace {
+// Whole numbers in full up to a million, everything else as %g with the exponent trimmed:
+// "65536", "0.05", "1e9", "-1e12", "9.22337e18".
 std::string num(double v) {
   char buf[64];
-  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e15) {
+  if (std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 1e6) {
     std::snprintf(buf, sizeof buf, "%.0f", v);
-  } else {
-    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
   }
-  return buf;
+  std::snprintf(buf, sizeof buf, "%g", v);
+  std::string s = buf;
+  if (const std::size_t e = s.find('e'); e != std::string::npos) {
+    std::size_t d = e + 1;
+    if (s[d] == '+') {
+      s.erase(d, 1);
+    } else if (s[d] == '-') {
+      ++d;
+    }
+    while (d + 1 < s.size() && s[d] == '0') {
+      s.erase(d, 1);
+    }
+  }
+  return s;
+}
+
+// The message check_field and range_violation give for a value outside the range, e.g.
+// "must be in (0, 10] (got 20)" or, with the unit, "must be in (0, 10] mm/s/us (got 20)".
+std::string outside(const Range& r, double v, std::string_view unit = {}) {
+  const std::string t = r.text();
+  const bool interval = !t.empty() && (t[0] == '[' || t[0] == '(');
+  return std::string("must be ") + (interval ? "in " : "") + t +
+         (unit.empty() ? "" : " " + std::string(unit)) + " (got " + num(v) + ")";
 }
 }  // namespace
 
 bool Range::unbounded() const noexcept { return std::isinf(lo) && std::isinf(hi); }
+
+bool Range::bounded() const noexcept { return std::isfinite(lo) && std::isfinite(hi) && lo < hi; }
 
 std::string Range::text() const {
   const bool has_lo = !std::isinf(lo);
@@ -128,10 +153,45 @@ void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef 
       break;
   }
   if (!spec.range.contains(v)) {
+    errs.push_back({std::string(name), outside(spec.range, v)});
+  }
+}
+
+std::string range_violation(const ParamSpec& spec, const ParamValue& v, bool with_unit) {
+  switch (v.type) {
+    case ParamType::kBool:
+    case ParamType::kString:
+      return {};
+    case ParamType::kReal:
+      if (spec.finite && !std::isfinite(v.r)) {
+        return "must be a finite number (got " + num(v.r) + ")";
+      }
+      break;
+    case ParamType::kInt:
+    case ParamType::kDuration:
+      break;
+  }
+  const double x = v.as_double();
+  return spec.range.contains(x) ? std::string()
+                                : outside(spec.range, x, with_unit ? spec.unit : std::string_view{});
+}
+
+void SpecAudit::on_param(std::string_view name, ParamRef ref, ParamSpec spec) {
+  if (!needs_range(ref.type, spec)) {
+    return;
+  }
+  ++writable_numbers;
+  const std::string type(to_string(ref.type));
+  if (!spec.range.bounded()) {
     const std::string t = spec.range.text();
-    const bool interval = !t.empty() && (t[0] == '[' || t[0] == '(');
-    errs.push_back({std::string(name), std::string("must be ") + (interval ? "in " : "") + t +
-                                           " (got " + num(v) + ")"});
+    problems.push_back(
+        {std::string(name), "is a runtime-writable " + type + " without a bounded range (" +
+                                (t.empty() ? std::string("none") : t) +
+                                "): declare its physical [min, max], or load_time_only"});
+    return;
+  }
+  if (const std::string why = range_violation(spec, read_param(ref)); !why.empty()) {
+    problems.push_back({std::string(name), "default outside its own range: " + why});
   }
 }
 

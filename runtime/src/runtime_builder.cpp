@@ -463,6 +463,8 @@ class RuntimeBuilder {
       v.unit = pl.fields[i].spec.unit;
       v.description = pl.fields[i].spec.description;
       v.range = pl.fields[i].spec.range.text();
+      v.param_range = pl.fields[i].spec.range;
+      v.param_finite = pl.fields[i].spec.finite;
       v.load_time_only = pl.fields[i].spec.load_time_only;
       v.owner = owner;
       if (!rt_->variables_.add(std::move(v))) {

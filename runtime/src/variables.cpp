@@ -149,6 +149,14 @@ VarStatus VariableRegistry::write(std::string_view name, const ParamValue& value
                                           std::string(to_string(v->param_type)) + ", not " +
                                           std::string(to_string(value.type))};
   }
+  if (!v->load_time_only) {
+    // Here, not only in the block's stage_param(): no writer reaches a block with a value outside
+    // the declared physical range, whatever the block type overrides.
+    const ParamSpec spec{.unit = v->unit, .range = v->param_range, .finite = v->param_finite};
+    if (std::string why = range_violation(spec, value, /*with_unit=*/true); !why.empty()) {
+      return {VarResult::kInvalid, "'" + std::string(name) + "': out of range: " + why};
+    }
+  }
   std::lock_guard lock(param_mutex_);
   const ParamValue previous = v->block->read_param(v->param_index);
   auto errs = v->block->stage_param(v->param_index, value);

@@ -215,11 +215,13 @@ void SimParams::visit(rt::ParamVisitor& outer) {
   v.param("tool_width_mm", tool_width_mm, {.unit = "mm", .description = "block width"});
   v.param("tool_length_mm", tool_length_mm, {.unit = "mm", .description = "block length"});
   v.param("wire_d_mm", wire_d_mm, {.unit = "mm", .description = "wire diameter D"});
-  // Outside LoadTimeOnly: the retained electrode length is restored through this (§5a).
+  // Outside LoadTimeOnly: the retained electrode length is restored through this (§5a). Its
+  // range: 100 km, the wire on a spool (20 kg of Ø0.25 mm brass is ~48 km; the wire preset has
+  // 1 km); the hole's below: 5 m, beyond any EDM machine's travel.
   outer.param("electrode_length_mm", electrode_length_mm,
               {.unit = "mm",
                .description = "electrode length; reads the length left, a runtime write sets it",
-               .range = rt::kNonNegative});
+               .range = rt::closed(0.0, 1.0e8)});
   v.param(
       "work_thickness_mm", work_thickness_mm,
       {.unit = "mm", .description = "through at this depth (0: blind)", .range = rt::kNonNegative});
@@ -294,13 +296,15 @@ void SimParams::visit(rt::ParamVisitor& outer) {
   outer.param("hole_depth_mm", hole_depth_mm,
               {.unit = "mm",
                .description = "the hole in the work: reads its live depth, a write sets it",
-               .range = rt::kNonNegative});
+               .range = rt::closed(0.0, 5000.0)});
   outer.param("hole_x_mm", hole_x_mm,
               {.unit = "mm",
-               .description = "the hole's axis, machine X: reads the live one, a write sets it"});
+               .description = "the hole's axis, machine X: reads the live one, a write sets it",
+               .range = rt::closed(-5000.0, 5000.0)});
   outer.param("hole_y_mm", hole_y_mm,
               {.unit = "mm",
-               .description = "the hole's axis, machine Y: reads the live one, a write sets it"});
+               .description = "the hole's axis, machine Y: reads the live one, a write sets it",
+               .range = rt::closed(-5000.0, 5000.0)});
   v.param("debris_kappa", debris_kappa,
           {.unit = "1", .description = "kappa: c += kappa V / V_gap", .range = rt::kNonNegative});
   v.param(

@@ -86,7 +86,7 @@ TEST(NestedParams, EveryChildParameterOfTheDemoMachineIsAVariable) {
   }
   const rt::Variable* kg = vars.find("cnc.job.drill.gap.kg");
   ASSERT_NE(kg, nullptr);
-  EXPECT_EQ(kg->range, "> 0");
+  EXPECT_EQ(kg->range, "(0, 10]");
   EXPECT_FALSE(kg->load_time_only);
   EXPECT_TRUE(vars.find("cnc.job.drill.td.window")->load_time_only);
 }
@@ -98,7 +98,7 @@ TEST(NestedParams, ListVarsOfTheDemoMachineShowsKgWithItsMetadata) {
   ASSERT_NE(kg, nullptr);
   const std::string row = rt::list_row(*kg);
   EXPECT_EQ(row.rfind("cnc.job.drill.gap.kg\tparam\tLREAL\tmm/s/us\t", 0), 0u) << row;
-  EXPECT_NE(row.find("\t> 0\truntime\t"), std::string::npos) << row;
+  EXPECT_NE(row.find("\t(0, 10]\truntime\t"), std::string::npos) << row;
   const std::string window = rt::list_row(*r->variables().find("cnc.job.drill.td.window"));
   EXPECT_NE(window.find("\t[1, 65536]\tload-time\t"), std::string::npos) << window;
 }
@@ -140,7 +140,7 @@ TEST(NestedParams, BadChildParametersAreRefusedAtTheirLine) {
   const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
   rt::Diagnostic d = first_error(with_gap_params("gap: {kg: -1}"));
   EXPECT_EQ(d.loc.line, line) << d.str();
-  EXPECT_NE(d.message.find("gap.kg must be > 0 (got -1)"), std::string::npos) << d.str();
+  EXPECT_NE(d.message.find("gap.kg must be in (0, 10] (got -1)"), std::string::npos) << d.str();
   d = first_error(with_gap_params("gap: {kg: 0.1}, gap.kg: 0.2"));
   EXPECT_NE(d.message.find("parameter 'gap.kg' is set twice"), std::string::npos) << d.str();
   d = first_error(with_gap_params("gap: {kgg: 0.1}"));
@@ -198,7 +198,9 @@ TEST(NestedParams, ABridgeWriteOfKgActsOnTheNextCycle) {
   const bridge::Reply negative =
       client.request("var.write", {{"name", "cycle.drill.gap.kg"}, {"value", -1.0}});
   EXPECT_FALSE(negative);
-  EXPECT_NE(negative.message.find("gap.kg must be > 0"), std::string::npos) << negative.message;
+  EXPECT_NE(negative.message.find("gap.kg': out of range: must be in (0, 10] mm/s/us (got -1)"),
+            std::string::npos)
+      << negative.message;
   EXPECT_EQ(value("cycle.drill.gap.kg"), 0.02);
   EXPECT_NE(p_law(0.02), p_law(0.05));
   server.stop();

@@ -24,6 +24,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -39,7 +40,9 @@ struct ButterworthLowPassParams {
              .description = "cut-off Wn as a fraction of the Nyquist frequency",
              .range = rt::open(0.0, 1.0)});
     v.param("initial", initial,
-            {.unit = "", .description = "steady-state value after activation, signal unit"});
+            {.unit = "",
+             .description = "steady-state value after activation, signal unit",
+             .range = ranges::kSignal});
     v.param("prime", prime,
             {.unit = "", .description = "the first sample after activation sets the steady state"});
   }

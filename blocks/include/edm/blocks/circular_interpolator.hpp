@@ -32,6 +32,7 @@
 #include <cstdint>
 
 #include "edm/blocks/move_interpolator.hpp"
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -42,13 +43,17 @@ struct CircularInterpolatorParams {
   double end_tol_mm{1e-3};  // [mm] allowed | |end − C| − R |, ≥ 0
 
   void visit(rt::ParamVisitor& v) {
-    v.param("x0_mm", x0_mm, {.unit = "mm", .description = "X position at activation"});
-    v.param("y0_mm", y0_mm, {.unit = "mm", .description = "Y position at activation"});
+    v.param(
+        "x0_mm", x0_mm,
+        {.unit = "mm", .description = "X position at activation", .range = ranges::kPositionMm});
+    v.param(
+        "y0_mm", y0_mm,
+        {.unit = "mm", .description = "Y position at activation", .range = ranges::kPositionMm});
     v.param("end_tol_mm", end_tol_mm,
             {.unit = "mm",
              .description =
                  "largest accepted difference between the end point's radius and the start radius",
-             .range = rt::kNonNegative});
+             .range = ranges::kToleranceMm});
   }
 };
 

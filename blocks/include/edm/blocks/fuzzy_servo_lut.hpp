@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "edm/blocks/fuzzy_mamdani.hpp"
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -122,7 +123,7 @@ struct FuzzyServoLUTParams {
     v.param("v_max_mm_s", v_max_mm_s,
             {.unit = "mm/s",
              .description = "speed at a normalised output of +-1",
-             .range = rt::kPositive});
+             .range = ranges::kSpeedMmS});
   }
 };
 

@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -19,9 +20,12 @@ struct GainParams {
   double offset{0.0};  // [out unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("k", k, {.unit = "", .description = "gain"});
+    // Ranges (issue 31): a gain within ±1e6, an offset within ±1e12 (param_ranges.hpp).
+    v.param("k", k, {.unit = "", .description = "gain", .range = ranges::kGain});
     v.param("offset", offset,
-            {.unit = "", .description = "added after the gain, in the output's unit"});
+            {.unit = "",
+             .description = "added after the gain, in the output's unit",
+             .range = ranges::kSignal});
   }
 };
 

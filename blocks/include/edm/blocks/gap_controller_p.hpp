@@ -34,6 +34,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -48,31 +49,34 @@ struct GapControllerPParams {
   double ki{0.0};                  // [mm/s per µs·s] ≥ 0, integral gain (0: the paper's P law)
 
   void visit(rt::ParamVisitor& v) {
+    // Ranges (issue 31): kg up to 10 mm/s per µs of Td error (seed 004 designs Kg ≈ 0.05; at 10 a
+    // 1 µs error already saturates any speed limit); Tdr and Td within 10 ms (param_ranges.hpp);
+    // ki up to 1e4 (ki/kg = 1/Ti: Ti = 1 ms even at the largest kg, 5 µs at the default one).
     v.param("kg", kg,
             {.unit = "mm/s/us",
              .description = "gain: Vz per microsecond of Td error",
-             .range = rt::kPositive});
+             .range = rt::open_closed(0.0, 10.0)});
     v.param("tdr_default_us", tdr_default_us,
             {.unit = "us",
              .description = "reference ignition delay while the tdr_us input is 0",
-             .range = rt::kPositive});
+             .range = rt::open_closed(0.0, 10000.0)});
     v.param("v_feed_max_mm_s", v_feed_max_mm_s,
-            {.unit = "mm/s", .description = "largest downward speed", .range = rt::kPositive});
+            {.unit = "mm/s", .description = "largest downward speed", .range = ranges::kSpeedMmS});
     v.param("v_retract_max_mm_s", v_retract_max_mm_s,
-            {.unit = "mm/s", .description = "largest upward speed", .range = rt::kPositive});
+            {.unit = "mm/s", .description = "largest upward speed", .range = ranges::kSpeedMmS});
     v.param("retract_speed_mm_s", retract_speed_mm_s,
             {.unit = "mm/s",
              .description = "upward speed while retract, <= v_retract_max_mm_s",
-             .range = rt::kPositive});
+             .range = ranges::kSpeedMmS});
     v.param("idle_feed_mm_s", idle_feed_mm_s,
             {.unit = "mm/s",
              .description = "speed while no valid Td, >= -v_feed_max_mm_s",
-             .range = rt::at_most(0.0)});
+             .range = rt::closed(-1000.0, 0.0)});
     v.param("ki", ki,
             {.unit = "mm/s/(us*s)",
              .description = "integral gain on the Td error; 0 = seed 004's P law (steady Td "
                             "offset v_b/Kg while drilling)",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1.0e4)});
   }
   /// Cross-field rules: retract_speed <= v_retract_max, idle_feed >= -v_feed_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

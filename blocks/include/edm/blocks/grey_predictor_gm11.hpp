@@ -38,6 +38,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
@@ -66,9 +67,12 @@ struct GreyPredictorGM11Params {
     v.param("paper_exp", paper_exp,
             {.unit = "",
              .description = "true: exp(-c) of the paper's eq. 1; false: the exact discrete rho"});
-    v.param("out_min", out_min, {.unit = "", .description = "lower clamp of out (Rab: 0)"});
+    v.param("out_min", out_min,
+            {.unit = "", .description = "lower clamp of out (Rab: 0)", .range = ranges::kSignal});
     v.param("out_max", out_max,
-            {.unit = "", .description = "upper clamp of out (Rab: 1), >= out_min"});
+            {.unit = "",
+             .description = "upper clamp of out (Rab: 1), >= out_min",
+             .range = ranges::kSignal});
   }
   /// Cross-field rule: out_min <= out_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -18,6 +18,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -29,12 +30,19 @@ struct IntegratorParams {
   double initial{0.0};  // [out unit], used clamped to [min, max]
 
   void visit(rt::ParamVisitor& v) {
+    // Ranges (issue 31): a gain within ±1e6, signals within ±1e12 (param_ranges.hpp).
     v.param("k", k,
-            {.unit = "1/s", .description = "integration gain: out changes by k·in per second"});
-    v.param("min", min, {.unit = "", .description = "lower limit of out"});
-    v.param("max", max, {.unit = "", .description = "upper limit of out, >= min"});
+            {.unit = "1/s",
+             .description = "integration gain: out changes by k·in per second",
+             .range = ranges::kGain});
+    v.param("min", min,
+            {.unit = "", .description = "lower limit of out", .range = ranges::kSignal});
+    v.param("max", max,
+            {.unit = "", .description = "upper limit of out, >= min", .range = ranges::kSignal});
     v.param("initial", initial,
-            {.unit = "", .description = "out at configure and while reset is true (clamped)"});
+            {.unit = "",
+             .description = "out at configure and while reset is true (clamped)",
+             .range = ranges::kSignal});
   }
   /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -41,6 +41,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/blocks/rising_edge.hpp"
 #include "edm/runtime/block.hpp"
 
@@ -70,10 +71,16 @@ struct IterativeLearningControlParams {
              .description = "samples per cycle N",
              .range = rt::closed(2.0, static_cast<double>(kMaxSamples)),
              .load_time_only = true});
+    // Ranges (issue 31): model coefficients within ±1e6 (the sinking config: p0 0.005, k_delta
+    // 1290), u and the error clamp in the position signal's unit, within ±1e12 (param_ranges.hpp).
     v.param("p0", p0,
-            {.unit = "1", .description = "first impulse-response sample of the axis loop, != 0"});
+            {.unit = "1",
+             .description = "first impulse-response sample of the axis loop, != 0",
+             .range = ranges::kCoefficient});
     v.param("k_delta", k_delta,
-            {.unit = "", .description = "output per unit of gap, y = k_delta*gap + b, != 0"});
+            {.unit = "",
+             .description = "output per unit of gap, y = k_delta*gap + b, != 0",
+             .range = ranges::kCoefficient});
     v.param("q_pole", q_pole,
             {.unit = "1",
              .description = "pole a of the Q low-pass (0: no filter)",
@@ -90,11 +97,14 @@ struct IterativeLearningControlParams {
             {.unit = "1",
              .description = "within-cycle pole",
              .range = rt::closed(-kMaxPole, kMaxPole)});
-    v.param(
-        "u_initial", u_initial,
-        {.unit = "", .description = "output before learning, position unit, in [u_min, u_max]"});
-    v.param("u_min", u_min, {.unit = "", .description = "lower clamp of u"});
-    v.param("u_max", u_max, {.unit = "", .description = "upper clamp of u, >= u_min"});
+    v.param("u_initial", u_initial,
+            {.unit = "",
+             .description = "output before learning, position unit, in [u_min, u_max]",
+             .range = ranges::kSignal});
+    v.param("u_min", u_min,
+            {.unit = "", .description = "lower clamp of u", .range = ranges::kSignal});
+    v.param("u_max", u_max,
+            {.unit = "", .description = "upper clamp of u, >= u_min", .range = ranges::kSignal});
     v.param("auto_cycle", auto_cycle,
             {.unit = "", .description = "a cycle ends every n_samples without cycle_start"});
     v.param("warm_cycles", warm_cycles,
@@ -108,7 +118,7 @@ struct IterativeLearningControlParams {
              .description =
                  "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b "
                  "holds (0: off)",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1.0e12)});
   }
   /// Rules a range cannot say: p0 != 0, k_delta != 0, u_min <= u_initial <= u_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -19,6 +19,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -29,12 +30,18 @@ struct LimiterParams {
   double rate{0.0};    // [signal unit / s], ≥ 0; 0 = no slew-rate limit
 
   void visit(rt::ParamVisitor& v) {
-    v.param("min", min, {.unit = "", .description = "lower limit, in the signal's unit"});
-    v.param("max", max, {.unit = "", .description = "upper limit, >= min, in the signal's unit"});
+    // Ranges (issue 31): a signal within ±1e12 (param_ranges.hpp: the ±1e9 defaults are "no limit").
+    v.param(
+        "min", min,
+        {.unit = "", .description = "lower limit, in the signal's unit", .range = ranges::kSignal});
+    v.param("max", max,
+            {.unit = "",
+             .description = "upper limit, >= min, in the signal's unit",
+             .range = ranges::kSignal});
     v.param("rate", rate,
             {.unit = "1/s",
              .description = "slew-rate limit in signal units per second (0 = unlimited)",
-             .range = rt::kNonNegative});
+             .range = ranges::kSignalRate});
   }
   /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

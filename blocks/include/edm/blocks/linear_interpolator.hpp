@@ -26,6 +26,7 @@
 #include <array>
 
 #include "edm/blocks/move_interpolator.hpp"
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -36,9 +37,15 @@ struct LinearInterpolatorParams {
   double z0_mm{0.0};  // [mm]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("x0_mm", x0_mm, {.unit = "mm", .description = "X position at activation"});
-    v.param("y0_mm", y0_mm, {.unit = "mm", .description = "Y position at activation"});
-    v.param("z0_mm", z0_mm, {.unit = "mm", .description = "Z position at activation"});
+    v.param(
+        "x0_mm", x0_mm,
+        {.unit = "mm", .description = "X position at activation", .range = ranges::kPositionMm});
+    v.param(
+        "y0_mm", y0_mm,
+        {.unit = "mm", .description = "Y position at activation", .range = ranges::kPositionMm});
+    v.param(
+        "z0_mm", z0_mm,
+        {.unit = "mm", .description = "Z position at activation", .range = ranges::kPositionMm});
   }
 };
 

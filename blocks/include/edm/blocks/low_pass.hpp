@@ -15,6 +15,7 @@
 
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -24,9 +25,12 @@ struct LowPassParams {
   double initial{0.0};                              // y after activate() [signal unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("tau", tau, {.unit = "s", .description = "time constant", .range = rt::kPositive});
+    v.param("tau", tau,
+            {.unit = "s", .description = "time constant", .range = ranges::kPositiveProcessTimeS});
     v.param("initial", initial,
-            {.unit = "", .description = "output after activation, in the signal's unit"});
+            {.unit = "",
+             .description = "output after activation, in the signal's unit",
+             .range = ranges::kSignal});
   }
 };
 

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/blocks/rising_edge.hpp"
 #include "edm/runtime/block.hpp"
 
@@ -39,14 +40,17 @@ struct OrbitExpanderParams {
   std::int64_t samples_per_rev{0};  // samples per revolution; 0 = revolutions from rev_pulse
 
   void visit(rt::ParamVisitor& v) {
+    // Ranges (issue 31): kr up to 1 mm/µs (x a mean Td of 10-100 µs: 10-100 mm a revolution, far
+    // past the seed 004 default 1e-4 that "too large a kr shorts the gap"; dr_max, at most 10 mm,
+    // clamps the step).
     v.param("kr", kr,
             {.unit = "mm/us",
              .description = "radius growth per revolution per us of mean ignition delay",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1.0)});
     v.param("dr_max_mm", dr_max_mm,
             {.unit = "mm",
              .description = "largest radius growth per revolution",
-             .range = rt::kNonNegative});
+             .range = ranges::kToleranceMm});
     v.param("samples_per_rev", samples_per_rev,
             {.unit = "",
              .description = "samples per revolution (0: a rising edge of rev_pulse ends a "

@@ -25,6 +25,7 @@
 #include <chrono>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -37,7 +38,7 @@ struct PolaritySwitchParams {
     v.param("settle", settle,
             {.unit = "s",
              .description = "generator-off time before and after a switch",
-             .range = rt::kPositive});
+             .range = ranges::kPositiveSettleS});
     v.param(
         "initial_positive", initial_positive,
         {.unit = "", .description = "polarity after activation (false: negative, electrode -)"});

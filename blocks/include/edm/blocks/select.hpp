@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -42,7 +43,7 @@ struct SelectParams {
         {.unit = "s",
          .description =
              "after a switch, the output's step decays linearly to 0 over this time (0 = at once)",
-         .range = rt::kNonNegative});
+         .range = ranges::kProcessTimeS});
   }
 };
 

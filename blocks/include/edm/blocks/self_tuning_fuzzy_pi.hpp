@@ -50,6 +50,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -74,23 +75,32 @@ struct SelfTuningFuzzyPIParams {
   std::int64_t settle_samples{0};  // hold u, v for this many samples after activate()
 
   void visit(rt::ParamVisitor& v) {
-    v.param("ge", ge, {.unit = "1", .description = "error scaling Ge", .range = rt::kPositive});
+    // Ranges (issue 31), seed 000 Table 5 and Table 1: Ge 5 and Gce 40 (up to 1e4), ol 2-3 (up to
+    // 100), Ku 0.06-0.08 µs and Kv 0.03-0.16 V (up to 1000), the d_pf gain 100 (up to 1e4), the
+    // arc-off time 9-50 µs (within 10 ms) and the servo reference 30-70 V (within 400 V); psi_min
+    // down to -1e9, the documented "no floor".
+    v.param("ge", ge,
+            {.unit = "1", .description = "error scaling Ge", .range = rt::open_closed(0.0, 1.0e4)});
     v.param("gce", gce,
-            {.unit = "1", .description = "change-of-error scaling Gce", .range = rt::kPositive});
+            {.unit = "1",
+             .description = "change-of-error scaling Gce",
+             .range = rt::open_closed(0.0, 1.0e4)});
     v.param("alpha", alpha,
             {.unit = "1",
              .description = "overshoot attenuation alpha",
              .range = rt::closed(1e-9, 1.0)});
     v.param("ol", ol,
-            {.unit = "1", .description = "overloading parameter ol", .range = rt::kPositive});
+            {.unit = "1",
+             .description = "overloading parameter ol",
+             .range = rt::open_closed(0.0, 100.0)});
     v.param("ku", ku,
             {.unit = "us",
              .description = "global gain of the arc-off time",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1000.0)});
     v.param("kv", kv,
             {.unit = "V",
              .description = "global gain of the servo reference voltage",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1000.0)});
     v.param("rab_ref_default", rab_ref_default,
             {.unit = "1",
              .description = "Rab set point while rab_ref is 0",
@@ -102,23 +112,33 @@ struct SelfTuningFuzzyPIParams {
     v.param("dpf_gain", dpf_gain,
             {.unit = "1",
              .description = "gain on d_pf = Rab_p - Rab_f in Psi",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1.0e4)});
     v.param(
         "psi_min", psi_min,
         {.unit = "1",
-         .description = "floor of Psi in overload (0: no reversal; -1e9: none, eq. 8 as printed)"});
-    v.param("u_min_us", u_min_us, {.unit = "us", .description = "shortest arc-off time"});
+         .description = "floor of Psi in overload (0: no reversal; -1e9: none, eq. 8 as printed)",
+         .range = rt::closed(-1.0e9, 100.0)});
+    v.param("u_min_us", u_min_us,
+            {.unit = "us", .description = "shortest arc-off time", .range = ranges::kPulseUs});
     v.param("u_max_us", u_max_us,
-            {.unit = "us", .description = "longest arc-off time, >= u_min_us"});
+            {.unit = "us",
+             .description = "longest arc-off time, >= u_min_us",
+             .range = ranges::kPulseUs});
+    v.param("u_initial_us", u_initial_us,
+            {.unit = "us",
+             .description = "arc-off time after activation, in [u_min_us, u_max_us]",
+             .range = ranges::kPulseUs});
     v.param(
-        "u_initial_us", u_initial_us,
-        {.unit = "us", .description = "arc-off time after activation, in [u_min_us, u_max_us]"});
-    v.param("v_min_v", v_min_v, {.unit = "V", .description = "lowest servo reference voltage"});
+        "v_min_v", v_min_v,
+        {.unit = "V", .description = "lowest servo reference voltage", .range = ranges::kVoltageV});
     v.param("v_max_v", v_max_v,
-            {.unit = "V", .description = "highest servo reference voltage, >= v_min_v"});
+            {.unit = "V",
+             .description = "highest servo reference voltage, >= v_min_v",
+             .range = ranges::kVoltageV});
     v.param("v_initial_v", v_initial_v,
             {.unit = "V",
-             .description = "servo reference voltage after activation, in [v_min_v, v_max_v]"});
+             .description = "servo reference voltage after activation, in [v_min_v, v_max_v]",
+             .range = ranges::kVoltageV});
     v.param(
         "settle_samples", settle_samples,
         {.unit = "samples",

@@ -44,6 +44,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/blocks/rls_core.hpp"
 #include "edm/runtime/block.hpp"
 
@@ -90,36 +91,61 @@ struct SelfTuningRegulatorParams {
              .description = "prediction delay d_v of the main model (shapes the regressor history)",
              .range = rt::closed(0.0, static_cast<double>(kMaxDelay)),
              .load_time_only = true});
+    // Ranges (issue 31), seed 001: beta00 = -1 (within ±1000), u_v a multiple of us_per_unit_v
+    // (0-100; the reference voltage itself below 400 V), ti and to up to 10 ms (PM §1: t_on
+    // 1-1000 µs), start values within ±1e6, the RLS covariance p0 up to 1e9 and its trace 1e12.
     v.param("beta00", beta00,
-            {.unit = "1", .description = "fixed beta00 of the main model, != 0 (paper -1)"});
+            {.unit = "1",
+             .description = "fixed beta00 of the main model, != 0 (paper -1)",
+             .range = rt::closed(-1000.0, 1000.0)});
     v.param("us_per_unit_v", us_per_unit_v,
             {.unit = "V",
              .description = "servo reference voltage per unit of u_v",
-             .range = rt::kPositive});
-    v.param("u_v_min", u_v_min, {.unit = "1", .description = "lowest u_v"});
-    v.param("u_v_max", u_v_max, {.unit = "1", .description = "highest u_v, >= u_v_min"});
+             .range = rt::open_closed(0.0, 400.0)});
+    v.param("u_v_min", u_v_min,
+            {.unit = "1", .description = "lowest u_v", .range = rt::closed(0.0, 100.0)});
+    v.param(
+        "u_v_max", u_v_max,
+        {.unit = "1", .description = "highest u_v, >= u_v_min", .range = rt::closed(0.0, 100.0)});
     v.param("u_v_initial", u_v_initial,
-            {.unit = "1", .description = "u_v after activation, in [u_v_min, u_v_max]"});
-    v.param("beta01_init", beta01_init, {.unit = "1", .description = "initial estimate of beta01"});
-    v.param("beta0c_init", beta0c_init, {.unit = "1", .description = "initial estimate of beta0c"});
+            {.unit = "1",
+             .description = "u_v after activation, in [u_v_min, u_v_max]",
+             .range = rt::closed(0.0, 100.0)});
+    v.param(
+        "beta01_init", beta01_init,
+        {.unit = "1", .description = "initial estimate of beta01", .range = ranges::kCoefficient});
+    v.param(
+        "beta0c_init", beta0c_init,
+        {.unit = "1", .description = "initial estimate of beta0c", .range = ranges::kCoefficient});
     v.param("ti_us", ti_us,
             {.unit = "us",
              .description = "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti",
-             .range = rt::kPositive});
+             .range = rt::open_closed(0.0, 10000.0)});
     v.param("to_min_us", to_min_us,
-            {.unit = "us", .description = "shortest pulse-off time", .range = rt::kPositive});
+            {.unit = "us",
+             .description = "shortest pulse-off time",
+             .range = rt::open_closed(0.0, 10000.0)});
     v.param("to_max_us", to_max_us,
-            {.unit = "us", .description = "longest pulse-off time, >= to_min_us"});
+            {.unit = "us",
+             .description = "longest pulse-off time, >= to_min_us",
+             .range = ranges::kPulseUs});
     v.param("to_initial_us", to_initial_us,
             {.unit = "us",
-             .description = "pulse-off time after activation, in [to_min_us, to_max_us]"});
-    v.param("beta1c_init", beta1c_init, {.unit = "1", .description = "initial estimate of beta1c"});
+             .description = "pulse-off time after activation, in [to_min_us, to_max_us]",
+             .range = ranges::kPulseUs});
+    v.param(
+        "beta1c_init", beta1c_init,
+        {.unit = "1", .description = "initial estimate of beta1c", .range = ranges::kCoefficient});
     v.param("lambda", lambda,
             {.unit = "1", .description = "RLS forgetting factor", .range = rt::closed(0.5, 1.0)});
     v.param("p0", p0,
-            {.unit = "1", .description = "initial RLS covariance", .range = rt::kPositive});
+            {.unit = "1",
+             .description = "initial RLS covariance",
+             .range = rt::open_closed(0.0, 1.0e9)});
     v.param("trace_max", trace_max,
-            {.unit = "1", .description = "bound of the RLS covariance trace, >= 2*p0"});
+            {.unit = "1",
+             .description = "bound of the RLS covariance trace, >= 2*p0",
+             .range = rt::open_closed(0.0, 1.0e12)});
     v.param("y_rv_good", y_rv_good,
             {.unit = "1",
              .description = "y_v reference in a good gap (paper 0.95)",
@@ -143,7 +169,7 @@ struct SelfTuningRegulatorParams {
     v.param("ref_step", ref_step,
             {.unit = "1",
              .description = "reference decrease per sample during a stable arc",
-             .range = rt::kNonNegative});
+             .range = rt::closed(0.0, 1.0)});
     v.param("y_rv_min", y_rv_min,
             {.unit = "1",
              .description = "floor of the y_v reference, <= y_rv_good",

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
 
 namespace edm::blocks {
@@ -27,13 +28,21 @@ struct SineSourceParams {
   double offset{0.0};        // [signal unit]
 
   void visit(rt::ParamVisitor& v) {
+    // Ranges (issue 31): signals within ±1e12 (param_ranges.hpp); up to 100 kHz, ten times the
+    // Nyquist frequency of the fastest (10 kHz) task; a phase within ±1000 rad.
     v.param("amplitude", amplitude,
-            {.unit = "", .description = "peak amplitude, in the signal's unit"});
+            {.unit = "",
+             .description = "peak amplitude, in the signal's unit",
+             .range = ranges::kSignal});
     v.param("frequency_hz", frequency_hz,
-            {.unit = "Hz", .description = "frequency", .range = rt::kPositive});
-    v.param("phase_rad", phase_rad, {.unit = "rad", .description = "phase at cycle 0"});
+            {.unit = "Hz", .description = "frequency", .range = rt::open_closed(0.0, 1.0e5)});
+    v.param(
+        "phase_rad", phase_rad,
+        {.unit = "rad", .description = "phase at cycle 0", .range = rt::closed(-1000.0, 1000.0)});
     v.param("offset", offset,
-            {.unit = "", .description = "added to the sine, in the signal's unit"});
+            {.unit = "",
+             .description = "added to the sine, in the signal's unit",
+             .range = ranges::kSignal});
   }
 };
 

@@ -35,6 +35,7 @@
 #include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
+#include "edm/blocks/param_ranges.hpp"
 namespace edm::blocks {
 
 struct TdDetectorParams {
@@ -59,11 +60,11 @@ struct TdDetectorParams {
     v.param("empty_td_us", empty_td_us,
             {.unit = "us",
              .description = "td_us after activation, and with an empty window when not holding",
-             .range = rt::kNonNegative});
+             .range = ranges::kTdUs});
     v.param("short_td_us", short_td_us,
             {.unit = "us",
              .description = "ignition delay a shorted pulse counts with (gap feedback ~ 0)",
-             .range = rt::kNonNegative});
+             .range = ranges::kTdUs});
   }
 };
 

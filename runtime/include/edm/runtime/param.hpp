@@ -74,6 +74,8 @@ struct Range {
     return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
   }
   [[nodiscard]] bool unbounded() const noexcept;
+  /// Both bounds finite and lo < hi: what every runtime-writable number declares.
+  [[nodiscard]] bool bounded() const noexcept;
   /// "> 0", ">= 1", "< 5", "<= 5", "[0, 1]", "(0, 1]", … ; empty when unbounded.
   [[nodiscard]] std::string text() const;
 };
@@ -98,6 +100,10 @@ inline constexpr Range kPositive = above(0.0);
 inline constexpr Range kNonNegative = at_least(0.0);
 
 /// Everything said about a parameter, declared once in the Params struct's visit().
+/// A runtime-writable INT, REAL or TIME field must declare a bounded range (finite lo < hi, the
+/// default inside): its physical range, so that no writer — bridge, Modbus, MQTT, config — can
+/// set a value the machine cannot mean (issue 31: gap.kg took 9.2e18). SpecAudit checks this
+/// for every registered type (ctest params.*, and edm_paramdoc).
 struct ParamSpec {
   std::string_view unit{};         // "mm/s", "us", "" (dimensionless)
   std::string_view description{};  // one line, for listings and docs/blocks.md
@@ -161,6 +167,33 @@ void require_ordered(std::vector<ParamError>& errs, std::string_view lo_field, d
 /// Non-RT (builds a message).
 void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef ref,
                  const ParamSpec& spec);
+
+/// Why `v` is not allowed by `spec` — a non-finite REAL, or outside the range — e.g.
+/// "must be in (0, 10] (got 9.22337e18)", with_unit "must be in (0, 10] mm/s/us (got …)"; empty
+/// when it is allowed (BOOL and STRING always are). TIME in seconds. Non-RT (builds a message).
+std::string range_violation(const ParamSpec& spec, const ParamValue& v, bool with_unit = false);
+
+/// True when a runtime write of a field of this type can happen: not load-time only and not a
+/// STRING (strings are set in the config only). RT-safe.
+constexpr bool runtime_writable(ParamType t, const ParamSpec& spec) noexcept {
+  return !spec.load_time_only && t != ParamType::kString;
+}
+/// True when the field must declare a bounded range: a runtime-writable INT, REAL or TIME.
+constexpr bool needs_range(ParamType t, const ParamSpec& spec) noexcept {
+  return runtime_writable(t, spec) && t != ParamType::kBool;
+}
+
+/// Audits the declarations of a Params struct (or a block's visit_params()): every field that
+/// needs_range() declares a bounded range, and the field's current value (on a default-built
+/// block: its default) lies in it. One problem per bad field, naming it. Non-RT.
+class SpecAudit final : public ParamVisitor {
+ public:
+  std::vector<ParamError> problems;
+  std::size_t writable_numbers{0};  // fields seen that need a range (with or without one)
+
+ protected:
+  void on_param(std::string_view name, ParamRef ref, ParamSpec spec) override;
+};
 
 /// Checks every field of a Params struct against its ParamSpec. Non-RT.
 class SpecChecker final : public ParamVisitor {

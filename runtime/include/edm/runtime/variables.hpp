@@ -48,6 +48,8 @@ struct Variable {
   // Parameters: from the block's ParamSpec.
   std::string description;
   std::string range;  // "> 0", "[1, 65536]", "" (any)
+  Range param_range{};  // what write() accepts (with param_finite), checked before the block sees it
+  bool param_finite{true};
   bool load_time_only{false};
 
   [[nodiscard]] bool is_pin() const noexcept { return kind != VarKind::kParam; }
@@ -64,7 +66,7 @@ enum class VarResult : std::uint8_t {
   kNotFound,      // no such variable
   kWrongKind,     // e.g. writing a pin or forcing a parameter
   kTypeMismatch,  // value does not fit the variable's type
-  kInvalid,       // the block's validate() refused it (message says why)
+  kInvalid,       // outside the parameter's range, or its block's validate() refused it
   kBusy,          // the task's write queue is full
   kInvalidState,  // refused in this machine state (forcing in FAULT or ESTOP)
 };
@@ -89,8 +91,11 @@ class VariableRegistry {
   [[nodiscard]] std::optional<double> read(std::string_view name) const;
   [[nodiscard]] std::optional<ParamValue> read_param(std::string_view name) const;
 
-  /// Writes a parameter: checks type, validates on the block's shadow copy, queues it to the
-  /// owning task (or applies it at once when `apply_now`, only before tasks run).
+  /// Writes a parameter: the one entry point of every runtime writer (bridge var.write, Modbus,
+  /// MQTT). Checks the type, then the value against the parameter's ParamSpec range (and
+  /// finiteness: NaN and ±inf are refused) — kInvalid "out of range", nothing changed — then
+  /// validates on the block's shadow copy and queues it to the owning task (or applies it at
+  /// once when `apply_now`, only before tasks run).
   VarStatus write(std::string_view name, double value, bool apply_now = false);
   VarStatus write(std::string_view name, const ParamValue& value, bool apply_now = false);
   /// Forces a pin to a value (converted to the pin's type: bool ≠ 0, integers must be whole).
