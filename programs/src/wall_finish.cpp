@@ -19,10 +19,10 @@ constexpr double kMinBaseRadiusMm = 1e-3;  // the arc's radius when the final of
 }  // namespace
 
 void WallFinishParams::visit(rt::ParamVisitor& v) {
-  v.param("feed_default_mm_min", feed_default_mm_min,
   namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
   // Ranges (issue 31): the orbit feed up to 60 m/min (1 m/s, as any axis speed); spark-out up to
   // 1e6 revolutions; the rest in param_ranges.hpp.
+  v.param("feed_default_mm_min", feed_default_mm_min,
           {.unit = "mm/min",
            .description = "orbit feed fr along the arc's radius (the final offset) while the "
                           "feed_mm_min input is <= 0",

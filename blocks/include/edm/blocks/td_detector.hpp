@@ -32,10 +32,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "edm/blocks/param_ranges.hpp"
 #include "edm/blocks/window_ring.hpp"
 #include "edm/runtime/block.hpp"
 
-#include "edm/blocks/param_ranges.hpp"
 namespace edm::blocks {
 
 struct TdDetectorParams {
