@@ -77,7 +77,8 @@ void one_message(std::string_view text, std::optional<bridge::Role>& role,
   const std::string& last = backend.calls.back();
   if (last.starts_with("relay:")) {
     EDM_FUZZ_CHECK(last.substr(6) == info.name);
-    EDM_FUZZ_CHECK(backend.last_params.is_object());
+    // What reached edmplc's side is an object (unless the fake failed before it looked).
+    EDM_FUZZ_CHECK(back["ok"] == false || backend.last_params.is_object());
   }
   if (backend.calls.size() > 4096) backend.calls.clear();
 }
