@@ -172,8 +172,9 @@ std::string range_violation(const ParamSpec& spec, const ParamValue& v, bool wit
       break;
   }
   const double x = v.as_double();
-  return spec.range.contains(x) ? std::string()
-                                : outside(spec.range, x, with_unit ? spec.unit : std::string_view{});
+  return spec.range.contains(x)
+             ? std::string()
+             : outside(spec.range, x, with_unit ? spec.unit : std::string_view{});
 }
 
 void SpecAudit::on_param(std::string_view name, ParamRef ref, ParamSpec spec) {

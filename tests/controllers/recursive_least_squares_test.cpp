@@ -144,7 +144,8 @@ RecursiveLeastSquaresParams start_with_one_direction_excited(BlockHarness<Recurs
 TEST(RecursiveLeastSquares, covariance_grows_as_lambda_to_the_minus_k_without_excitation) {
   // φ = [1, 0]: the second direction is never excited, so P11 = p0·λ^(−k) exactly (wind-up).
   BlockHarness<RecursiveLeastSquares> h;
-  const RecursiveLeastSquaresParams p = start_with_one_direction_excited(h, 1e12);  // the bound never reached
+  // trace_max 1e12, its range's top: never reached here (p0·λ^-200 ≈ 4.4e3).
+  const RecursiveLeastSquaresParams p = start_with_one_direction_excited(h, 1e12);
   ASSERT_FALSE(::testing::Test::HasFailure());
   const int k = 200;
   for (int i = 0; i < k; ++i) {

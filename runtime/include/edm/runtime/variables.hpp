@@ -48,7 +48,8 @@ struct Variable {
   // Parameters: from the block's ParamSpec.
   std::string description;
   std::string range;  // "> 0", "[1, 65536]", "" (any)
-  Range param_range{};  // what write() accepts (with param_finite), checked before the block sees it
+  // What write() accepts (with param_finite), checked before the block sees the value.
+  Range param_range{};
   bool param_finite{true};
   bool load_time_only{false};
 
