@@ -26,6 +26,7 @@ void TdDetector::activate() noexcept {
   open_ratio.set(0.0);
   short_ratio.set(0.0);
   valid.set(false);
+  cycle_short_ratio.set(0.0);
 }
 
 rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
@@ -44,6 +45,8 @@ rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
     return rt::BlockStatus::kFault;  // a delay sum without pulses
   }
 
+  cycle_short_ratio.set(
+      c.n_total > 0 ? static_cast<double>(c.n_short) / static_cast<double>(c.n_total) : 0.0);
   const Counts old = window_.push(c);  // all 0 until the window is full
   sum_.td_sum_ns += c.td_sum_ns - old.td_sum_ns;
   sum_.td_count += c.td_count - old.td_count;

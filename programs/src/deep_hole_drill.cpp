@@ -108,7 +108,7 @@ void DeepHoleDrill::bind_self() {
   wear_.enable.follow(enable_wear_comp);
   wear_.reset_wear.connect(reset_wear);
   retract_.z_mm.follow(z_mm);
-  retract_.short_detected.connect(gap_short);
+  retract_.short_detected.connect(short_now);
   retract_.enable.connect(retract_enable);
   zloop_.x_ref_mm.connect(retract_.z_sp_mm);
   zloop_.v_ff_mm_s.connect(retract_vff_mm_s);
@@ -133,6 +133,8 @@ void DeepHoleDrill::activate_self() noexcept {
   wear_mm.set(0.0);
   done.set(false);
   gap_short.set(false);
+  cycle_short.set(false);
+  short_now.set(false);
   retract_enable.set(false);
   retract_vff_mm_s.set(0.0);
   short_retracts.set(0);
@@ -210,6 +212,8 @@ bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
                                  rt::BlockStatus& status) noexcept {
   retract_enable.set(true);
   gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
+  cycle_short.set(ShortGuard::cycle_reads_short(td_, params_.shorts));
+  short_now.set(gap_short.get() || cycle_short.get());
   status = rt::worst(status, step(retract_, ctx));
   const bool active = retract_.active.get();
   switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
@@ -274,14 +278,19 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
   if (state_value_ == State::kApproach) {
     status = rt::worst(status, step(td_, ctx));  // fills the Td window before the gap loop starts
     td_stepped = true;
-    spark_cycles_ = pulses.td_count.get() > 0 ? spark_cycles_ + 1 : 0;
+    // A cycle whose own pulses read short has closed the gap too: it counts as a touch, and it
+    // feeds no further (the P law then backs off from Td ≈ 0, the short handling from there on).
+    const bool shorted = ShortGuard::cycle_reads_short(td_, params_.shorts);
+    cycle_short.set(shorted);
+    short_now.set(shorted);
+    spark_cycles_ = pulses.td_count.get() > 0 || shorted ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
       touch_z_mm.set(measured_ ? contact_z_mm_ : resume_ ? resume_touch_z_mm_ : z);
       reset_wear.set(true);  // the wear estimate starts at the touch
       set_state(State::kDrill);
     } else {
       gen_on.set(true);
-      vz_cmd_mm_s.set(-params_.approach_speed_mm_s * feed_scale());
+      vz_cmd_mm_s.set(shorted ? 0.0 : -params_.approach_speed_mm_s * feed_scale());
     }
   }
 
@@ -304,7 +313,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       // The servo's command into the wear compensator: the gap child's Vz, or the external
       // servo's clamped to the gap child's limits; ramped back in after a retract (v_scale
       // 0 → 1), so the compensator sees the feed the axis makes; never down while the window
-      // reads short.
+      // or this cycle's own pulses read short.
       double v = gap_.vz_mm_s.get();
       if (vz_servo_mm_s.connected()) {
         v = vz_servo_mm_s.get();
@@ -317,7 +326,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       }
       v *= retract_.v_scale.get();
       v = std::max(v, -gap_.params().v_feed_max_mm_s * feed_scale());  // the override's cap
-      vz_servo_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
+      vz_servo_cmd_mm_s.set(feed_stopped() ? std::max(v, 0.0) : v);
       status = rt::worst(status, step(wear_, ctx));
       reset_wear.set(false);
     }
@@ -345,10 +354,14 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     } else if (state_value_ == State::kDrill) {
       gen_on.set(true);
       // Retracting: zloop follows the retract's setpoint; else the compensated servo command.
-      // While the window reads short, never toward the work.
+      // While the window or this cycle reads short, never toward the work.
       const double v = retracting ? zloop_.v_cmd_mm_s.get() : wear_.vz_out_mm_s.get();
-      vz_cmd_mm_s.set(gap_short.get() ? std::max(v, 0.0) : v);
+      vz_cmd_mm_s.set(feed_stopped() ? std::max(v, 0.0) : v);
     }
+  }
+  if (state_value_ != State::kApproach && state_value_ != State::kDrill) {
+    cycle_short.set(false);  // the generator is off: no pulses of this program's
+    short_now.set(false);
   }
   if (state_value_ != State::kDrill && retract_enable.get()) {
     retract_enable.set(false);  // the history is the path of this hole's DRILL only

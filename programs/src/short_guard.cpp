@@ -5,7 +5,8 @@ namespace edm::programs {
 void ShortLimits::visit(rt::ParamVisitor& v) {
   v.param("short_ratio_limit", short_ratio_limit,
           {.unit = "",
-           .description = "the Td window reads short at this fraction of shorted pulses",
+           .description = "the Td window, or one cycle alone, reads short at this fraction of "
+                          "shorted pulses",
            .range = rt::open_closed(0.0, 1.0)});
   v.param(
       "short_retracts_max", short_retracts_max,

@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kMinBaseRadiusMm = 1e-3;  // the arc's radius when the final offset is ~0
+constexpr double kCentreRadiusMm = 1e-6;   // closer to the hole centre: no radial direction
 
 }  // namespace
 
@@ -122,7 +123,7 @@ void WallFinish::bind_self() {
   py_.enable.connect(loop_enable);
   retract_.x_mm.connect(x_ref_mm);  // the contour as commanded
   retract_.y_mm.connect(y_ref_mm);
-  retract_.short_detected.connect(gap_short);
+  retract_.short_detected.connect(short_now);
   retract_.enable.connect(retract_enable);
 }
 
@@ -149,6 +150,8 @@ void WallFinish::activate_self() noexcept {
   revolutions.set(0);
   done.set(false);
   gap_short.set(false);
+  cycle_short.set(false);
+  short_now.set(false);
   retract_enable.set(false);
   short_retracts.set(0);
   guard_.reset();
@@ -188,6 +191,8 @@ void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexce
 bool WallFinish::handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept {
   retract_enable.set(true);
   gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
+  cycle_short.set(ShortGuard::cycle_reads_short(td_, params_.shorts));
+  short_now.set(gap_short.get() || cycle_short.get());
   status = rt::worst(status, step(retract_, ctx));
   switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
     case ShortGuard::Event::kNone:
@@ -287,7 +292,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       status = rt::BlockStatus::kFault;
     }
     retracting = handle_short(ctx, status);
-    if (retracting || gap_short.get()) {
+    if (retracting || short_now.get()) {
       rho_target = rho_;  // a short: the phase and the radius wait
     } else {
       const double radius = orbit_.radius_mm.get();
@@ -322,6 +327,10 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       }
     }
   }
+  if (state_value_ != State::kOrbit) {
+    cycle_short.set(false);  // the generator is off outside the orbit
+    short_now.set(false);
+  }
   if (state_value_ != State::kOrbit && retract_enable.get()) {
     retract_enable.set(false);  // the history is this orbit's contour only
     status = rt::worst(status, step(retract_, ctx));
@@ -348,8 +357,25 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     loop_enable.set(true);
     status = rt::worst(status, step(px_, ctx));
     status = rt::worst(status, step(py_, ctx));
-    vx_cmd_mm_s.set(px_.v_cmd_mm_s.get());
-    vy_cmd_mm_s.set(py_.v_cmd_mm_s.get());
+    double vx = px_.v_cmd_mm_s.get();
+    double vy = py_.v_cmd_mm_s.get();
+    if (state_value_ == State::kOrbit && short_now.get()) {
+      // Reading short: nothing toward the wall, i.e. no outward part along the electrode's
+      // radius from the hole centre (at the centre itself, where every way is outward: stop).
+      const double rx = x - x0_, ry = y - y0_;
+      const double r = std::hypot(rx, ry);
+      if (!(r > kCentreRadiusMm)) {
+        vx = vy = 0.0;
+      } else {
+        const double out = (vx * rx + vy * ry) / r;
+        if (out > 0.0) {
+          vx -= out * rx / r;
+          vy -= out * ry / r;
+        }
+      }
+    }
+    vx_cmd_mm_s.set(vx);
+    vy_cmd_mm_s.set(vy);
     rho_mm.set(rho_);
   }
 

@@ -59,6 +59,7 @@ class Parser {
   void parse_realtime(const Value& v, RealtimeSpec& out);
   void parse_safety(const Value& v, MachineSpec& machine);  // config_safety.cpp
   void parse_safety_axis(const Value& v, const MachineSpec& machine, SafetyAxisSpec& out);
+  void parse_short_stop(const Value& v, SafetySpec& out);
   std::optional<NameRef> io_pin_name(const Value& v);
   void parse_task(const Value& v, TaskSpec& out);
   void parse_watchdog(const Value& v, WatchdogSpec& out);

@@ -86,11 +86,56 @@ void Parser::parse_safety_axis(const Value& v, const MachineSpec& machine, Safet
   }
 }
 
+void Parser::parse_short_stop(const Value& v, SafetySpec& out) {
+  auto m = r_.map(v, {"shorts", "pulses", "limit"});
+  if (!m) {
+    return;
+  }
+  ShortStopSpec s;
+  s.loc = v.loc;
+  if (const Field* f = r_.require(*m, "shorts")) {
+    if (auto n = io_pin_name(f->value)) s.shorts = *n;
+  }
+  if (const Field* f = r_.require(*m, "pulses")) {
+    if (auto items = r_.list(f->value)) {
+      if (items->empty()) {
+        r_.error(f->value,
+                 "needs at least one pin: the pulse counters that add up to all pulses "
+                 "of a cycle");
+      }
+      for (const Value& item : *items) {
+        if (auto n = io_pin_name(item)) s.pulses.push_back(*n);
+      }
+    }
+  }
+  if (const Field* f = m->find("limit")) {
+    if (auto x = r_.real(f->value)) {
+      if (!(*x > 0.0 && *x <= 1.0)) {
+        r_.error(f->value,
+                 "must be in (0, 1], the fraction of a cycle's pulses that are shorts "
+                 "(got " +
+                     f->value.node.Scalar() + ")");
+      } else {
+        s.limit = *x;
+      }
+    }
+  }
+  const bool any_retract = std::any_of(out.axes.begin(), out.axes.end(), [](const auto& a) {
+    return a.retract != RetractDirection::kNone;
+  });
+  if (!any_retract) {
+    r_.error(v,
+             "no supervised axis has a retract direction (axes[].retract): the short stop "
+             "cuts the motion against it, toward the work");
+  }
+  out.short_stop = std::move(s);
+}
+
 void Parser::parse_safety(const Value& v, MachineSpec& machine) {
   SafetySpec& out = machine.safety;
   out.present = true;
   out.loc = v.loc;
-  auto m = r_.map(v, {"axes", "electrode", "wire_break", "generator"});
+  auto m = r_.map(v, {"axes", "electrode", "wire_break", "generator", "short_stop"});
   if (!m) {
     return;
   }
@@ -150,6 +195,9 @@ void Parser::parse_safety(const Value& v, MachineSpec& machine) {
         }
       }
     }
+  }
+  if (const Field* f = m->find("short_stop")) {
+    parse_short_stop(f->value, out);  // after the axes: it needs one with a retract direction
   }
 }
 

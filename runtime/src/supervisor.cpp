@@ -10,6 +10,10 @@ namespace {
 // Below this, two positions or speeds are the same (the encoder resolves 1 µm).
 constexpr double kEpsilon = 1e-9;
 
+// A per-cycle pulse counter above this is a broken signal (no generator fires 2^40 pulses in a
+// cycle), and the sum of a few stays far from int64 overflow.
+constexpr std::int64_t kMaxPulseCount = std::int64_t{1} << 40;
+
 /// The highest speed from which an axis decelerating at a_max after one more cycle at that
 /// speed stops within d: v·dt + v²/(2a) = d.
 double stop_speed(double d_mm, double a_mm_s2, double dt_s) noexcept {
@@ -35,6 +39,9 @@ Supervisor::Supervisor(Machine& machine, SupervisorSetup setup, Duration period)
       wire_broken_(setup.wire_broken),
       generator_(std::move(setup.generator)),
       manual_(setup.manual),
+      short_count_(setup.short_count),
+      pulse_counts_(std::move(setup.pulse_counts)),
+      short_limit_(setup.short_limit),
       period_(period),
       dt_s_(to_seconds(period)) {
   for (std::size_t k = 0; k < axes_.size(); ++k) {
@@ -69,6 +76,25 @@ void Supervisor::check_machine(TimePoint now) noexcept {
               make_alarm(AlarmCode::kWireBreak, AlarmSeverity::kFault, now, "safety.wire",
                          "wire break", 1.0));
   }
+}
+
+bool Supervisor::cycle_reads_short() const noexcept {
+  if (short_count_ == nullptr) {
+    return false;
+  }
+  const std::int64_t shorts = short_count_->get();
+  std::int64_t pulses = 0;
+  for (const Output<std::int64_t>* p : pulse_counts_) {
+    const std::int64_t n = p->get();
+    if (n < 0 || n > kMaxPulseCount) {
+      return true;  // a broken counter: the gap may be short, so nothing toward the work
+    }
+    pulses += n;
+  }
+  if (shorts < 0 || shorts > kMaxPulseCount) {
+    return true;
+  }
+  return pulses > 0 && static_cast<double>(shorts) >= short_limit_ * static_cast<double>(pulses);
 }
 
 bool Supervisor::referenced(const Axis& a) const noexcept {
@@ -222,6 +248,24 @@ void Supervisor::supervise(const CycleContext& ctx, TimePoint inputs_at) noexcep
   }
   for (std::size_t k = 0; k < axes_.size(); ++k) {
     command_[k] = limit_command(axes_[k], ctx.release);
+  }
+
+  // The same-cycle short stop: a cycle whose own pulses read short commands nothing toward
+  // the work (against an axis's retract direction), whatever the programs' windows say.
+  const bool short_now = cycle_reads_short();
+  if (short_now) {
+    short_cycles_.fetch_add(1, std::memory_order_relaxed);
+    bool cut = false;
+    for (std::size_t k = 0; k < axes_.size(); ++k) {
+      const double way = static_cast<double>(axes_[k].cfg.retract);
+      if (way != 0.0 && command_[k] * way < 0.0) {
+        command_[k] = 0.0;
+        cut = true;
+      }
+    }
+    if (cut) {
+      short_stopped_cycles_.fetch_add(1, std::memory_order_relaxed);
+    }
   }
 
   // The state now, after this cycle's alarms: a fault found above stops the axes in this cycle.

@@ -71,6 +71,16 @@ std::unique_ptr<Supervisor> build_supervisor(const SafetySpec& spec,
     setup.generator.push_back(static_cast<Input<bool>*>(
         typed_pin<bool>(resolve(n), PinDir::kInput, n, "generator", diag)));
   }
+  if (spec.short_stop) {
+    const ShortStopSpec& ss = *spec.short_stop;
+    setup.short_count = static_cast<const Output<std::int64_t>*>(typed_pin<std::int64_t>(
+        resolve(ss.shorts), PinDir::kOutput, ss.shorts, "short_stop.shorts", diag));
+    for (const NameRef& n : ss.pulses) {
+      setup.pulse_counts.push_back(static_cast<const Output<std::int64_t>*>(
+          typed_pin<std::int64_t>(resolve(n), PinDir::kOutput, n, "short_stop.pulses", diag)));
+    }
+    setup.short_limit = ss.limit;
+  }
   if (diag.diagnostics().size() != errors_before) {
     return nullptr;
   }

@@ -21,6 +21,10 @@ constexpr std::int64_t kMaxHazardIntervalNs = 1'000'000;
 
 double Plant::tip_z_mm() const noexcept { return axes_[2].position_mm() + wear_length_mm_; }
 
+void Plant::inject_short(edm::rt::Duration duration) noexcept {
+  injected_short_end_ns_ = state_.now.count() + duration.count();
+}
+
 void Plant::track_short_events() noexcept {
   const auto& p = params_;
   if (contact_ == Contact::kMet && !p.contact_persistent &&
@@ -40,6 +44,7 @@ Plant::ShortCause Plant::short_event(std::int64_t t_ns, std::uint64_t k, double 
   const double dt_s =
       static_cast<double>(std::min(t_ns - last_pulse_ns_, kMaxHazardIntervalNs)) * 1e-9;
   last_pulse_ns_ = t_ns;
+  if (t_ns < injected_short_end_ns_) return ShortCause::kContact;  // a test's short burst
 
   // The injected contact: met once, when the hole reaches its depth, at the tip's position then.
   if (contact_ == Contact::kArmed && depth_mm() >= p.contact_at_depth_mm) {

@@ -367,15 +367,27 @@ TEST(Allocations, NoneInsideCyclesOfTheWallFinishProgram) {
 
 TEST(Allocations, NoneInsideCyclesOfTheSafetySupervisorActing) {
   // sink-sim's supervisor refusing a forced feed at Z's soft limit (alarm 141, FAULT), then
-  // holding the safe state; the alarms' text and sources are static, nothing is formatted.
+  // holding the safe state; the alarms' text and sources are static, nothing is formatted. The
+  // generator is disarmed: sparking, the short at the work would stop the feed first (below).
   auto r = build_shipped("sink-sim");
   ASSERT_NE(r->supervisor(), nullptr);
   r->machine().command(rt::MachineCommand::kPowerOn);
+  ASSERT_TRUE(r->variables().force("io.gen_arm", 0.0));
   ASSERT_TRUE(r->variables().force("io.vz_cmd", -30.0));  // down to Z min = -60 in 2 s
   EXPECT_EQ(allocations_in_cycles(*r, 2500), 0u);
   EXPECT_EQ(r->machine().state(), rt::MachineState::kFault);
   EXPECT_EQ(r->machine().last_cause(), rt::AlarmCode::kSoftLimit);
   EXPECT_GT(r->supervisor()->refused_cycles(), 0u);
+}
+
+TEST(Allocations, NoneInsideCyclesOfTheShortStopActing) {
+  // sink-sim's supervisor cutting a forced feed into the work in every cycle whose pulses read
+  // short (machine.safety.short_stop, issue 31).
+  auto r = build_shipped("sink-sim");
+  r->machine().command(rt::MachineCommand::kPowerOn);
+  ASSERT_TRUE(r->variables().force("io.vz_cmd", -5.0));
+  EXPECT_EQ(allocations_in_cycles(*r, 2500), 0u);
+  EXPECT_GT(r->supervisor()->short_stopped_cycles(), 0u);
 }
 
 TEST(Allocations, TheCounterSeesAllocations) {

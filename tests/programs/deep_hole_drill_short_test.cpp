@@ -58,7 +58,7 @@ struct ContactRun {
     }
     rig.step();
     rig.ctx.release += 1ms;
-    const bool reads_short = rig.out<bool>("gap_short");
+    const bool reads_short = rig.out<bool>("short_now");  // the window or the cycle
     if (reads_short) {
       EXPECT_GE(rig.vz(), 0.0) << "fed toward the work while the gap reads short, cycle " << cycles;
       if (++run_length == short_cycles && first_short_cycle < 0) first_short_cycle = cycles;

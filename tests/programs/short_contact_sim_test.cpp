@@ -41,7 +41,7 @@ struct ContactOutcome {
   std::int64_t retracts{0};      // cycle.drill.short_retracts
   double lost_s{0.0};            // cycle.drill.short_time_s
   std::int64_t latency{-1};      // cycles from the detection to the retract (first contact)
-  std::int64_t short_cycles{0};  // cycles with gap_short
+  std::int64_t short_cycles{0};  // cycles reading short (short_now: the window or the cycle)
   std::int64_t violations{0};    // cycles fed toward the work while the gap read short
   double z_alarm{0.0}, z_end{0.0};
   bool gen_on_end{true};
@@ -63,11 +63,11 @@ ContactOutcome run(int seed, const std::string& sim_extra, double limit_s = 200.
   task.detach_trace();
   auto& vars = r->variables();
   const auto pin = [&](const char* n) { return vars.find(n)->pin; };
-  const rt::PinRef state = pin("cycle.drill.state"), gap_short = pin("cycle.drill.gap_short"),
+  const rt::PinRef state = pin("cycle.drill.state"), reads_short = pin("cycle.drill.short_now"),
                    active = pin("cycle.drill.retract.active"), vz = pin("cycle.drill.vz_cmd_mm_s"),
                    io_vz = pin("io.vz_cmd"), z = pin("io.z_mm");
   ContactOutcome o;
-  std::int64_t detected = -1;  // gap_short for retract.short_cycles consecutive cycles
+  std::int64_t detected = -1;  // short_now for retract.short_cycles consecutive cycles
   std::int64_t run_length = 0;
   const auto needed =
       static_cast<std::int64_t>(vars.read("cycle.drill.retract.short_cycles").value());
@@ -77,7 +77,7 @@ ContactOutcome run(int seed, const std::string& sim_extra, double limit_s = 200.
     clock.advance_to(release);
     const double z_before = rt::read_pin_as_double(z);
     task.run_cycle(release, clock);
-    if (rt::read_pin_as_double(gap_short) != 0.0) {
+    if (rt::read_pin_as_double(reads_short) != 0.0) {
       ++o.short_cycles;
       if (++run_length == needed && detected < 0) detected = k;
       if (rt::read_pin_as_double(vz) < 0.0 || rt::read_pin_as_double(io_vz) < 0.0) {

@@ -83,7 +83,8 @@ inline void replace_once(std::string& s, const std::string& from, const std::str
 // a virtual clock: `run_cycle(k)` runs cycle k (released at k ms), `cycle()` the next one. The
 // trace is drained every 4096 cycles so that it never fills.
 /// Seed 004's rule, asserted on every cycle it is shown (issue 19): while a drilling program's Td
-/// window reads short (`<program>.gap_short`), its Z command (`<program>.vz_cmd_mm_s`) and the
+/// window reads short (`<program>.gap_short`), or this cycle's own pulses do
+/// (`<program>.cycle_short`, issue 31), its Z command (`<program>.vz_cmd_mm_s`) and the
 /// machine's (`io.vz_cmd`) never point toward the work (down). Finds every such program of a
 /// built machine; a machine without one checks nothing.
 class ShortFeedWatch {
@@ -98,8 +99,10 @@ class ShortFeedWatch {
       }
       const std::string base = v.name.substr(0, v.name.size() - suffix.size());
       const rt::Variable* vz = vars.find(base + ".vz_cmd_mm_s");
+      const rt::Variable* cycle = vars.find(base + ".cycle_short");
       if (vz != nullptr && v.is_pin() && vz->is_pin()) {
-        watched_.push_back({base, v.pin, vz->pin, io != nullptr ? io->pin : vz->pin});
+        watched_.push_back({base, v.pin, cycle != nullptr ? cycle->pin : v.pin, vz->pin,
+                            io != nullptr ? io->pin : vz->pin});
       }
     }
   }
@@ -110,7 +113,10 @@ class ShortFeedWatch {
   }
   void check(std::int64_t cycle) {
     for (const Watched& w : watched_) {
-      if (rt::read_pin_as_double(w.gap_short) == 0.0) continue;
+      if (rt::read_pin_as_double(w.gap_short) == 0.0 &&
+          rt::read_pin_as_double(w.cycle_short) == 0.0) {
+        continue;
+      }
       if (rt::read_pin_as_double(w.vz) < 0.0 || rt::read_pin_as_double(w.io_vz) < 0.0) {
         if (violations_++ == 0) first_ = w.program + " at cycle " + std::to_string(cycle);
       }
@@ -121,7 +127,7 @@ class ShortFeedWatch {
  private:
   struct Watched {
     std::string program;
-    rt::PinRef gap_short, vz, io_vz;
+    rt::PinRef gap_short, cycle_short, vz, io_vz;
   };
   std::vector<Watched> watched_;
   std::int64_t violations_{0};

@@ -87,7 +87,7 @@ TEST(WallFinishShort, AShortStopsTheOrbitRetractsAlongTheContourThenTheOrbitGoes
   double rho_max = 0.0;
   for (std::int64_t k = 0; k < 150; ++k) {
     rig.step();
-    const bool reads_short = rig.out<bool>("gap_short");
+    const bool reads_short = rig.out<bool>("short_now");  // the window or the cycle
     if (reads_short) {
       if (rho0 < 0.0) rho0 = rig.out<double>("rho_mm");
       rho_max = std::max(rho_max, rig.out<double>("rho_mm"));

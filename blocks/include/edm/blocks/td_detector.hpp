@@ -8,6 +8,9 @@
 //                                                                   over the last `window` cycles
 //   open_ratio  = Σ n_open / Σ total,  short_ratio = Σ n_short / Σ total   (same window)
 //   valid       = Σ td_count + Σ n_short > 0   (an ignited or a shorted pulse in the window)
+//   cycle_short_ratio = n_short(k) / total(k)  this cycle alone (0 without pulses): a short
+//               shorter than the window reads here at once, while short_ratio climbs 1/window a
+//               cycle (DESIGN §11: a cycle whose own pulses are all shorted reads short)
 // Gap truth (seed 004): the gap feedback reads the full applied voltage on an open gap and about
 // zero on a contact. A short is therefore a pulse whose ignition delay is Ts = short_td_us (0 by
 // default: breakdown at once), pooled with the ignited pulses: a window of shorts reads Td ≈ 0,
@@ -101,6 +104,7 @@ class TdDetector final : public rt::BlockWithParams<TdDetectorParams> {
   rt::Output<double> open_ratio{pins_, "open_ratio", "1"};
   rt::Output<double> short_ratio{pins_, "short_ratio", "1"};
   rt::Output<bool> valid{pins_, "valid"};
+  rt::Output<double> cycle_short_ratio{pins_, "cycle_short_ratio", "1"};
 
  private:
   WindowRing<Counts> window_;  // allocated in configure(); its capacity is the window in use

@@ -66,7 +66,14 @@
 //   gap_short = td.short_ratio ≥ short_ratio_limit (0.9: a short-dominated td.window; the
 //   occasional debris shorts of a loaded gap stay below it and are the P law's to handle);
 //   while gap_short the Z command never points down (vz ≥ 0);
-//   retract (ShortRetract, after retract.short_cycles consecutive gap_short cycles, 5 here) backs
+//   cycle_short = td.cycle_short_ratio ≥ short_ratio_limit (this cycle's own pulses, issue 31):
+//   a short shorter than the window stops the feed in the cycle it shows (vz ≥ 0) without
+//   waiting for the window. short_now = gap_short || cycle_short: the gap reads short, so no
+//   feed toward the work; the retract child counts its consecutive cycles (with the feed stopped
+//   at the first shorted cycle the window may never fill at a persistent contact: counting the
+//   window alone let the drill sit at one without a retract or alarm 150). In APPROACH a cycle
+//   that reads short is a touch (the gap has closed), with vz = 0 in it.
+//   retract (ShortRetract, after retract.short_cycles consecutive short_now cycles, 5 here) backs
 //   Z off along the path already drilled (retract.retract_distance_mm at retract_speed_mm_s),
 //   walks forward again and hands back with a ramp (v_scale); zloop (PositionLoop) follows its
 //   setpoint; the generator stays on. short_retracts counts them, short_time_s is the time
@@ -200,6 +207,10 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this hole
   rt::Output<double> short_time_s{pins_, "short_time_s",
                                   "s"};  // time spent retracting and resuming in this hole
+  rt::Output<bool> cycle_short{
+      pins_, "cycle_short"};  // this cycle's own pulses read short: no feed toward the work
+  rt::Output<bool> short_now{
+      pins_, "short_now"};  // gap_short || cycle_short: no feed down; the retract counts it
 
  protected:
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
@@ -212,6 +223,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
  private:
   /// The feed override input, clamped to [0, 1.5]; not finite: 0 (stop feeding). RT-safe.
   [[nodiscard]] double feed_scale() const noexcept;
+  /// The window (gap_short) or this cycle's own pulses (cycle_short) read short. RT-safe.
+  [[nodiscard]] bool feed_stopped() const noexcept { return short_now.get(); }
   void set_state(State s) noexcept;
   void begin_cycle() noexcept;
   void begin_retract(double target_z) noexcept;

@@ -4,6 +4,21 @@
 //   ShortGuard   per cycle: reads the window, counts the retract child's retracts against the
 //                budget, raises alarm 150 when it is spent.
 //
+// Two readings (issue 31, DESIGN §11 "never a feed toward the work while the gap reads short"):
+//   reads_short        the Td window: short_ratio ≥ short_ratio_limit. It takes ~window cycles to
+//                      rise, and after retract.short_cycles of it the retract begins.
+//   cycle_reads_short  this cycle's own pulses: td.cycle_short_ratio ≥ short_ratio_limit. A short
+//                      shorter than the window (3-4 cycles of a fully shorted gap left the
+//                      window at 0.29-0.49 while the drill fed down at up to 1 mm/s) stops the
+//                      feed in that same cycle.
+// Either one (the programs' short_now) stops every feed toward the work, and the retract child
+// counts consecutive cycles of it: with the feed stopped at the first shorted cycle, the window
+// alone may never fill at a persistent contact (the drill then sat at it, neither retracting
+// nor raising alarm 150). The runtime's supervisor makes the
+// same per-cycle stop on the process image for every program (machine.safety.short_stop,
+// docs/safety.md); the programs make it too so that their own outputs, the wear estimate
+// integrated from their command and the orbit's radius agree with what the axes do.
+//
 // RetractBudget: how many short retracts a cycle may make before alarm 150. A retract that
 // follows progress (the retract child's tries back at 1: the hole or orbit advanced
 // retract.progress_mm since the last one) starts the count again; more than `max` retracts
@@ -74,6 +89,11 @@ class ShortGuard {
   [[nodiscard]] static bool reads_short(const blocks::TdDetector& td,
                                         const ShortLimits& p) noexcept {
     return td.valid.get() && td.short_ratio.get() >= p.short_ratio_limit;
+  }
+  /// This cycle's own pulses are shorted at the limit or beyond (td stepped this cycle). RT-safe.
+  [[nodiscard]] static bool cycle_reads_short(const blocks::TdDetector& td,
+                                              const ShortLimits& p) noexcept {
+    return td.cycle_short_ratio.get() >= p.short_ratio_limit;
   }
   /// After the retract child's step: did a retract begin, and is the budget spent? RT-safe.
   Event after_retract_step(rt::TimePoint now, const blocks::ShortRetract& r,

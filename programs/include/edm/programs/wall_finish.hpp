@@ -50,7 +50,11 @@
 // the commanded reference x_ref_mm/y_ref_mm) backs the electrode along the contour already
 // travelled and walks it forward again, the loops following its setpoint; then the orbit
 // continues from where it stopped. Too many retracts without progress: alarm 150 (fault); the
-// safe state stops the orbit.
+// safe state stops the orbit. cycle_short (td.cycle_short_ratio ≥ short_ratio_limit: this
+// cycle's own pulses, issue 31) makes the phase and the radius wait in that same cycle too, and
+// while either reads short (short_now = gap_short || cycle_short, which the retract child
+// counts) the X/Y command has no component toward the wall: its part along the electrode's
+// radius from the hole centre, outward, is removed.
 // Extra outputs (the signals the sequence gives its children): polarity_request,
 // generator_request, orbit_start, orbit_enable, rev_pulse, orbit_r0_mm, orbit_final_mm,
 // x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s, loop_enable.
@@ -143,6 +147,10 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<bool> retract_enable{
       pins_, "retract_enable"};  // the short retract records the contour (ORBIT only)
   rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this cycle
+  rt::Output<bool> cycle_short{
+      pins_, "cycle_short"};  // this cycle's own pulses read short: nothing toward the wall
+  rt::Output<bool> short_now{
+      pins_, "short_now"};  // gap_short || cycle_short: the orbit waits; the retract counts it
 
  protected:
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;

@@ -128,10 +128,21 @@ struct SafetyAxisSpec {
   SourceLoc loc;
 };
 
+/// `machine.safety.short_stop`: the same-cycle short stop (supervisor.hpp). A cycle whose own
+/// pulses are shorted at `limit` or beyond (n_short ≥ limit · Σ pulses, Σ pulses > 0) commands
+/// no supervised axis against its `retract` direction (toward the work).
+struct ShortStopSpec {
+  NameRef shorts;               // io.<LINT output>: the shorted pulses of this cycle
+  std::vector<NameRef> pulses;  // io.<LINT output>s whose sum is all pulses of this cycle
+  double limit{0.9};            // (0, 1]
+  SourceLoc loc;
+};
+
 /// `machine.safety`: the runtime's safety supervisor. Absent (present == false): none.
 struct SafetySpec {
   bool present{false};
   std::vector<SafetyAxisSpec> axes;
+  std::optional<ShortStopSpec> short_stop;
   std::optional<NameRef> electrode_length;  // io.<LREAL output>, mm of electrode left
   double electrode_margin_mm{0.0};          // alarm 160 at or below this length
   std::optional<NameRef> wire_break;        // io.<BOOL output>, true = broken

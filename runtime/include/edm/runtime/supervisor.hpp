@@ -12,6 +12,15 @@
 //               v that cannot stop inside the range → cut to the speed that stops at the limit
 //                 (v·dt + v²/(2·a_max) <= distance left; 0 at or beyond it), alarm 141, fault
 //               a non-finite v                     → 0 (no alarm: a broken wire is a block's)
+//   short stop  this cycle's own pulses shorted at the limit or beyond:
+//                 n_short ≥ limit · Σ pulses, Σ pulses > 0 (the counters the I/O driver latched
+//                 for this cycle: the generator's FPGA, the simulator's io.n_*; a negative count
+//                 is a broken signal and reads short too)
+//                                                  → every axis with a `retract` direction is
+//                 commanded nothing against it (toward the work): 0 or its retract, in this very
+//                 cycle, whatever a program's window says or a force asks (DESIGN §11: never a
+//                 feed toward the work while the gap reads short). No alarm: a short is the
+//                 process's, the programs retract from it; counted (short_stopped_cycles()).
 //   safe state  FAULT: every axis 0 except its `retract` direction (Z backs off), within the
 //               limits above; ESTOP: every axis 0; the `generator` pins false — read from the
 //               machine's state now, so a fault raised earlier in this very cycle already acts,
@@ -76,6 +85,10 @@ struct SupervisorSetup {
   const Output<bool>* wire_broken{nullptr};
   std::vector<Input<bool>*> generator;
   const ManualControl* manual{nullptr};  // referenced axes and position epoch; null: all referenced
+  // The same-cycle short stop (machine.safety.short_stop); short_count null: none.
+  const Output<std::int64_t>* short_count{nullptr};
+  std::vector<const Output<std::int64_t>*> pulse_counts;  // their sum: all pulses of the cycle
+  double short_limit{0.9};                                // (0, 1]
 };
 
 class Supervisor {
@@ -100,6 +113,14 @@ class Supervisor {
     return k < axes_.size() ? axes_[k].ferror_now_mm.load(std::memory_order_relaxed) : 0.0;
   }
   [[nodiscard]] std::size_t axis_count() const noexcept { return axes_.size(); }
+  /// Cycles that read short (the short stop's condition held). Any thread.
+  [[nodiscard]] std::uint64_t short_cycles() const noexcept {
+    return short_cycles_.load(std::memory_order_relaxed);
+  }
+  /// Cycles in which the short stop cut a command toward the work. Any thread.
+  [[nodiscard]] std::uint64_t short_stopped_cycles() const noexcept {
+    return short_stopped_cycles_.load(std::memory_order_relaxed);
+  }
 
  private:
   struct Axis {
@@ -120,6 +141,8 @@ class Supervisor {
   [[nodiscard]] bool is_outside(const Axis& a, double x) const noexcept;
   [[nodiscard]] bool referenced(const Axis& a) const noexcept;
   void check_machine(TimePoint now) noexcept;
+  /// This cycle's own pulses are shorted at the limit or beyond (short_stop configured).
+  [[nodiscard]] bool cycle_reads_short() const noexcept;
   void check_axis(Axis& a, TimePoint now, bool track) noexcept;
   /// The command after the speed and range limits; raises/clears 141.
   double limit_command(Axis& a, TimePoint now) noexcept;
@@ -144,6 +167,9 @@ class Supervisor {
   const Output<bool>* wire_broken_;
   std::vector<Input<bool>*> generator_;
   const ManualControl* manual_;
+  const Output<std::int64_t>* short_count_;
+  std::vector<const Output<std::int64_t>*> pulse_counts_;
+  double short_limit_;
   std::uint64_t epoch_seen_{0};
   Duration period_;
   double dt_s_;
@@ -152,6 +178,8 @@ class Supervisor {
   bool electrode_raised_{false};
   bool wire_raised_{false};
   std::atomic<std::uint64_t> refused_cycles_{0};
+  std::atomic<std::uint64_t> short_cycles_{0};
+  std::atomic<std::uint64_t> short_stopped_cycles_{0};
 };
 
 }  // namespace edm::rt

@@ -118,6 +118,9 @@ class Plant {
   void release_gap() noexcept;
   void set_depth_mm(double h) noexcept;
   void set_debris(double c) noexcept;
+  /// Every pulse that begins within `duration` from the plant's time now is a short (a hard
+  /// contact for that long, whatever the gap): the safety tests' short bursts. RT-safe.
+  void inject_short(edm::rt::Duration duration) noexcept;
   /// The electrode now measures `mm` (a retained length restored at start, an electrode
   /// change): the wear becomes electrode_length_mm − mm, so the tip sits that much above where a
   /// new electrode's would. RT-safe.
@@ -237,7 +240,8 @@ class Plant {
   double working_gap_um_{0.0};  // beyond it a clean gap never ignites: nothing forms there
   enum class Contact : std::uint8_t { kArmed, kMet, kCleared, kOff };
   Contact contact_{Contact::kOff};
-  double contact_tip_mm_{0.0};  // tip z where the injected contact was met
+  double contact_tip_mm_{0.0};             // tip z where the injected contact was met
+  std::int64_t injected_short_end_ns_{0};  // inject_short(): pulses before this are shorts
 
   // The work on the machine (plant_work.cpp). Axis positions are machine X, Y and the plant's z
   // (surface at 0); machine Z = z + work_surface_z_mm. An encoder reads position − bias.
