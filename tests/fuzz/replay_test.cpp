@@ -74,8 +74,8 @@ TEST(FuzzReplay, page_seeds_and_regressions_run_clean) {
 }
 
 TEST(FuzzReplay, empty_input_runs_clean_everywhere) {
-  for (Entry entry : {gcode_one_input, config_one_input, retain_one_input, protocol_one_input,
-                      page_one_input}) {
+  for (Entry entry :
+       {gcode_one_input, config_one_input, retain_one_input, protocol_one_input, page_one_input}) {
     EXPECT_EQ(entry(nullptr, 0), 0);
   }
 }

@@ -32,9 +32,9 @@ programs:
 )";
 
 /// The register map of the tests: holding 0-1 p.g.k (float32, rw), 2 p.g.out (int16, r),
-/// 3 p.lp.tau (ms, rw), 4-5 p.g.k again (rw), 100-224 p.g.out (r: 125 registers for the longest reply), 65534-65535
-/// p.g.k (float32, rw); input 0-1 io.ai0 (int32); coil 0 io.do0 (r), 1 p.dsc.arcs_as_short (rw);
-/// discrete input 0 io.di0.
+/// 3 p.lp.tau (ms, rw), 4-5 p.g.k again (rw), 100-224 p.g.out (r: 125 registers for the longest
+/// reply), 65534-65535 p.g.k (float32, rw); input 0-1 io.ai0 (int32); coil 0 io.do0 (r), 1
+/// p.dsc.arcs_as_short (rw); discrete input 0 io.di0.
 inline std::string server_map() {
   std::string m = R"(  map:
     - {table: holding_register, address: 0, var: p.g.k, type: float32, writable: true}

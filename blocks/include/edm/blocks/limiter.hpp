@@ -30,7 +30,8 @@ struct LimiterParams {
   double rate{0.0};    // [signal unit / s], ≥ 0; 0 = no slew-rate limit
 
   void visit(rt::ParamVisitor& v) {
-    // Ranges (issue 31): a signal within ±1e12 (param_ranges.hpp: the ±1e9 defaults are "no limit").
+    // Ranges (issue 31): a signal within ±1e12 (param_ranges.hpp: the ±1e9 defaults are "no
+    // limit").
     v.param(
         "min", min,
         {.unit = "", .description = "lower limit, in the signal's unit", .range = ranges::kSignal});

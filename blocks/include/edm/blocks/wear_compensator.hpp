@@ -52,8 +52,8 @@ struct WearCompensatorParams {
 
   void visit(rt::ParamVisitor& v) {
     // Ranges (issue 31): areas up to 1 m² (a large die-sinking electrode is ~0.25 m²; the drill
-    // tube ~0.7 mm²); wear ratios up to 10, the bound of a condition's wear_ratio (machining; PM §2:
-    // drills at ~100 V wear >300 %).
+    // tube ~0.7 mm²); wear ratios up to 10, the bound of a condition's wear_ratio (machining; PM
+    // §2: drills at ~100 V wear >300 %).
     v.param("hole_area_mm2", hole_area_mm2,
             {.unit = "mm^2",
              .description = "cross-section of the hole A_hole",

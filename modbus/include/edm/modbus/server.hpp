@@ -85,7 +85,7 @@ class Server {
 
   rt::VariableRegistry& vars_;
   ServerConfig config_;
-  MapRegisters regs_;  // over config_.map
+  MapRegisters regs_;               // over config_.map
   rt::LogRateLimiter limiter_;      // per peer address: log_burst, log_per_s
   rt::LogRateLimiter all_limiter_;  // every address together: ten times that
   int listen_fd_{-1};
