@@ -91,11 +91,15 @@ else
   fail "installed edmhmi check: $out"
 fi
 # serve refuses a missing page before it contacts edmplc: the page must be found, and
-# $EDM_DATA_DIR must win over the install prefix.
-out=$(env -u EDM_DATA_DIR "$R/usr/bin/edmhmi" --port 1 serve --listen 127.0.0.1:0 2>&1 || true)
-if grep -q "index.html missing" <<<"$out"; then fail "installed edmhmi serve: $out"; else
-  ok "installed edmhmi serve finds the page in the install prefix"; fi
-out=$(EDM_DATA_DIR=$tmp/none "$R/usr/bin/edmhmi" --port 1 serve --listen 127.0.0.1:0 2>&1 || true)
+# $EDM_DATA_DIR must win over the install prefix. With the page found, serve listens and waits for
+# edmplc (none at port 1) until it is stopped: timeout ends it.
+out=$(env -u EDM_DATA_DIR timeout 5 "$R/usr/bin/edmhmi" --port 1 serve --listen 127.0.0.1:0 2>&1 || true)
+if grep -q "index.html missing" <<<"$out" || ! grep -q "listening on" <<<"$out"; then
+  fail "installed edmhmi serve: $out"
+else
+  ok "installed edmhmi serve finds the page in the install prefix"
+fi
+out=$(EDM_DATA_DIR=$tmp/none timeout 5 "$R/usr/bin/edmhmi" --port 1 serve --listen 127.0.0.1:0 2>&1 || true)
 if grep -qF "$tmp/none/web/index.html missing" <<<"$out"; then
   ok "\$EDM_DATA_DIR overrides the install prefix"
 else
