@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "edm/apps/cli.hpp"
+#include "edm/apps/free_port.hpp"
 #include "edm/sparkplug/edge_node.hpp"
 #include "edm/sparkplug/sparkplug.hpp"
 
@@ -35,13 +36,6 @@ std::uint64_t now_us() {
   return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::microseconds>(
                                         std::chrono::system_clock::now().time_since_epoch())
                                         .count());
-}
-
-int free_port() {
-  for (int p = 20000 + static_cast<int>(getpid() % 20000);; ++p) {
-    const std::string cmd = "ss -Hltn 'sport = :" + std::to_string(p) + "' | grep -q .";
-    if (std::system(cmd.c_str()) != 0) return p;
-  }
 }
 
 /// CPU seconds (user + system) of a process, from /proc/PID/stat.
@@ -127,7 +121,7 @@ int main(int argc, char** argv) {
   const auto dir =
       std::filesystem::temp_directory_path() / ("edm-bench-fleet-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  const int port = free_port();
+  const int port = edm::apps::free_port();
   {
     std::ofstream conf(dir / "mosquitto.conf");
     conf << "listener " << port << " 127.0.0.1\nallow_anonymous true\npersistence false\n"

@@ -33,6 +33,7 @@
 
 #include "bench_util.hpp"
 #include "edm/apps/cli.hpp"
+#include "edm/apps/free_port.hpp"
 #include "jitter_load.hpp"
 #include "jitter_parse.hpp"
 
@@ -114,24 +115,6 @@ void print_run(const RunRecord& r) {
       r.condition, r.round, r.tool, r.stats.cycles, r.stats.p50_us, r.stats.p99_us, r.stats.max_us,
       extra.empty() ? "" : "  ", extra);
   std::fflush(stdout);
-}
-
-/// A free TCP port on loopback (bound and released; nothing else on this machine races for it).
-int free_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  int port = 7791;
-  if (fd >= 0 && bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
-    port = ntohs(a.sin_port);
-  }
-  if (fd >= 0) {
-    close(fd);
-  }
-  return port;
 }
 
 std::string bridge_note(const Options& opt, std::uint64_t replies) {
@@ -507,7 +490,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> rt_lines;
   int rc = 0;
   for (const std::string& condition : opt.conditions) {
-    Setup s{variant, condition, config, *cyclictest, condition == "bridge" ? free_port() : 0};
+    Setup s{variant, condition, config, *cyclictest,
+            condition == "bridge" ? edm::apps::free_port() : 0};
     std::optional<StressLoad> stress;
     fmt::print("\n{}: ", condition);
     if (condition == "idle") {

@@ -27,9 +27,11 @@
 
 #include "bench_util.hpp"
 #include "edm/apps/cli.hpp"
+#include "edm/apps/free_port.hpp"
 #include "soak_hostile.hpp"
 #include "soak_job.hpp"
 #include "soak_plc.hpp"
+#include "soak_report.hpp"
 
 namespace {
 
@@ -37,6 +39,10 @@ namespace fs = std::filesystem;
 namespace soak = edm::bench::soak;
 using edm::bench::read_file;
 using edm::bench::run_child;
+using soak::JobRecord;
+using soak::MemFigures;
+using soak::Phase;
+using soak::TaskStats;
 using Json = nlohmann::json;
 using namespace std::chrono_literals;
 
@@ -55,45 +61,6 @@ struct Options {
   std::set<std::string, std::less<>> skip;  // hostile action kinds left out (--skip a,b)
   bool memory{false};                       // --memory: the job loop alone, a memory report
 };
-
-struct JobRecord {
-  int index{0};
-  double start_s{0}, wall_s{0};
-  int busy_retries{0};
-  std::string error;  // edmhmi did not exit 0 / no report
-  soak::JobFigures fig;
-};
-
-struct TaskStats {
-  std::string name;
-  std::uint64_t cycles{0}, overruns{0};
-  double p99_us{0}, max_us{0};
-};
-
-struct Phase {
-  std::string name;
-  std::vector<JobRecord> jobs;
-  std::vector<soak::ProcSample> samples;
-  std::optional<std::size_t> ref;   // the first sample after the first job
-  soak::ProcSample start_q, end_q;  // quiesced: nobody connected
-  std::string crash;                // how edmplc ended if it was not our SIGINT
-  double crash_t_s{-1};
-  bool answered_at_end{false}, clean_stop{false}, rss_killed{false};
-  std::vector<TaskStats> tasks;
-  double seconds{0};
-};
-
-std::uint16_t free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  ::close(fd);
-  return ntohs(a.sin_port);
-}
 
 /// Pins (trace.start candidates) and all names (var.read), from var.list over a raw socket.
 void list_vars(std::uint16_t port, std::vector<std::string>& pins, std::vector<std::string>& all) {
@@ -204,7 +171,7 @@ class Runner {
     std::error_code ec;
     fs::remove_all(dir, ec);  // no job files of an earlier, longer run left behind
     fs::create_directories(dir);
-    const std::uint16_t port = free_port();
+    const auto port = static_cast<std::uint16_t>(edm::apps::free_port());
     soak::PlcProcess plc;
     const auto t0 = soak::Clock::now();
     auto since = [t0] { return std::chrono::duration<double>(soak::Clock::now() - t0).count(); };
@@ -394,87 +361,6 @@ class Runner {
   fs::path config_;
   std::string edmplc_, edmhmi_, demo_, stamp_;
 };
-
-struct MemFigures {
-  long rss_start_kb{0}, rss_ref_kb{0}, rss_end_kb{0}, rss_max_kb{0};
-  int fd_start{0}, fd_ref{0}, fd_end{0}, fd_max{0};
-};
-
-MemFigures mem_figures(const Phase& ph) {
-  MemFigures m;
-  m.rss_start_kb = ph.start_q.rss_kb;
-  m.fd_start = ph.start_q.fds;
-  m.rss_end_kb = ph.end_q.rss_kb;
-  m.fd_end = ph.end_q.fds;
-  for (const auto& s : ph.samples) {
-    m.rss_max_kb = std::max(m.rss_max_kb, s.rss_kb);
-    m.fd_max = std::max(m.fd_max, s.fds);
-  }
-  if (ph.ref && *ph.ref < ph.samples.size()) {
-    m.rss_ref_kb = ph.samples[*ph.ref].rss_kb;
-    m.fd_ref = ph.samples[*ph.ref].fds;
-  }
-  return m;
-}
-
-std::size_t jobs_at_depth(const Phase& ph) {
-  return static_cast<std::size_t>(std::count_if(
-      ph.jobs.begin(), ph.jobs.end(), [](const JobRecord& j) { return j.fig.at_depth(); }));
-}
-
-std::string mib(long kb) { return fmt::format("{:.1f}", static_cast<double>(kb) / 1024.0); }
-
-void write_samples(const fs::path& path, const Phase& ph) {
-  std::ofstream csv(path);
-  csv << "t_s,rss_kb,fds\n";
-  for (const auto& s : ph.samples) {
-    csv << fmt::format("{:.1f},{},{}\n", s.t_s, s.rss_kb, s.fds);
-  }
-}
-
-constexpr long kMemoryFlatKb = 1024;  // --memory: "flat" = end ≤ after job 1 + 1 MiB
-
-/// --memory: the resident size over a run of the job loop alone. Exit 0 flat, 1 not (or failed).
-int memory_report(const Phase& ph, const fs::path& out) {
-  write_samples(out / "memory-samples.csv", ph);
-  const MemFigures m = mem_figures(ph);
-  const bool ran = ph.crash.empty() && ph.clean_stop && m.rss_ref_kb > 0;
-  // Least-squares slope of VmRSS over the samples from the end of job 1 on, KiB per minute.
-  double n = 0, st = 0, sr = 0, stt = 0, str = 0;
-  for (std::size_t i = ph.ref.value_or(ph.samples.size()); i < ph.samples.size(); ++i) {
-    const double t = ph.samples[i].t_s / 60.0;
-    const auto r = static_cast<double>(ph.samples[i].rss_kb);
-    n += 1;
-    st += t;
-    sr += r;
-    stt += t * t;
-    str += t * r;
-  }
-  const double den = n * stt - st * st;
-  const double slope = n > 1 && den > 0 ? (n * str - st * sr) / den : 0.0;
-  fmt::print("\nmemory (VmRSS of edmplc, drill-sim; the job loop alone, {:.0f} s, {} jobs)\n",
-             ph.seconds, ph.jobs.size());
-  fmt::print("  loaded, idle (bridge up, before job 1)   {:>8} MiB\n", mib(m.rss_start_kb));
-  fmt::print("  after job 1                              {:>8} MiB\n", mib(m.rss_ref_kb));
-  double next_min = 1;
-  for (const auto& smp : ph.samples) {
-    if (smp.t_s >= next_min * 60.0) {
-      fmt::print("  at {:>4.0f} s                                {:>8} MiB\n", smp.t_s,
-                 mib(smp.rss_kb));
-      next_min += 1;
-    }
-  }
-  fmt::print("  end (quiesced)                           {:>8} MiB\n", mib(m.rss_end_kb));
-  fmt::print("  max                                      {:>8} MiB\n", mib(m.rss_max_kb));
-  fmt::print("  slope after job 1                        {:>8.1f} KiB/min\n", slope);
-  const bool flat = ran && m.rss_end_kb <= m.rss_ref_kb + kMemoryFlatKb;
-  fmt::print("  {} flat: end {} MiB <= after job 1 {} MiB + 1 MiB{}\n", flat ? "PASS" : "FAIL",
-             mib(m.rss_end_kb), mib(m.rss_ref_kb),
-             ran ? "" : " (edmplc did not run to the end cleanly: " + ph.crash + ")");
-  fmt::print("  written: {}/memory-samples.csv (t_s, rss_kb, fds), memory/edmplc.log\n",
-             out.string());
-  return flat ? 0 : 1;
-}
 
 }  // namespace
 

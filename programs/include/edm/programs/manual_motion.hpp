@@ -166,6 +166,8 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   [[nodiscard]] bool switch_on(int axis) const noexcept;
   [[nodiscard]] bool is_referenced(int axis) const noexcept;
   [[nodiscard]] bool limits(int axis, double& lo, double& hi) const noexcept;
+  /// One cycle of the running operation's steps (manual_motion_steps.cpp).
+  void advance(const rt::CycleContext& ctx) noexcept;
   void next_home_axis(const rt::CycleContext& ctx) noexcept;
   void next_touch(const rt::CycleContext& ctx) noexcept;  // the next side (center) or the end
   void begin_touch_side() noexcept;
