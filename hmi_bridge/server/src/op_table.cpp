@@ -20,7 +20,8 @@ constexpr StateMask kAll = (1U << kOpStateCount) - 1;
 constexpr StateMask kNotDuringAJob = kAll & ~(S::kRunning | S::kHold);
 constexpr StateMask kNotInASafeState = kAll & ~(S::kFault | S::kEstop);
 
-constexpr OpKind every(StateMask m) noexcept { return OpKind{"", m}; }
+/// One kind of an op, allowed in `m`.
+constexpr OpKind states(StateMask m) noexcept { return OpKind{"", m}; }
 
 constexpr auto kBefore = OpAccess::kBeforeHello;
 constexpr auto kView = OpAccess::kViewer;
@@ -30,43 +31,43 @@ constexpr auto kOper = OpAccess::kOperator;
 // continuous jog is refreshed, or changes speed or axis, by another jog with a velocity); a job
 // starts only from there too. A stop or an E-stop is never refused.
 constexpr OpSpec kOps[] = {
-    {"hello", kBefore, every(kAll), ops::op_hello},
-    {"ping", kView, every(kAll), ops::op_ping},
-    {"status", kView, every(kAll), ops::op_status},
-    {"subscribe", kView, every(kAll), ops::op_subscribe},
-    {"unsubscribe", kView, every(kAll), ops::op_unsubscribe},
-    {"program.begin", kOper, every(kAll), ops::op_program_begin},
-    {"program.chunk", kOper, every(kAll), ops::op_program_chunk},
-    {"program.commit", kOper, every(kNotDuringAJob), ops::op_program_commit},
-    {"program.abort", kOper, every(kAll), ops::op_program_abort},
-    {"cycle.start", kOper, every(mask_of(S::kIdle)), ops::op_cycle_start},
-    {"cycle.hold", kOper, every(mask_of(S::kRunning)), ops::op_cycle_hold},
-    {"cycle.resume", kOper, every(mask_of(S::kHold)), ops::op_cycle_resume},
-    {"cycle.stop", kOper, every(S::kRunning | S::kHold), ops::op_cycle_stop},
-    {"estop", kOper, every(kAll), ops::op_estop},
-    {"reset", kOper, every(S::kFault | S::kEstop), ops::op_reset},
-    {"var.list", kView, every(kAll), ops::op_var_list},
-    {"var.read", kView, every(kAll), ops::op_var_read},
-    {"var.write", kOper, every(kAll), ops::op_var_write},
-    {"var.force", kOper, every(kNotInASafeState), ops::op_var_force},
-    {"var.unforce", kOper, every(kAll), ops::op_var_unforce},
-    {"tasks.stats", kView, every(kAll), ops::op_tasks_stats},
-    {"trace.start", kView, every(kAll), ops::op_trace_start},
-    {"trace.stop", kView, every(kAll), ops::op_trace_stop},
-    {"machine.info", kView, every(kAll), ops::op_machine_info},
-    {"feed.override", kOper, every(kAll), ops::op_feed_override},
-    {"home", kOper, every(mask_of(S::kIdle)), ops::op_home},
+    {"hello", kBefore, states(kAll), ops::op_hello},
+    {"ping", kView, states(kAll), ops::op_ping},
+    {"status", kView, states(kAll), ops::op_status},
+    {"subscribe", kView, states(kAll), ops::op_subscribe},
+    {"unsubscribe", kView, states(kAll), ops::op_unsubscribe},
+    {"program.begin", kOper, states(kAll), ops::op_program_begin},
+    {"program.chunk", kOper, states(kAll), ops::op_program_chunk},
+    {"program.commit", kOper, states(kNotDuringAJob), ops::op_program_commit},
+    {"program.abort", kOper, states(kAll), ops::op_program_abort},
+    {"cycle.start", kOper, states(mask_of(S::kIdle)), ops::op_cycle_start},
+    {"cycle.hold", kOper, states(mask_of(S::kRunning)), ops::op_cycle_hold},
+    {"cycle.resume", kOper, states(mask_of(S::kHold)), ops::op_cycle_resume},
+    {"cycle.stop", kOper, states(S::kRunning | S::kHold), ops::op_cycle_stop},
+    {"estop", kOper, states(kAll), ops::op_estop},
+    {"reset", kOper, states(S::kFault | S::kEstop), ops::op_reset},
+    {"var.list", kView, states(kAll), ops::op_var_list},
+    {"var.read", kView, states(kAll), ops::op_var_read},
+    {"var.write", kOper, states(kAll), ops::op_var_write},
+    {"var.force", kOper, states(kNotInASafeState), ops::op_var_force},
+    {"var.unforce", kOper, states(kAll), ops::op_var_unforce},
+    {"tasks.stats", kView, states(kAll), ops::op_tasks_stats},
+    {"trace.start", kView, states(kAll), ops::op_trace_start},
+    {"trace.stop", kView, states(kAll), ops::op_trace_stop},
+    {"machine.info", kView, states(kAll), ops::op_machine_info},
+    {"feed.override", kOper, states(kAll), ops::op_feed_override},
+    {"home", kOper, states(mask_of(S::kIdle)), ops::op_home},
     {"jog",
      kOper,
      {"distance", mask_of(S::kIdle)},
      ops::op_jog,
      "velocity",
      {"velocity", S::kIdle | S::kJogging}},
-    {"jog.stop", kOper, every(kAll), ops::op_jog_stop},
-    {"touch", kOper, every(mask_of(S::kIdle)), ops::op_touch},
-    {"manual.status", kView, every(kAll), ops::op_manual_status},
-    {"offset.get", kView, every(kAll), ops::op_offset_get},
-    {"offset.set", kOper, every(kNotDuringAJob), ops::op_offset_set},
+    {"jog.stop", kOper, states(kAll), ops::op_jog_stop},
+    {"touch", kOper, states(mask_of(S::kIdle)), ops::op_touch},
+    {"manual.status", kView, states(kAll), ops::op_manual_status},
+    {"offset.get", kView, states(kAll), ops::op_offset_get},
+    {"offset.set", kOper, states(kNotDuringAJob), ops::op_offset_set},
 };
 
 // A row without a handler, or a name twice, does not compile.
