@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "bridge_fixture.hpp"
+#include "edm/bridge/op_table.hpp"
 #include "edm/runtime/log_escape.hpp"
 
 namespace edm::bridge::test {
@@ -110,8 +111,8 @@ TEST_F(AuditEscape, every_string_field_of_every_audited_op_stays_inside_its_line
     params[key] = hostile;
   }
   int sent = 0;
-  for (const OpInfo& info : all_ops()) {
-    if (!info.operator_only) continue;
+  for (const OpSpec& info : op_table()) {
+    if (info.access != OpAccess::kOperator) continue;
     for (Client* c : {&op, &viewer}) {
       const Reply r = c->request(info.name, params);
       EXPECT_TRUE(r.ok || r.code.has_value()) << info.name << ": a transport error";

@@ -148,13 +148,6 @@ TEST(Codec, error_codes_have_stable_unique_names) {
   EXPECT_FALSE(error_code_from_string("nope", out));
 }
 
-TEST(Codec, op_table_knows_roles) {
-  ASSERT_NE(find_op("cycle.start"), nullptr);
-  EXPECT_TRUE(find_op("cycle.start")->operator_only);
-  EXPECT_FALSE(find_op("status")->operator_only);
-  EXPECT_EQ(find_op("format.disk"), nullptr);
-}
-
 TEST(Codec, parse_request_classifies_bad_lines) {
   ErrorCode code{};
   std::string msg;

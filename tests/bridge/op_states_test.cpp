@@ -1,18 +1,17 @@
-// The op-state table (issue 31, item 6): every op of the protocol against every state the
-// machine can be in, through the real server. A request outside its states is refused
-// invalid_state and changes nothing; inside them it is never refused for its state.
+// The op table's states (issue 31, item 6; issue 32, item 4): every op of the protocol against
+// every state the machine can be in, through the real server. A request outside its states is
+// refused invalid_state and changes nothing; inside them it is never refused for its state.
 //
 // The drill machine is built but its tasks do not run: the test stands in for the RT side (it
 // drives the machine's state and takes the manual requests itself), so every state is exact —
 // also "a jog sent and not taken yet", the state in which the tester's `home` and `touch`
 // answered ok.
-#include "edm/bridge/op_states.hpp"
-
 #include <gtest/gtest.h>
 
 #include <set>
 
 #include "bridge_fixture.hpp"
+#include "edm/bridge/op_table.hpp"
 #include "programs/sim_machine.hpp"
 
 namespace edm::bridge::test {
@@ -115,10 +114,10 @@ class OpStates : public ::testing::Test {
     return queued;
   }
 
-  /// A request of `rule` with valid parameters (it succeeds where the state allows it and
-  /// nothing else stands in the way), after whatever it needs first.
-  Json request_for(const OpStateRule& rule) {
-    const std::string op(rule.op);
+  /// A request of `spec` of this kind with valid parameters (it succeeds where the state allows
+  /// it and nothing else stands in the way), after whatever it needs first.
+  Json request_for(const OpSpec& spec, const OpKind& kind) {
+    const std::string op(spec.name);
     const MotionBlock end = [] {
       MotionBlock b;
       b.kind = MotionKind::kEnd;
@@ -149,8 +148,8 @@ class OpStates : public ::testing::Test {
     if (op == "feed.override") return {{"percent", 100}};
     if (op == "home") return {{"axes", "Z"}};
     if (op == "jog") {
-      return rule.variant == "velocity" ? Json{{"axis", "X"}, {"velocity", 1.0}}
-                                        : Json{{"axis", "X"}, {"distance", 0.5}};
+      return kind.name == "velocity" ? Json{{"axis", "X"}, {"velocity", 1.0}}
+                                     : Json{{"axis", "X"}, {"distance", 0.5}};
     }
     if (op == "touch") return {{"target", "z"}};
     if (op == "offset.set") return {{"frame", "G54"}, {"x", 1.0}};
@@ -169,67 +168,81 @@ constexpr OpState kAllStates[] = {OpState::kOff,    OpState::kIdle,    OpState::
                                   OpState::kFault,  OpState::kEstop};
 static_assert(std::size(kAllStates) == static_cast<std::size_t>(kOpStateCount));
 
-TEST(OpStateTable, every_op_has_a_row_and_stops_are_never_refused) {
-  std::set<std::string_view> with_rule;
-  for (const OpStateRule& r : op_state_rules()) with_rule.insert(r.op);
-  for (const OpInfo& op : all_ops()) {
-    EXPECT_TRUE(with_rule.count(op.name)) << op.name << " has no row in the op-state table";
-    EXPECT_NE(op_state_rule(op.name, Json::object()), nullptr) << op.name;
-  }
-  EXPECT_EQ(with_rule.size(), all_ops().size()) << "a row for an op the protocol does not have";
-  for (const char* op : {"estop", "jog.stop", "cycle.stop"}) {
-    const OpStateRule* r = op_state_rule(op, Json::object());
-    ASSERT_NE(r, nullptr);
+/// Every kind of an op: its own, and jog's second ("velocity").
+std::vector<const OpKind*> kinds_of(const OpSpec& op) {
+  std::vector<const OpKind*> k{&op.kind};
+  if (!op.kind_field.empty()) k.push_back(&op.field_kind);
+  return k;
+}
+
+TEST(OpStateTable, stops_are_never_refused) {
+  for (const char* name : {"estop", "jog.stop", "cycle.stop"}) {
+    const OpSpec* op = find_op(name);
+    ASSERT_NE(op, nullptr) << name;
     for (OpState s : {OpState::kJogging, OpState::kManual, OpState::kRunning, OpState::kHold}) {
-      if (std::string_view(op) != "cycle.stop" || s == OpState::kRunning || s == OpState::kHold) {
-        EXPECT_TRUE(allowed_in(*r, s)) << op << " in " << to_string(s);
+      if (std::string_view(name) != "cycle.stop" || s == OpState::kRunning || s == OpState::kHold) {
+        EXPECT_TRUE(allowed_in(op_kind(*op, Json::object()), s)) << name << " in " << to_string(s);
       }
     }
   }
 }
 
+TEST(OpStateTable, a_jog_is_judged_by_its_kind) {
+  const OpSpec* jog = find_op("jog");
+  ASSERT_NE(jog, nullptr);
+  EXPECT_EQ(op_kind(*jog, {{"axis", "X"}, {"velocity", 1.0}}).name, "velocity");
+  EXPECT_EQ(op_kind(*jog, {{"axis", "X"}, {"distance", 1.0}}).name, "distance");
+  EXPECT_EQ(op_kind(*jog, Json::object()).name, "distance") << "neither: judged as a distance";
+  EXPECT_TRUE(allowed_in(op_kind(*jog, {{"velocity", 1.0}}), OpState::kJogging));
+  EXPECT_FALSE(allowed_in(op_kind(*jog, {{"distance", 1.0}}), OpState::kJogging));
+}
+
 TEST_F(OpStates, every_op_in_every_state_is_run_or_refused_as_the_table_says) {
   int refused = 0;
   int run = 0;
-  for (const OpStateRule& rule : op_state_rules()) {
-    for (const OpState state : kAllStates) {
-      const std::string what = std::string(rule.op) + (rule.variant.empty() ? "" : " ") +
-                               std::string(rule.variant) + " in " + std::string(to_string(state));
-      const int queued = set_state(state);
-      const Json params = request_for(rule);
-      // What a refusal must leave as it was.
-      const rt::MachineState machine_before = rt_->machine().state();
-      const std::uint64_t offsets_before = rt_->work_offsets().generation();
-      const double feed_before = rt_->machine().feed_override();
-      const std::size_t forced_before = rt_->variables().forced().size();
-      const std::optional<double> param_before = rt_->variables().read(param_);
+  for (const OpSpec& spec : op_table()) {
+    for (const OpKind* kind : kinds_of(spec)) {
+      for (const OpState state : kAllStates) {
+        const std::string what = std::string(spec.name) + (kind->name.empty() ? "" : " ") +
+                                 std::string(kind->name) + " in " + std::string(to_string(state));
+        const int queued = set_state(state);
+        const Json params = request_for(spec, *kind);
+        // What a refusal must leave as it was.
+        const rt::MachineState machine_before = rt_->machine().state();
+        const std::uint64_t offsets_before = rt_->work_offsets().generation();
+        const double feed_before = rt_->machine().feed_override();
+        const std::size_t forced_before = rt_->variables().forced().size();
+        const std::optional<double> param_before = rt_->variables().read(param_);
 
-      const Reply r = c_.request(rule.op, params);
-      const bool state_refusal = !r.ok && r.code == ErrorCode::kInvalidState &&
-                                 r.message.find("is not allowed in") != std::string::npos;
-      const int taken = take_manual();
-      if (allowed_in(rule, state)) {
-        ++run;
-        EXPECT_FALSE(state_refusal) << what << ": " << r.message;
-        const bool motion =
-            rule.op == "home" || rule.op == "jog" || rule.op == "touch" || rule.op == "jog.stop";
-        if (motion) {
-          EXPECT_TRUE(r.ok) << what << ": " << r.message;
-          EXPECT_EQ(taken, queued + 1) << what << ": the request reached the RT side";
+        const Reply r = c_.request(std::string(spec.name), params);
+        const bool state_refusal = !r.ok && r.code == ErrorCode::kInvalidState &&
+                                   r.message.find("is not allowed in") != std::string::npos;
+        const int taken = take_manual();
+        if (allowed_in(*kind, state)) {
+          ++run;
+          EXPECT_FALSE(state_refusal) << what << ": " << r.message;
+          const bool motion = spec.name == "home" || spec.name == "jog" || spec.name == "touch" ||
+                              spec.name == "jog.stop";
+          if (motion) {
+            EXPECT_TRUE(r.ok) << what << ": " << r.message;
+            EXPECT_EQ(taken, queued + 1) << what << ": the request reached the RT side";
+          }
+        } else {
+          ++refused;
+          EXPECT_TRUE(state_refusal) << what << ": " << (r.ok ? r.body.dump() : r.message);
+          EXPECT_NE(r.message.find(to_string(state)), std::string::npos) << r.message;
+          EXPECT_EQ(taken, queued) << what << ": nothing reached the RT side";
+          EXPECT_EQ(rt_->machine().state(), machine_before) << what;
+          EXPECT_EQ(rt_->work_offsets().generation(), offsets_before) << what;
+          EXPECT_EQ(rt_->machine().feed_override(), feed_before) << what;
+          EXPECT_EQ(rt_->variables().forced().size(), forced_before) << what;
+          EXPECT_EQ(rt_->variables().read(param_), param_before) << what;
         }
-      } else {
-        ++refused;
-        EXPECT_TRUE(state_refusal) << what << ": " << (r.ok ? r.body.dump() : r.message);
-        EXPECT_NE(r.message.find(to_string(state)), std::string::npos) << r.message;
-        EXPECT_EQ(taken, queued) << what << ": nothing reached the RT side";
-        EXPECT_EQ(rt_->machine().state(), machine_before) << what;
-        EXPECT_EQ(rt_->work_offsets().generation(), offsets_before) << what;
-        EXPECT_EQ(rt_->machine().feed_override(), feed_before) << what;
-        EXPECT_EQ(rt_->variables().forced().size(), forced_before) << what;
-        EXPECT_EQ(rt_->variables().read(param_), param_before) << what;
+        if (spec.name == "program.chunk" || spec.name == "program.commit") {
+          c_.request("program.abort");
+        }
+        if (spec.name == "trace.start") c_.request("trace.stop");
       }
-      if (rule.op == "program.chunk" || rule.op == "program.commit") c_.request("program.abort");
-      if (rule.op == "trace.start") c_.request("trace.stop");
     }
   }
   std::printf("op-state table: %d (op, state) pairs run, %d refused\n", run, refused);

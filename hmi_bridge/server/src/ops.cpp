@@ -1,4 +1,5 @@
-// The protocol's operations (docs/protocol.md), run on the server thread for one session.
+// The session, program-transfer and machine-command ops (ops_handlers.hpp; docs/protocol.md),
+// run on the server thread for one session.
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -7,25 +8,18 @@
 #include <variant>
 
 #include "edm/bridge/machine_info.hpp"
-#include "edm/bridge/op_states.hpp"
 #include "edm/machining/program_check.hpp"
 #include "edm/runtime/stats_json.hpp"
 #include "ops_body.hpp"
+#include "ops_handlers.hpp"
 #include "ops_operator.hpp"
-#include "ops_vars.hpp"
 #include "server_impl.hpp"
 
-namespace edm::bridge {
+namespace edm::bridge::ops {
 
 namespace {
 
 constexpr std::size_t kMaxIssuesReported = 100;
-
-using ops::Body;
-using ops::brief_name;
-using ops::error;
-using ops::Error;
-using ops::field;
 
 /// hello's optional "peer" (a relaying HMI's end client): "" when absent, nullopt when invalid.
 std::optional<std::string> hello_peer(const Json& msg) {
@@ -37,11 +31,39 @@ std::optional<std::string> hello_peer(const Json& msg) {
   return it->get<std::string>();
 }
 
-Body op_hello(Session& s, const Json& msg, const std::string& via) {
-  auto& srv = s.server();
-  if (s.role_) {
+Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
+  auto& m = s.server().rt.machine();
+  const rt::MachineState before = m.state();
+  // cycle.start's own checks (program loaded, referenced, offsets): ops::prepare_start().
+  if (m.command(c) != rt::CommandResult::kOk) {
     return error(ErrorCode::kInvalidState,
-                 "hello already said (role " + std::string(to_string(*s.role_)) + ")");
+                 std::string(op) + " is not allowed in " + std::string(to_string(before)));
+  }
+  return Json{{"state", std::string(to_string(m.state()))}};
+}
+
+}  // namespace
+
+std::optional<SteadyClock::time_point> hello_wait(Session& s, const Json& msg) {
+  const std::optional<std::string> via = hello_peer(msg);
+  if (!via) return std::nullopt;
+  const auto now = SteadyClock::now();
+  const auto when = s.server().throttle.admit_at(s.peer_address(), *via, now);
+  if (when > now) return when;
+  return std::nullopt;
+}
+
+Body op_hello(Session& s, const Json& msg) {
+  auto& srv = s.server();
+  const std::optional<std::string> via = hello_peer(msg);
+  if (!via) {
+    return error(ErrorCode::kBadRequest, "'peer' must be 1 to " +
+                                             std::to_string(kMaxHelloPeerChars) +
+                                             " printable ASCII characters");
+  }
+  if (s.role()) {
+    return error(ErrorCode::kInvalidState,
+                 "hello already said (role " + std::string(to_string(*s.role())) + ")");
   }
   const Json* proto = field(msg, "protocol", [](const Json& j) { return j.is_number_integer(); });
   std::string token;
@@ -52,16 +74,16 @@ Body op_hello(Session& s, const Json& msg, const std::string& via) {
   if (proto != nullptr && proto->get<std::int64_t>() == kProtocolVersion) {
     role = authenticate(srv.tokens, token, s.loopback());
   }
-  s.via_ = via;
+  s.set_via(*via);
   if (!role) {
     srv.counters.hello_failures.fetch_add(1, std::memory_order_relaxed);
-    const auto delay = srv.throttle.on_failure(s.peer_address(), via, SteadyClock::now());
+    const auto delay = srv.throttle.on_failure(s.peer_address(), *via, SteadyClock::now());
     std::string why = proto == nullptr || proto->get<std::int64_t>() != kProtocolVersion
                           ? "protocol version " + std::to_string(kProtocolVersion) + " required"
                       : !srv.tokens.any() ? "only loopback clients are served without a token"
                                           : "bad token";
     s.log(spdlog::level::warn, "hello refused: {} (next hello from this {} in {} ms)", why,
-          via.empty() ? "address" : "peer", delay.count());
+          via->empty() ? "address" : "peer", delay.count());
     return error(ErrorCode::kUnauthorized, std::move(why));
   }
   if (!srv.admit(s, *role)) {
@@ -70,7 +92,7 @@ Body op_hello(Session& s, const Json& msg, const std::string& via) {
                                        std::to_string(srv.opt.max_sessions) + ", " +
                                        std::to_string(kOperatorReserve) + " kept for an operator)");
   }
-  s.role_ = role;
+  s.set_role(*role);
   s.log(spdlog::level::info, "hello as {}{}", to_string(*role), s.loopback() ? "" : " (network)");
   return Json{{"role", std::string(to_string(*role))},
               {"protocol", kProtocolVersion},
@@ -102,7 +124,7 @@ Body op_subscribe(Session& s, const Json& msg) {
                        " (status, alarm, progress; traces: trace.start)");
     }
   }
-  int rate = s.rate_hz_ > 0 ? s.rate_hz_ : 10;
+  int rate = s.subscriptions().rate_hz > 0 ? s.subscriptions().rate_hz : 10;
   if (auto it = msg.find("rate_hz"); it != msg.end()) {
     if (!it->is_number_integer() || it->get<std::int64_t>() < kMinRateHz ||
         it->get<std::int64_t>() > kMaxRateHz) {
@@ -110,22 +132,17 @@ Body op_subscribe(Session& s, const Json& msg) {
     }
     rate = it->get<int>();
   }
-  s.sub_alarm_ = s.sub_alarm_ || alarm;
-  s.sub_progress_ = s.sub_progress_ || progress;
-  if (status) {
-    s.sub_status_ = true;
-    s.rate_hz_ = rate;
-    s.restart_status_timer();
-  }
+  s.subscribe(status, alarm, progress, rate);
+  const Session::Subscriptions now = s.subscriptions();
   Json subs = Json::array();
-  for (auto [on, name] : {std::pair{s.sub_status_, kTopicStatus},
-                          {s.sub_alarm_, kTopicAlarm},
-                          {s.sub_progress_, kTopicProgress}}) {
+  for (auto [on, name] : {std::pair{now.status, kTopicStatus},
+                          {now.alarm, kTopicAlarm},
+                          {now.progress, kTopicProgress}}) {
     if (on) {
       subs.push_back(std::string(name));
     }
   }
-  return Json{{"topics", std::move(subs)}, {"rate_hz", s.sub_status_ ? s.rate_hz_ : 0}};
+  return Json{{"topics", std::move(subs)}, {"rate_hz", now.status ? now.rate_hz : 0}};
 }
 
 Body op_unsubscribe(Session& s, const Json& msg) {
@@ -134,16 +151,7 @@ Body op_unsubscribe(Session& s, const Json& msg) {
   auto drop = [&](std::string_view t) {
     return all || std::find(topics->begin(), topics->end(), Json(std::string(t))) != topics->end();
   };
-  if (drop(kTopicStatus)) {
-    s.sub_status_ = false;
-    s.restart_status_timer();
-  }
-  if (drop(kTopicAlarm)) {
-    s.sub_alarm_ = false;
-  }
-  if (drop(kTopicProgress)) {
-    s.sub_progress_ = false;
-  }
+  s.unsubscribe(drop(kTopicStatus), drop(kTopicAlarm), drop(kTopicProgress));
   return Json::object();
 }
 
@@ -163,15 +171,15 @@ Body op_program_begin(Session& s, const Json& msg) {
   u.expected = n->get<std::size_t>();
   // Grown as chunks arrive: a one-line begin of 1,000,000 blocks must not take 150 MB at once.
   u.blocks.reserve(std::min<std::size_t>(u.expected, 4096));
-  s.upload_ = std::move(u);
-  return Json{{"upload", s.upload_->id}, {"blocks", s.upload_->expected}};
+  const Upload& now = s.begin_upload(std::move(u));
+  return Json{{"upload", now.id}, {"blocks", now.expected}};
 }
 
 Body op_program_chunk(Session& s, const Json& msg) {
-  if (!s.upload_) {
+  if (s.upload() == nullptr) {
     return error(ErrorCode::kNotFound, "no upload in progress (program.begin first)");
   }
-  Upload& u = *s.upload_;
+  Upload& u = *s.upload();
   const Json* first = field(msg, "first", [](const Json& j) { return j.is_number_unsigned(); });
   const Json* blocks = field(msg, "blocks", [](const Json& j) { return j.is_array(); });
   if (first == nullptr || blocks == nullptr) {
@@ -204,7 +212,7 @@ Body op_program_chunk(Session& s, const Json& msg) {
 
 Body op_program_commit(Session& s, const Json& msg) {
   auto& srv = s.server();
-  if (!s.upload_) {
+  if (s.upload() == nullptr) {
     return error(ErrorCode::kNotFound, "no upload in progress (program.begin first)");
   }
   std::uint32_t want = 0;
@@ -212,7 +220,7 @@ Body op_program_commit(Session& s, const Json& msg) {
   if (it == msg.end() || !parse_checksum(*it, want)) {
     return error(ErrorCode::kBadRequest, "'checksum' must be 8 hex digits (CRC-32, see protocol)");
   }
-  Upload& u = *s.upload_;
+  Upload& u = *s.upload();
   if (u.blocks.size() != u.expected) {
     return error(ErrorCode::kBadRequest, "incomplete program: " + std::to_string(u.blocks.size()) +
                                              " of " + std::to_string(u.expected) +
@@ -220,7 +228,7 @@ Body op_program_commit(Session& s, const Json& msg) {
   }
   const std::uint32_t got = u.crc.value();
   if (got != want) {
-    s.upload_.reset();
+    s.end_upload();
     return error(ErrorCode::kBadRequest, "checksum mismatch; upload discarded",
                  Json{{"expected", format_checksum(want)}, {"computed", format_checksum(got)}});
   }
@@ -258,10 +266,10 @@ Body op_program_commit(Session& s, const Json& msg) {
   const rt::LoadResult loaded = slot == rt::JobSlot::kMdi ? rt.job().load_mdi(std::move(u.blocks))
                                                           : rt.job().load(std::move(u.blocks), got);
   if (loaded != rt::LoadResult::kOk) {
-    s.upload_.reset();
+    s.end_upload();
     return error(ErrorCode::kBusy, "a job became active; program not swapped");
   }
-  s.upload_.reset();
+  s.end_upload();
   srv.committed_offsets[static_cast<std::size_t>(slot)] = offsets;
   srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
   s.log(spdlog::level::info, "committed {} of {} blocks (crc32 {})",
@@ -272,18 +280,7 @@ Body op_program_commit(Session& s, const Json& msg) {
               {"generation", rt.job().progress().generation}};
 }
 
-Body op_machine(Session& s, rt::MachineCommand c, std::string_view op) {
-  auto& m = s.server().rt.machine();
-  const rt::MachineState before = m.state();
-  // cycle.start's own checks (program loaded, referenced, offsets): ops::prepare_start().
-  if (m.command(c) != rt::CommandResult::kOk) {
-    return error(ErrorCode::kInvalidState,
-                 std::string(op) + " is not allowed in " + std::string(to_string(before)));
-  }
-  return Json{{"state", std::string(to_string(m.state()))}};
-}
-
-Body op_tasks_stats(Session& s) {
+Body op_tasks_stats(Session& s, const Json& /*msg*/) {
   auto& srv = s.server();
   Json doc = Json::parse(rt::stats_to_json(srv.rt.stats_reports()));
   const ServerStats st = srv.stats_snapshot();
@@ -331,165 +328,46 @@ Body op_feed_override(Session& s, const Json& msg) {
   return Json{{"percent", pct}};
 }
 
-Body dispatch(Session& s, const std::string& op, const Json& msg) {
-  if (op == "ping") {
-    return Json{{"pong", true}};
-  }
-  if (op == "status") {
-    StatusMessage m = s.server().status_message();
-    return to_json(m);
-  }
-  if (op == "subscribe") {
-    return op_subscribe(s, msg);
-  }
-  if (op == "unsubscribe") {
-    return op_unsubscribe(s, msg);
-  }
-  if (op == "program.begin") {
-    return op_program_begin(s, msg);
-  }
-  if (op == "program.chunk") {
-    return op_program_chunk(s, msg);
-  }
-  if (op == "program.commit") {
-    return op_program_commit(s, msg);
-  }
-  if (op == "program.abort") {
-    s.upload_.reset();
-    return Json::object();
-  }
-  using C = rt::MachineCommand;
-  static const std::pair<const char*, C> kCommands[] = {
-      {"cycle.start", C::kStart}, {"cycle.hold", C::kHold}, {"cycle.resume", C::kResume},
-      {"cycle.stop", C::kStop},   {"estop", C::kEstop},     {"reset", C::kReset}};
-  for (const auto& [name, c] : kCommands) {
-    if (op == name) {
-      if (c == C::kStart) {
-        if (auto e = ops::prepare_start(s, msg)) return *e;
-      }
-      return op_machine(s, c, op);
-    }
-  }
-  if (auto body = ops::dispatch_operator(s, op, msg)) {
-    return *body;
-  }
-  if (auto body = ops::dispatch_vars(s, op, msg)) {
-    return *body;
-  }
-  if (op == "tasks.stats") {
-    return op_tasks_stats(s);
-  }
-  if (op == "feed.override") {
-    return op_feed_override(s, msg);
-  }
-  if (op == "machine.info") {
-    rt::Runtime& rt = s.server().rt;
-    Json info = to_json(rt.tables(), rt.config().machine.name);
-    Json ops_list = Json::array();
-    for (const OpInfo& o : all_ops()) ops_list.push_back(std::string(o.name));
-    info["ops"] = std::move(ops_list);
-    info["manual"] = ops::manual_info_json(rt.manual().info());
-    return info;
-  }
-  return error(ErrorCode::kUnknownOp, "unknown op " + brief_name(op));
+Body op_ping(Session& /*s*/, const Json& /*msg*/) { return Json{{"pong", true}}; }
+
+Body op_status(Session& s, const Json& /*msg*/) {
+  StatusMessage m = s.server().status_message();
+  return to_json(m);
 }
 
-/// What an audit entry says about a request beyond its op: the variable and value, the frame,
-/// the program's checksum. Short, one line: every client-supplied part is escaped and cut.
-std::string audit_detail(const std::string& op, const Json& msg) {
-  std::string d;
-  const auto add = [&d](std::string_view key, std::string_view text) {
-    if (!d.empty()) d += ' ';
-    d += key;
-    d += '=';
-    d += text;
-  };
-  for (const char* key : {"name", "frame", "axis", "axes", "target", "slot"}) {
-    if (auto it = msg.find(key); it != msg.end() && it->is_string()) {
-      add(key, brief_name(it->get_ref<const std::string&>()));
-    }
-  }
-  for (const char* key : {"value", "distance", "velocity", "percent", "x", "y", "z"}) {
-    if (auto it = msg.find(key); it != msg.end() && it->is_primitive()) {
-      // A number, boolean or null dumps as plain ASCII; a string is quoted and escaped.
-      add(key, it->is_string() ? brief_name(it->get_ref<const std::string&>())
-                               : it->dump().substr(0, 32));
-    }
-  }
-  if (op == "program.commit") {
-    if (auto it = msg.find("checksum"); it != msg.end() && it->is_string()) {
-      d = "checksum=" + brief_name(it->get_ref<const std::string&>());
-    }
-  }
-  return d;
+Body op_program_abort(Session& s, const Json& /*msg*/) {
+  s.end_upload();
+  return Json::object();
 }
 
-/// The op-state table's refusal of this request (op_states.hpp), or nullopt: it may run now.
-std::optional<Body> refuse_in_state(Session& s, const ParsedRequest& req) {
-  const OpStateRule* rule = op_state_rule(req.op, req.msg);
-  if (rule == nullptr) return std::nullopt;
-  const OpState state = current_op_state(s.server().rt);
-  if (allowed_in(*rule, state)) return std::nullopt;
-  const std::string what =
-      rule->variant.empty() ? req.op : req.op + " (" + std::string(rule->variant) + ")";
-  return error(ErrorCode::kInvalidState,
-               what + " is not allowed in " + std::string(to_string(state)));
+Body op_cycle_start(Session& s, const Json& msg) {
+  if (auto e = prepare_start(s, msg)) return *e;
+  return op_machine(s, rt::MachineCommand::kStart, "cycle.start");
+}
+Body op_cycle_hold(Session& s, const Json& /*msg*/) {
+  return op_machine(s, rt::MachineCommand::kHold, "cycle.hold");
+}
+Body op_cycle_resume(Session& s, const Json& /*msg*/) {
+  return op_machine(s, rt::MachineCommand::kResume, "cycle.resume");
+}
+Body op_cycle_stop(Session& s, const Json& /*msg*/) {
+  return op_machine(s, rt::MachineCommand::kStop, "cycle.stop");
+}
+Body op_estop(Session& s, const Json& /*msg*/) {
+  return op_machine(s, rt::MachineCommand::kEstop, "estop");
+}
+Body op_reset(Session& s, const Json& /*msg*/) {
+  return op_machine(s, rt::MachineCommand::kReset, "reset");
 }
 
-}  // namespace
-
-OpResult run_op(Session& s, const ParsedRequest& req) {
-  OpResult r;
-  const OpInfo* info = find_op(req.op);
-  Body body;
-  if (info == nullptr) {
-    body = error(ErrorCode::kUnknownOp, "unknown op " + brief_name(req.op));
-  } else if (req.op == "hello") {
-    const std::optional<std::string> via = hello_peer(req.msg);
-    if (!via) {
-      body = error(ErrorCode::kBadRequest, "'peer' must be 1 to " +
-                                               std::to_string(kMaxHelloPeerChars) +
-                                               " printable ASCII characters");
-    } else {
-      if (!s.role_) {
-        const auto now = SteadyClock::now();
-        const auto when = s.server().throttle.admit_at(s.peer_address(), *via, now);
-        if (when > now) {
-          r.retry_at = when;  // evaluated later: the failed-hello throttle
-          return r;
-        }
-      }
-      body = op_hello(s, req.msg, *via);
-    }
-    r.close_after = std::holds_alternative<Error>(body) && !s.role_;  // refused: session ends
-  } else if (!s.role_) {
-    body = error(ErrorCode::kUnauthorized, "hello first");
-  } else if (info->operator_only && *s.role_ != Role::kOperator) {
-    body = error(ErrorCode::kForbidden, "'" + req.op + "' needs the operator role");
-  } else if (auto refusal = refuse_in_state(s, req)) {
-    body = std::move(*refusal);
-  } else {
-    body = dispatch(s, req.op, req.msg);
-  }
-  const auto* e = std::get_if<Error>(&body);
-  if (info != nullptr && info->operator_only && s.role_) {
-    const std::string detail = audit_detail(req.op, req.msg);
-    s.server().audit.record({.session = s.id(),
-                             .role = to_string(*s.role_),
-                             .peer = s.peer(),
-                             .address = s.peer_address(),
-                             .via = s.via_,
-                             .op = req.op,
-                             .detail = detail,
-                             .outcome = e != nullptr ? to_string(e->code) : "ok"},
-                            s.server().log_limiter);
-  }
-  if (e != nullptr) {
-    r.reply = make_error(req.id, e->code, e->message, e->details);
-  } else {
-    r.reply = make_reply(req.id, std::get<Json>(body));
-  }
-  return r;
+Body op_machine_info(Session& s, const Json& /*msg*/) {
+  rt::Runtime& rt = s.server().rt;
+  Json info = to_json(rt.tables(), rt.config().machine.name);
+  Json ops_list = Json::array();
+  for (const OpSpec& o : op_table()) ops_list.push_back(std::string(o.name));
+  info["ops"] = std::move(ops_list);
+  info["manual"] = manual_info_json(rt.manual().info());
+  return info;
 }
 
-}  // namespace edm::bridge
+}  // namespace edm::bridge::ops

@@ -1,6 +1,7 @@
 #pragma once
-// What an op returns (a reply body or a protocol error) and the field helpers every op file
-// shares (ops.cpp, ops_operator.cpp). Server thread only.
+// The helpers every op file shares (ops.cpp, ops_operator.cpp, ops_vars.cpp): an error body, a
+// quoted client name, required fields. What an op returns (ops::Body) is op_table.hpp's. Server
+// thread only.
 
 #include <optional>
 #include <string>
@@ -9,18 +10,11 @@
 #include <vector>
 
 #include "edm/bridge/codec.hpp"
+#include "edm/bridge/op_table.hpp"
 #include "edm/bridge/protocol.hpp"
 #include "edm/runtime/log_escape.hpp"
 
 namespace edm::bridge::ops {
-
-struct Error {
-  ErrorCode code;
-  std::string message;
-  Json details{nullptr};
-};
-
-using Body = std::variant<Json, Error>;
 
 inline Body error(ErrorCode code, std::string message, Json details = nullptr) {
   return Error{code, std::move(message), std::move(details)};

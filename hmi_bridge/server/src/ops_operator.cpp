@@ -1,10 +1,13 @@
-// The operator functions' ops (ops_operator.hpp; docs/protocol.md "Operator functions").
+// The operator functions' ops (ops_handlers.hpp; docs/protocol.md "Operator functions"):
+//   home, jog, jog.stop, touch, manual.status   → rt::ManualControl (the runtime's ManualMotion)
+//   offset.get, offset.set                      → rt::WorkOffsets (retained)
 #include "ops_operator.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <cmath>
 
+#include "ops_handlers.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge::ops {
@@ -20,7 +23,7 @@ int axis_index(const std::string& a) {
 }
 
 /// Manual motion needs a machine that has it. When it may run (READY, no job, no other manual
-/// operation) is the op-state table's (op_states.cpp), checked before any op runs.
+/// operation) is the op table's (op_table.cpp), checked before any op runs.
 std::optional<Body> manual_available(rt::Runtime& rt) {
   if (!rt.manual().info().available) {
     return error(ErrorCode::kInvalidState, "this machine has no manual motion (no EdmJob)");
@@ -39,6 +42,8 @@ Body send_manual(rt::Runtime& rt, const rt::ManualRequest& r, Json body = Json::
   body["seq"] = seq;
   return body;
 }
+
+}  // namespace
 
 Body op_home(Session& s, const Json& msg) {
   auto& rt = s.server().rt;
@@ -106,7 +111,7 @@ Body op_jog(Session& s, const Json& msg) {
   return send_manual(rt, r, Json{{"deadman_ms", info.deadman_ms}});
 }
 
-Body op_jog_stop(Session& s) {
+Body op_jog_stop(Session& s, const Json& /*msg*/) {
   rt::ManualRequest r;
   r.op = rt::ManualOp::kStop;
   return send_manual(s.server().rt, r);
@@ -130,11 +135,15 @@ Body op_touch(Session& s, const Json& msg) {
   return send_manual(rt, r);
 }
 
+namespace {
+
 Json referenced_json(std::uint8_t mask) {
   return Json{{"X", (mask & 1U) != 0}, {"Y", (mask & 2U) != 0}, {"Z", (mask & 4U) != 0}};
 }
 
-Body op_manual_status(Session& s) {
+}  // namespace
+
+Body op_manual_status(Session& s, const Json& /*msg*/) {
   auto& m = s.server().rt.manual();
   const rt::ManualStatus st = m.status();
   Json out{{"mode", std::string(rt::to_string(st.mode))},
@@ -163,9 +172,13 @@ Body op_manual_status(Session& s) {
   return out;
 }
 
+namespace {
+
 Json frame_json(const rt::WorkFrame& f) { return Json{{"x", f.x}, {"y", f.y}, {"z", f.z}}; }
 
-Body op_offset_get(Session& s) {
+}  // namespace
+
+Body op_offset_get(Session& s, const Json& /*msg*/) {
   auto& w = s.server().rt.work_offsets();
   Json frames = Json::object();
   const auto all = w.all();
@@ -217,8 +230,6 @@ Body op_offset_set(Session& s, const Json& msg) {
   out["retained"] = rt.retain() != nullptr;  // false: this run retains nothing (no retain file)
   return out;
 }
-
-}  // namespace
 
 Json manual_info_json(const rt::ManualInfo& info) {
   return Json{
@@ -292,17 +303,6 @@ std::optional<Body> prepare_start(Session& s, const Json& msg) {
     }
   }
   rt.job().set_start_options(o);
-  return std::nullopt;
-}
-
-std::optional<Body> dispatch_operator(Session& s, const std::string& op, const Json& msg) {
-  if (op == "home") return op_home(s, msg);
-  if (op == "jog") return op_jog(s, msg);
-  if (op == "jog.stop") return op_jog_stop(s);
-  if (op == "touch") return op_touch(s, msg);
-  if (op == "manual.status") return op_manual_status(s);
-  if (op == "offset.get") return op_offset_get(s);
-  if (op == "offset.set") return op_offset_set(s, msg);
   return std::nullopt;
 }
 

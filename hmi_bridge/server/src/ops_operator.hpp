@@ -1,7 +1,6 @@
 #pragma once
-// The operator functions' ops (DESIGN §12, issue 21; docs/protocol.md "Operator functions"):
-//   home, jog, jog.stop, touch, manual.status   → rt::ManualControl (the runtime's ManualMotion)
-//   offset.get, offset.set                      → rt::WorkOffsets (retained)
+// What the operator functions' ops share with the other ops (DESIGN §12, issue 21;
+// docs/protocol.md "Operator functions"; the handlers are in ops_handlers.hpp):
 //   cycle.start {slot, dry_run}                 → the checks before a start and StartOptions
 // Server thread only.
 
@@ -17,9 +16,6 @@ namespace edm::bridge {
 class Session;
 
 namespace ops {
-
-/// The body of an operator-function op, or nullopt when `op` is not one of them.
-std::optional<Body> dispatch_operator(Session& s, const std::string& op, const Json& msg);
 
 /// cycle.start's own checks and options ({"slot": "main"|"mdi", "dry_run": bool}); an error, or
 /// nullopt when the start may be commanded (the options are then set in the job store).

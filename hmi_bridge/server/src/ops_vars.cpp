@@ -1,10 +1,12 @@
-// The variable and trace ops (ops_vars.hpp; docs/protocol.md "Variables", "Trace streaming").
-#include "ops_vars.hpp"
-
+// The variable and trace ops (ops_handlers.hpp; docs/protocol.md "Variables", "Trace streaming"):
+//   var.list, var.read, var.write, var.force, var.unforce → rt::VariableRegistry (non-RT API)
+//   trace.start, trace.stop                               → the session's trace variables
 #include <algorithm>
 #include <cmath>
 #include <set>
 
+#include "ops_body.hpp"
+#include "ops_handlers.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge::ops {
@@ -24,6 +26,10 @@ ErrorCode var_error(rt::VarResult r) {
       return ErrorCode::kBadRequest;
   }
 }
+
+Body var_write(Session& s, const Json& msg, bool force);
+
+}  // namespace
 
 Body op_var_list(Session& s, const Json& msg) {
   std::string prefix;
@@ -78,7 +84,12 @@ Body op_var_read(Session& s, const Json& msg) {
   return Json{{"values", std::move(values)}};
 }
 
-Body op_var_write(Session& s, const Json& msg, bool force) {
+Body op_var_write(Session& s, const Json& msg) { return var_write(s, msg, false); }
+Body op_var_force(Session& s, const Json& msg) { return var_write(s, msg, true); }
+
+namespace {
+
+Body var_write(Session& s, const Json& msg, bool force) {
   const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
   const Json* value =
       field(msg, "value", [](const Json& j) { return j.is_number() || j.is_boolean(); });
@@ -124,6 +135,8 @@ Body op_var_write(Session& s, const Json& msg, bool force) {
   return Json{{"name", n}};
 }
 
+}  // namespace
+
 Body op_var_unforce(Session& s, const Json& msg) {
   const Json* name = field(msg, "name", [](const Json& j) { return j.is_string(); });
   if (name == nullptr) {
@@ -167,28 +180,13 @@ Body op_trace_start(Session& s, const Json& msg) {
     }
     names.push_back(n);
   }
-  s.trace_vars_ = names;
-  s.server().retrace();
+  s.set_trace_vars(names);
   return Json{{"vars", names}};
 }
 
-Body op_trace_stop(Session& s) {
-  s.trace_vars_.clear();
-  s.server().retrace();
+Body op_trace_stop(Session& s, const Json& /*msg*/) {
+  s.set_trace_vars({});
   return Json::object();
-}
-
-}  // namespace
-
-std::optional<Body> dispatch_vars(Session& s, const std::string& op, const Json& msg) {
-  if (op == "var.list") return op_var_list(s, msg);
-  if (op == "var.read") return op_var_read(s, msg);
-  if (op == "var.write") return op_var_write(s, msg, false);
-  if (op == "var.force") return op_var_write(s, msg, true);
-  if (op == "var.unforce") return op_var_unforce(s, msg);
-  if (op == "trace.start") return op_trace_start(s, msg);
-  if (op == "trace.stop") return op_trace_stop(s);
-  return std::nullopt;
 }
 
 }  // namespace edm::bridge::ops

@@ -306,7 +306,7 @@ void Server::Impl::adopt(std::unique_ptr<Transport> t) {
 bool Server::Impl::admit(Session& s, Role role) {
   std::size_t viewers = 0;
   for (const auto& w : live_sessions()) {
-    viewers += w->role_ == Role::kViewer ? 1 : 0;
+    viewers += w->role() == Role::kViewer ? 1 : 0;
   }
   const auto max = static_cast<std::size_t>(opt.max_sessions);
   const std::size_t reserve = max > 1 ? kOperatorReserve : 0;

@@ -206,7 +206,6 @@ class Session : public std::enable_shared_from_this<Session> {
   }
 
  private:
-  friend struct Ops;
   void on_handshake(boost::system::error_code ec);
   void do_read();
   void on_read(boost::system::error_code ec, std::size_t n);
@@ -253,22 +252,66 @@ class Session : public std::enable_shared_from_this<Session> {
   std::optional<SteadyClock::time_point> stalled_since_;
   std::uint64_t status_gen_{0};
 
- public:  // state the ops (ops.cpp) read and change
   std::optional<Role> role_;
   std::string via_;  // hello's "peer" (validated, printable ASCII), "" when none
   bool sub_status_{false};
   bool sub_alarm_{false};
   bool sub_progress_{false};
-  int rate_hz_{0};
+  int rate_hz_{0};  // kept after an unsubscribe: the next subscribe's default
   SteadyClock::time_point next_status_{};
   asio::steady_timer status_timer_;
   std::optional<Upload> upload_;
   std::vector<std::string> trace_vars_;
 
+ public:  // what the ops (op_table.cpp, ops*.cpp) read and change
+  struct Subscriptions {
+    bool status{false};
+    bool alarm{false};
+    bool progress{false};
+    int rate_hz{0};  // the status rate; 0 before the first status subscription
+  };
+
   [[nodiscard]] Server::Impl& server() { return server_; }
   [[nodiscard]] bool loopback() const { return loopback_; }
   [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
-  void restart_status_timer() { start_status_timer(); }
+  [[nodiscard]] std::optional<Role> role() const { return role_; }
+  /// A valid hello: the session is `r` from now on.
+  void set_role(Role r) { role_ = r; }
+  /// hello's "peer" (validated), "" when none.
+  [[nodiscard]] const std::string& via() const { return via_; }
+  void set_via(std::string via) { via_ = std::move(via); }
+  [[nodiscard]] Subscriptions subscriptions() const {
+    return {sub_status_, sub_alarm_, sub_progress_, rate_hz_};
+  }
+  /// Adds the topics given true; `status` (re)starts the status events at `rate_hz`.
+  void subscribe(bool status, bool alarm, bool progress, int rate_hz) {
+    sub_alarm_ = sub_alarm_ || alarm;
+    sub_progress_ = sub_progress_ || progress;
+    if (status) {
+      sub_status_ = true;
+      rate_hz_ = rate_hz;
+      start_status_timer();
+    }
+  }
+  /// Drops the topics given true; dropping status stops its events.
+  void unsubscribe(bool status, bool alarm, bool progress) {
+    if (status) {
+      sub_status_ = false;
+      start_status_timer();
+    }
+    sub_alarm_ = sub_alarm_ && !alarm;
+    sub_progress_ = sub_progress_ && !progress;
+  }
+  /// The upload in progress (program.begin … commit), or nullptr.
+  [[nodiscard]] Upload* upload() { return upload_ ? &*upload_ : nullptr; }
+  /// Starts an upload, replacing any in progress.
+  Upload& begin_upload(Upload u) { return upload_.emplace(std::move(u)); }
+  void end_upload() { upload_.reset(); }
+  /// The variables this session traces from now on (the server's taps follow).
+  void set_trace_vars(std::vector<std::string> names) {
+    trace_vars_ = std::move(names);
+    server_.retrace();
+  }
 };
 
 /// Runs one request for a session (ops.cpp).

@@ -1,8 +1,6 @@
 #include "edm/bridge/status_board.hpp"
 
-#include <cstring>
 #include <stdexcept>
-#include <thread>
 #include <type_traits>
 
 namespace edm::bridge {
@@ -37,42 +35,16 @@ void StatusBoard::publish_now(rt::TimePoint release, std::uint64_t cycle) noexce
   for (std::uint32_t i = 0; i < n_pins_; ++i) {
     s.vars[i] = rt::read_pin_as_double(pins_[i]);
   }
-  publish(s);
-}
-
-void StatusBoard::publish(const StatusSnapshot& s) noexcept {
-  std::array<std::uint64_t, kWords> w{};
-  std::memcpy(w.data(), &s, sizeof s);
-  const std::uint64_t v = version_.load(std::memory_order_relaxed);
-  version_.store(v + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  for (std::size_t i = 0; i < kWords; ++i) {
-    words_[i].store(w[i], std::memory_order_relaxed);
-  }
-  version_.store(v + 2, std::memory_order_release);
+  board_.store(s);
 }
 
 bool StatusBoard::read(StatusSnapshot& out) const noexcept {
-  std::array<std::uint64_t, kWords> w{};
-  for (unsigned attempt = 0;; ++attempt) {
-    const std::uint64_t v1 = version_.load(std::memory_order_acquire);
-    if (v1 == 0) {
-      return false;
-    }
-    if ((v1 & 1u) == 0) {
-      for (std::size_t i = 0; i < kWords; ++i) {
-        w[i] = words_[i].load(std::memory_order_relaxed);
-      }
-      std::atomic_thread_fence(std::memory_order_acquire);
-      if (version_.load(std::memory_order_relaxed) == v1) {
-        std::memcpy(static_cast<void*>(&out), w.data(), sizeof out);
-        return true;
-      }
-    }
-    if (attempt > 64) {
-      std::this_thread::yield();  // the writer was preempted mid-publish (reader side only)
-    }
+  const StatusSnapshot s = board_.load();
+  if (s.publication == 0) {
+    return false;
   }
+  out = s;
+  return true;
 }
 
 }  // namespace edm::bridge

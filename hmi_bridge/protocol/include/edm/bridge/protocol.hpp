@@ -1,14 +1,14 @@
 #pragma once
 // The HMI bridge protocol (DESIGN §9, docs/protocol.md): JSON Lines over TCP. This header holds
-// what both ends share — version, limits, error codes, roles, the op table — with no dependency
-// on the runtime (the HMI process links it) and no I/O.
+// what both ends share — version, limits, error codes, roles, topics — with no dependency on the
+// runtime (the HMI process links it) and no I/O. The ops are the server's op table
+// (edm/bridge/op_table.hpp); a client learns them from machine.info's "ops".
 //
 // Thread-safety: pure data and pure functions (thread-safe). Not for RT threads (the codec
 // allocates).
 
 #include <cstddef>
 #include <cstdint>
-#include <span>
 #include <string_view>
 
 namespace edm::bridge {
@@ -51,15 +51,6 @@ bool error_code_from_string(std::string_view s, ErrorCode& out) noexcept;
 
 enum class Role : std::uint8_t { kViewer, kOperator };
 std::string_view to_string(Role r) noexcept;
-
-/// Every op and whether only an operator may run it.
-struct OpInfo {
-  std::string_view name;
-  bool operator_only;
-};
-std::span<const OpInfo> all_ops() noexcept;
-/// nullptr when the op is unknown.
-const OpInfo* find_op(std::string_view name) noexcept;
 
 /// Subscription topics.
 inline constexpr std::string_view kTopicStatus = "status";

@@ -4,17 +4,14 @@
 // it copies the machine state, the job progress and a few key pins into a seqlock the server's
 // thread samples at each subscriber's rate.
 //
-// Seqlock: the writer bumps the version to odd, stores the snapshot's words with relaxed atomic
-// stores, and bumps it to even; a reader retries while the version is odd or has moved. Every
-// shared word is a std::atomic, so there is no data race (TSan-clean) and the writer never
-// waits: a slow or stalled reader only retries, it cannot hold the RT thread.
+// The snapshot lives in the runtime's one seqlock, rt::Seqlock<StatusSnapshot> (seqlock.hpp says
+// why its orderings are right): the writer never waits, a slow or stalled reader only retries.
 //
-// RT-safety: on_cycle_end() is RT-safe (no allocation, lock or syscall). read() is wait-free for
-// the writer and lock-free for readers; any number of reader threads. Construct and attach
-// before the tasks run.
+// RT-safety: on_cycle_end() is RT-safe (no allocation, lock or syscall; the snapshot is built on
+// the stack). read() is for non-RT threads (it retries, then yields, while a store overlaps); any
+// number of reader threads. Construct and attach before the tasks run.
 
 #include <array>
-#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -24,6 +21,7 @@
 #include "edm/runtime/job.hpp"
 #include "edm/runtime/machine.hpp"
 #include "edm/runtime/pin.hpp"
+#include "edm/runtime/seqlock.hpp"
 
 namespace edm::bridge {
 
@@ -50,20 +48,17 @@ class StatusBoard final : public rt::CycleObserver {
   /// Publishes from a non-RT thread (used only while no task runs, e.g. tests). Not concurrent
   /// with on_cycle_end().
   void publish_now(rt::TimePoint release, std::uint64_t cycle) noexcept;
-  /// The latest snapshot; false when none has been published yet. Any thread.
+  /// The latest snapshot; false (out untouched) when none has been published yet. Any non-RT
+  /// thread.
   bool read(StatusSnapshot& out) const noexcept;
 
  private:
-  static constexpr std::size_t kWords = (sizeof(StatusSnapshot) + 7) / 8;
-  void publish(const StatusSnapshot& s) noexcept;
-
   const rt::Machine* machine_;
   const rt::JobStore* job_;
   std::array<rt::PinRef, kMaxStatusVars> pins_{};
   std::uint32_t n_pins_{0};
-  std::uint64_t publications_{0};  // writer-side only
-  std::atomic<std::uint64_t> version_{0};
-  std::array<std::atomic<std::uint64_t>, kWords> words_{};
+  std::uint64_t publications_{0};      // writer-side only
+  rt::Seqlock<StatusSnapshot> board_;  // publication 0 until the first publish
 };
 
 }  // namespace edm::bridge

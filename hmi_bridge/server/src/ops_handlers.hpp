@@ -1,0 +1,54 @@
+#pragma once
+// Every op's handler, each run by run_op() from its row of the op table (op_table.cpp) once the
+// role and state checks passed. Server thread only.
+
+#include <chrono>
+#include <optional>
+
+#include "edm/bridge/op_table.hpp"
+
+namespace edm::bridge::ops {
+
+// ops.cpp: the session, program transfer and machine commands.
+Body op_hello(Session& s, const Json& msg);
+Body op_ping(Session& s, const Json& msg);
+Body op_status(Session& s, const Json& msg);
+Body op_subscribe(Session& s, const Json& msg);
+Body op_unsubscribe(Session& s, const Json& msg);
+Body op_program_begin(Session& s, const Json& msg);
+Body op_program_chunk(Session& s, const Json& msg);
+Body op_program_commit(Session& s, const Json& msg);
+Body op_program_abort(Session& s, const Json& msg);
+Body op_cycle_start(Session& s, const Json& msg);
+Body op_cycle_hold(Session& s, const Json& msg);
+Body op_cycle_resume(Session& s, const Json& msg);
+Body op_cycle_stop(Session& s, const Json& msg);
+Body op_estop(Session& s, const Json& msg);
+Body op_reset(Session& s, const Json& msg);
+Body op_tasks_stats(Session& s, const Json& msg);
+Body op_machine_info(Session& s, const Json& msg);
+Body op_feed_override(Session& s, const Json& msg);
+
+/// A hello that the failed-hello throttle does not let be evaluated yet: when it may be. Nullopt
+/// when it may be evaluated now (or its "peer" is invalid: op_hello refuses it at once).
+std::optional<std::chrono::steady_clock::time_point> hello_wait(Session& s, const Json& msg);
+
+// ops_vars.cpp: variables and traces.
+Body op_var_list(Session& s, const Json& msg);
+Body op_var_read(Session& s, const Json& msg);
+Body op_var_write(Session& s, const Json& msg);
+Body op_var_force(Session& s, const Json& msg);
+Body op_var_unforce(Session& s, const Json& msg);
+Body op_trace_start(Session& s, const Json& msg);
+Body op_trace_stop(Session& s, const Json& msg);
+
+// ops_operator.cpp: the operator functions.
+Body op_home(Session& s, const Json& msg);
+Body op_jog(Session& s, const Json& msg);
+Body op_jog_stop(Session& s, const Json& msg);
+Body op_touch(Session& s, const Json& msg);
+Body op_manual_status(Session& s, const Json& msg);
+Body op_offset_get(Session& s, const Json& msg);
+Body op_offset_set(Session& s, const Json& msg);
+
+}  // namespace edm::bridge::ops
