@@ -125,7 +125,7 @@ std::vector<int> seeds_from_env(const char* name, std::vector<int> fallback) {
 
 // Scoring seeds 1-5; one under a sanitizer (about 10x slower: five seeds of a 30 mm hole would
 // pass ctest's 300 s timeout there, and the sanitizers look for memory errors, not figures).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(EDM_UNDER_SANITIZER)
 const std::vector<int> kScoringSeeds = {1};
 #else
 const std::vector<int> kScoringSeeds = {1, 2, 3, 4, 5};

@@ -159,7 +159,7 @@ double sd(const std::vector<double>& v) {
 // The figures over seeds 1-20 (docs/benchmarks.md). Also a test: every seed must pass. Under a
 // sanitizer (about 9x slower: 210 s for twenty seeds, near ctest's 300 s timeout on a loaded
 // machine) seeds 1-5: the sanitizers look for memory errors, not figures.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(EDM_UNDER_SANITIZER)
 constexpr int kLastSeed = 5;
 #else
 constexpr int kLastSeed = 20;
