@@ -151,6 +151,11 @@ class Runner {
     }
     config_ = out_ / "drill-sim-soak.yaml";
     std::ofstream(config_) << cfg;
+    // The copy includes the machines' fragments (docs/config.md "Fragments"): linked beside it.
+    if (std::error_code lec; !fs::exists(out_ / "fragments", lec)) {
+      fs::create_directory_symlink(fs::absolute(fs::path(o_.root) / "config/machines/fragments"),
+                                   out_ / "fragments", lec);
+    }
     // Copies of the two programs: build/ is shared, and a rebuild of edmhmi mid-run made its
     // binary unrunnable for seconds (jobs that never started).
     const fs::path bin = out_ / "bin";

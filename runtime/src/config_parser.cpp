@@ -139,8 +139,6 @@ void Parser::cross_check(const Config& cfg) {
   }
 }
 
-}  // namespace config_detail
-
 namespace {
 
 /// Sees where a document starts and ignores everything else.
@@ -181,6 +179,30 @@ constexpr std::size_t kMaxConfigFileBytes = machining::kMaxConfigBytes;
 
 }  // namespace
 
+std::optional<YAML::Node> load_document(const std::string& text, const Reader& r,
+                                        DiagnosticSink& sink) {
+  const std::string& path = r.file();
+  std::optional<YAML::Node> root;
+  try {
+    root = YAML::Load(text);
+    if (const auto second = second_document_mark(text)) {
+      const SourceLoc at = r.loc(*second);
+      sink.error(at.line != 0 ? at : SourceLoc{path, 1, 1},
+                 "unexpected content after the first YAML document (one document per file)");
+    }
+  } catch (const YAML::DeepRecursion& e) {
+    sink.error(r.loc(e.mark), "YAML nesting is too deep");
+  } catch (const YAML::Exception& e) {
+    sink.error(r.loc(e.mark), "YAML syntax error: " + e.msg);
+  }
+  return root;
+}
+
+}  // namespace config_detail
+
+using config_detail::kMaxConfigFileBytes;
+using config_detail::kMaxDiagnostics;
+
 Config parse_config_text(const std::string& text, const std::string& path) {
   if (text.size() > kMaxConfigFileBytes) {  // the same bound for text that came another way
     throw ConfigError({{{path, 1, 1},
@@ -190,33 +212,19 @@ Config parse_config_text(const std::string& text, const std::string& path) {
   DiagnosticSink sink;
   Config cfg;
   cfg.path = path;
-  config_detail::Parser parser(path, sink);
+  config_detail::IncludeState inc;
+  inc.stack.push_back({config_detail::canonical_path(path), path});
+  inc.bytes = text.size();
+  inc.included = &cfg.includes;
+  config_detail::Parser parser(path, sink, inc);
   config_detail::Reader reader(path, sink);
-  YAML::Node root;
-  bool loaded = false;
-  try {
-    root = YAML::Load(text);
-    loaded = true;
-    if (const auto second = second_document_mark(text)) {
-      const SourceLoc at = reader.loc(*second);
-      sink.error(at.line != 0 ? at : SourceLoc{path, 1, 1},
-                 "unexpected content after the first YAML document (one document per file)");
-    }
-  } catch (const YAML::DeepRecursion& e) {
-    sink.error(reader.loc(e.mark), "YAML nesting is too deep");
-  } catch (const YAML::Exception& e) {
-    sink.error(reader.loc(e.mark), "YAML syntax error: " + e.msg);
-  }
-  if (loaded) {
-    parser.parse_document(root, cfg);
+  if (const auto root = config_detail::load_document(text, reader, sink)) {
+    parser.parse_document(*root, cfg);
   }
   if (sink.empty()) {
     return cfg;
   }
-  std::vector<Diagnostic> diags = sink.diagnostics();
-  std::stable_sort(diags.begin(), diags.end(), [](const Diagnostic& a, const Diagnostic& b) {
-    return a.loc.line != b.loc.line ? a.loc.line < b.loc.line : a.loc.col < b.loc.col;
-  });
+  std::vector<Diagnostic> diags = with_include_notes(cfg, sink.diagnostics());
   if (diags.size() > kMaxDiagnostics) {
     const std::size_t more = diags.size() - kMaxDiagnostics;
     SourceLoc at = diags[kMaxDiagnostics].loc;

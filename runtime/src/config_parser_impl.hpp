@@ -43,9 +43,33 @@ class UniqueNames {
   std::unordered_map<std::string, SourceLoc> first_;
 };
 
+/// "file:line:col" of a location, for messages naming another place.
+std::string where(const SourceLoc& loc);
+
+/// The path made absolute and canonical as far as it exists (a cycle is the same file reached
+/// again, whatever the spelling).
+std::string canonical_path(const std::string& path);
+
+/// The one YAML document of `text` (reported at Reader's file when it is not one), or nullopt.
+std::optional<YAML::Node> load_document(const std::string& text, const Reader& r,
+                                        DiagnosticSink& sink);
+
+/// The fragments of one parse (config_include.cpp): what is being read, to refuse cycles, depth
+/// and size, and what was read, for Config::includes.
+struct IncludeState {
+  struct Frame {
+    std::string canonical;  // to recognise a cycle
+    std::string file;       // as messages name it
+  };
+  std::vector<Frame> stack;  // the config file first, then each fragment being read
+  std::size_t bytes{0};      // of the config and every fragment read so far
+  std::vector<IncludedFile>* included{nullptr};
+};
+
 class Parser {
  public:
-  Parser(const std::string& path, DiagnosticSink& sink) : r_(path, sink) {}
+  Parser(const std::string& path, DiagnosticSink& sink, IncludeState& inc)
+      : r_(path, sink), sink_(sink), inc_(inc) {}
 
   void parse_document(const YAML::Node& root, Config& cfg);
 
@@ -69,6 +93,13 @@ class Parser {
   void parse_params_under(const Value& v, const std::string& prefix, int depth,
                           std::vector<ParamSetting>& out);
   void parse_wires(const Value& v, std::vector<WireSpec>& out);
+  // config_include.cpp: `include:` of a program, and a fragment's blocks and wires appended to it
+  // (a block name or wire destination the program already has is an error naming both places).
+  void parse_include(const Value& v, ProgramSpec& out);
+  void include_one(const Value& item, ProgramSpec& out);
+  void parse_fragment(const YAML::Node& root, ProgramSpec& out);
+  void append_blocks(std::vector<BlockSpec>& blocks, ProgramSpec& out);
+  void append_wires(std::vector<WireSpec>& wires, ProgramSpec& out);
   void parse_trace(const Value& v, TraceSpec& out);
   void parse_bridge(const Value& v, BridgeSpec& out);
   void parse_retain(const Value& v, RetainSpec& out);
@@ -112,6 +143,8 @@ class Parser {
   }
 
   Reader r_;
+  DiagnosticSink& sink_;
+  IncludeState& inc_;
   // Cross-reference checks stay quiet when a section could not be read, to avoid cascades.
   bool task_names_complete_{true};
   bool task_programs_complete_{true};

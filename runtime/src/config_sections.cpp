@@ -208,7 +208,7 @@ void Parser::program_or_block_name(const MapView& m, const char* what, std::stri
 void Parser::parse_program(const Value& v, ProgramSpec& out) {
   out.loc = v.loc;
   out.name_loc = v.loc;
-  auto m = r_.map(v, {"name", "blocks", "wires"});
+  auto m = r_.map(v, {"name", "blocks", "wires", "include"});
   if (!m) {
     program_names_complete_ = false;
     return;
@@ -226,6 +226,9 @@ void Parser::parse_program(const Value& v, ProgramSpec& out) {
   }
   if (const Field* f = m->find("wires")) {
     parse_wires(f->value, out.wires);
+  }
+  if (const Field* f = m->find("include")) {  // after its own: appended (config_include.cpp)
+    parse_include(f->value, out);
   }
 }
 

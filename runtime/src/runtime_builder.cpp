@@ -570,7 +570,11 @@ class RuntimeBuilder {
 std::unique_ptr<Runtime> Runtime::build(const Config& cfg, const BlockRegistry& blocks,
                                         const DriverRegistry& drivers,
                                         const BuildOptions& options) {
-  return RuntimeBuilder(cfg, blocks, drivers, options).build();
+  try {
+    return RuntimeBuilder(cfg, blocks, drivers, options).build();
+  } catch (const ConfigError& e) {  // a wire of a fragment names its include (config_include)
+    throw ConfigError(with_include_notes(cfg, e.diagnostics()));
+  }
 }
 
 }  // namespace edm::rt

@@ -196,9 +196,10 @@ std::unique_ptr<rt::Runtime> build_drill_modbus_sim(int port) {
     modbus::register_modbus_driver(r.second);
     return r;
   }();
-  auto r =
-      rt::Runtime::build(rt::parse_config_text(drill_modbus_sim(port), "drill-modbus-sim.yaml"),
-                         registries.first, registries.second);
+  auto r = rt::Runtime::build(
+      rt::parse_config_text(drill_modbus_sim(port),
+                            std::string(EDM_SOURCE_DIR) + "/config/machines/drill-modbus-sim.yaml"),
+      registries.first, registries.second);
   r->machine().command(rt::MachineCommand::kPowerOn);
   return r;
 }

@@ -26,7 +26,8 @@ class OperatorOps : public ::testing::Test {
     if (!manual_params.empty()) {
       edm::test::replace_once(text, "manual: {}", "manual: {" + manual_params + "}");
     }
-    rt_ = edm::test::build_sim_machine(rt::parse_config_text(text, "drill-sim.yaml"));
+    rt_ = edm::test::build_sim_machine(rt::parse_config_text(
+        text, std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
     ServerOptions o;
     o.port = 0;
     o.token_file = dir_.file("op.token");

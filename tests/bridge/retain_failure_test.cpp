@@ -31,7 +31,10 @@ class RetainFailure : public ::testing::Test {
         std::string("variables: [") + kRetainedParam + ", io.electrode_length_mm,");
     rt::BuildOptions bo;
     bo.state_dir = dir_.path().string();
-    rt_ = edm::test::build_sim_machine(rt::parse_config_text(text, "drill-sim.yaml"), bo);
+    rt_ = edm::test::build_sim_machine(
+        rt::parse_config_text(text,
+                              std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"),
+        bo);
     ASSERT_NE(rt_->retain(), nullptr);
     rt_->machine().command(rt::MachineCommand::kPowerOn);
     ServerOptions o;

@@ -98,13 +98,14 @@ TEST(MachineTables, SameMessageForABadCondition) {
   const auto at = text.find(good);
   ASSERT_NE(at, std::string::npos);
   text.replace(at, good.size(), "polarity: plus, open_voltage_v: '100'");
-  const std::vector<std::string> rt = runtime_errors(text, "drill.yaml");
+  // Under its own path: its `include:` finds the fragment beside it.
+  const std::vector<std::string> rt = runtime_errors(text, path);
   ASSERT_EQ(rt.size(), 2u);
   EXPECT_NE(rt[0].find("conditions[0].polarity: must be one of negative, positive (got 'plus')"),
             std::string::npos);
   EXPECT_NE(rt[1].find("conditions[0].open_voltage_v: expected a number, got the string '100'"),
             std::string::npos);
-  EXPECT_EQ(hmi_errors(text, "drill.yaml"), rt);
+  EXPECT_EQ(hmi_errors(text, path), rt);
 }
 
 // Every bad config of tests/configs/bad whose fault is in machine.axes or conditions: the HMI's

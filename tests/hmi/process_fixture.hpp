@@ -88,7 +88,8 @@ class EdmhmiProcessTest : public ::testing::Test {
  protected:
   static constexpr const char* kSpeed = "20";
 
-  EdmhmiProcessTest() : dir_("edm-hmi-test") {}
+  // The fragments link: drill-sim.yaml edited into dir_ finds the fragments it includes.
+  EdmhmiProcessTest() : dir_("edm-hmi-test") { edm::test::link_machine_fragments(dir_.path()); }
 
   void TearDown() override {
     for (auto& p : children_) p->kill();

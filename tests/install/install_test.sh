@@ -61,6 +61,7 @@ else
   cat "$tmp/dpkg.log"; fail "dpkg --root R --unpack"
 fi
 for f in edmplc:/usr/bin/edmplc edmplc:/usr/share/edmplc/machines/drill-sim.yaml \
+    edmplc:/usr/share/edmplc/machines/fragments/drill-job-wiring.yaml \
     edmplc:/usr/lib/systemd/system/edmplc.service edmplc:/usr/share/doc/edmplc/deploy.md \
     edmplc:/usr/lib/udev/rules.d/60-edmplc.rules edmhmi:/usr/bin/edmhmi \
     edmhmi:/usr/share/edmplc/web/index.html edmhmi:/usr/lib/systemd/system/edmhmi.service; do

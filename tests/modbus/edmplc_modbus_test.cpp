@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "modbus/remote_io.hpp"
+#include "support/files.hpp"
 #include "support/subprocess.hpp"
 #include "support/temp_dir.hpp"
 
@@ -44,6 +45,7 @@ Mbpoll mbpoll(int port, const std::vector<std::string>& args) {
 std::string write_file(const TempDir& dir, const std::string& name, const std::string& text) {
   const std::string path = dir.file(name);
   std::ofstream(path) << text;
+  edm::test::link_machine_fragments(dir.path().string());  // drill-modbus-sim's `include:`
   return path;
 }
 

@@ -4,6 +4,7 @@
 // machine positions, the work's surface, edges and bore), never against the block's own numbers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -258,6 +259,56 @@ TEST(ManualMotion, TouchRefusedWhenAlreadyInContact) {
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error, ManualError::kAlreadyInContact);
 }
+
+// Issue 32: every shipped drill machine has the job's manual wires (one shared wiring,
+// config/machines/fragments/drill-job-wiring.yaml): it homes with incremental encoders and then
+// touches off the unknown surface, against the simulator's truth. drill-fuzzy-sim could do
+// neither before it included the wiring.
+class DrillMachineManual : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(DrillMachineManual, HomesAndTouchesOffTheSurface) {
+  OperatorRig m(kWork +
+                    ", encoder_offset_x_mm: 23.4, encoder_offset_y_mm: -11.2, "
+                    "encoder_offset_z_mm: 3.3",
+                "referenced_at_start: false, reference_required: true", 1, GetParam());
+  EXPECT_FALSE(m.manual().may_run_programs());
+  const double x0 = m.truth().machine_x_mm, y0 = m.truth().machine_y_mm;
+  const double z0 = m.truth().machine_z_mm;  // 3 mm above the surface
+  const rt::ManualResult homed = m.home();
+  ASSERT_TRUE(homed.ok) << rt::to_string(homed.error);
+  EXPECT_EQ(m.manual().referenced(), 0x7);
+  EXPECT_TRUE(m.manual().may_run_programs());
+  m.run_for(20ms);
+  EXPECT_NEAR(m.read("io.x_mm"), m.truth().machine_x_mm, 0.004);
+  EXPECT_NEAR(m.read("io.y_mm"), m.truth().machine_y_mm, 0.004);
+  EXPECT_NEAR(m.read("io.z_mm"), m.truth().machine_z_mm, 0.004);
+  // Back over the work from the switches (the readings are machine coordinates now), then
+  // touch: the surface it finds is the simulator's.
+  const auto jog_to = [&m](int axis, const char* pin, double target) {  // 10 mm a jog at most
+    for (int i = 0; i < 20 && std::abs(target - m.read(pin)) > 1e-3; ++i) {
+      if (!m.jog(axis, std::clamp(target - m.read(pin), -10.0, 10.0)).ok) return false;
+    }
+    return std::abs(target - m.read(pin)) <= 1e-3;
+  };
+  ASSERT_TRUE(jog_to(0, "io.x_mm", x0));
+  ASSERT_TRUE(jog_to(1, "io.y_mm", y0));
+  ASSERT_TRUE(jog_to(2, "io.z_mm", z0));
+  EXPECT_NEAR(m.truth().machine_z_mm, z0, 0.01);
+  const rt::ManualResult touched = m.touch(TouchTarget::kZ);
+  ASSERT_TRUE(touched.ok) << rt::to_string(touched.error);
+  EXPECT_NEAR(touched.z, kSurfaceZ, 0.005);
+  m.run_for(10ms);
+  EXPECT_FALSE(m.read("io.contact") != 0.0);
+  EXPECT_EQ(m.truth().pulses, 0U);  // the generator never on
+  EXPECT_EQ(m.runtime->machine().state(), rt::MachineState::kReady);
+}
+
+INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachineManual,
+                         ::testing::Values("drill-sim", "drill-fuzzy-sim"),
+                         [](const ::testing::TestParamInfo<const char*>& p) {
+                           return std::string(p.param) == "drill-sim" ? "DrillSim"
+                                                                      : "DrillFuzzySim";
+                         });
 
 }  // namespace
 }  // namespace edm::test

@@ -30,15 +30,24 @@ struct OperatorRig {
   rt::TimePoint now{};
 
   /// `sim_params`: extra simulator parameters ("work_surface_z_mm: -7.3, …"); `manual`: the
-  /// job's manual child's parameters ("referenced_at_start: false, …").
-  OperatorRig(const std::string& sim_params, const std::string& manual, int seed = 1) {
-    std::string text = read_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
+  /// job's manual child's parameters ("referenced_at_start: false, …"); `machine`: a drill
+  /// machine of config/machines/ (its job block `job`, EdmJob).
+  OperatorRig(const std::string& sim_params, const std::string& manual, int seed = 1,
+              const std::string& machine = "drill-sim") {
+    const std::string dir = std::string(EDM_SOURCE_DIR) + "/config/machines/";
+    std::string text = read_file(dir + machine + ".yaml");
     replace_once(text, "params: {preset: drill, seed: 1, wall_sparks: true}",
                  "params: {preset: drill, seed: 1, wall_sparks: true" +
                      (sim_params.empty() ? std::string() : ", " + sim_params) + "}");
-    replace_once(text, "manual: {}", "manual: {" + manual + "}");
-    runtime =
-        build_sim_machine(rt::parse_config_text(text, "drill-sim-operator.yaml"), seeded(seed));
+    if (text.find("manual: {}") != std::string::npos) {
+      replace_once(text, "manual: {}", "manual: {" + manual + "}");
+    } else {  // a job with no parameters (drill-fuzzy-sim)
+      replace_once(text, "{name: job, type: EdmJob}",
+                   "{name: job, type: EdmJob, params: {manual: {" + manual + "}}}");
+    }
+    // Parsed as if beside the shipped machines, so that their fragments are found.
+    runtime = build_sim_machine(rt::parse_config_text(text, dir + machine + "-operator.yaml"),
+                                seeded(seed));
     runtime->machine().command(rt::MachineCommand::kPowerOn);
     std::vector<rt::Task*> tasks;
     for (const auto& t : runtime->tasks()) {

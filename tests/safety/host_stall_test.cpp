@@ -50,16 +50,17 @@ Outcome run_200_ms(SafetyRig& m) {
 
 TEST(HostStall, TheShippedSimulatedMachinesTolerateHostStallsAndTheDefaultIsFault) {
   for (const char* name : {"drill-sim", "sink-sim", "wire-sim"}) {
-    const rt::Config cfg = rt::parse_config_text(shipped_config(name), name);
+    const rt::Config cfg = rt::parse_config_text(shipped_config(name), shipped_path(name));
     for (const rt::TaskSpec& t : cfg.tasks) {
       EXPECT_EQ(t.watchdog.host_stall, rt::HostStallPolicy::kTolerate) << name << " " << t.name;
     }
   }
-  const rt::Config real =
-      rt::parse_config_text(edited(shipped_config("drill-sim"), kTolerate, kDefault), "real");
+  const rt::Config real = rt::parse_config_text(
+      edited(shipped_config("drill-sim"), kTolerate, kDefault), shipped_path("real"));
   EXPECT_EQ(real.tasks[0].watchdog.host_stall, rt::HostStallPolicy::kFault);
   try {
-    rt::parse_config_text(edited(shipped_config("drill-sim"), "tolerate}", "ignore}"), "bad.yaml");
+    rt::parse_config_text(edited(shipped_config("drill-sim"), "tolerate}", "ignore}"),
+                          shipped_path("bad"));
     ADD_FAILURE() << "host_stall: ignore accepted";
   } catch (const rt::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("tasks[0].watchdog.host_stall: must be one of fault, "

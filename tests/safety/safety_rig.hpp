@@ -35,6 +35,11 @@ inline std::string shipped_config(const std::string& name) {
   return ss.str();
 }
 
+/// A path beside the shipped machines: text parsed under it finds their fragments (`include:`).
+inline std::string shipped_path(const std::string& name) {
+  return std::string(EDM_SOURCE_DIR) + "/config/machines/" + name + ".yaml";
+}
+
 /// `text` with `from` replaced by `to` exactly once (a test failure otherwise).
 inline std::string edited(std::string text, const std::string& from, const std::string& to) {
   const std::size_t at = text.find(from);
@@ -50,7 +55,7 @@ struct SafetyRig {
   rt::TimePoint t{};
   std::vector<rt::Alarm> seen;
 
-  explicit SafetyRig(const std::string& yaml, const std::string& path = "rig.yaml") {
+  explicit SafetyRig(const std::string& yaml, const std::string& path = shipped_path("rig")) {
     static const auto registries = [] {
       std::pair<rt::BlockRegistry, rt::DriverRegistry> r;
       blocks::register_builtin_blocks(r.first);

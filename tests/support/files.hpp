@@ -28,6 +28,22 @@ inline void write_file(const std::string& path, const std::string& bytes) {
   out << bytes;
 }
 
+#ifdef EDM_SOURCE_DIR
+/// Makes `dir`/fragments a link to config/machines/fragments: a shipped machine's config written
+/// (edited) into `dir` then finds the fragments it includes (docs/config.md "Fragments").
+inline void link_machine_fragments(const std::string& dir) {
+  const std::filesystem::path link = std::filesystem::path(dir) / "fragments";
+  std::error_code ec;
+  if (!std::filesystem::exists(link, ec)) {
+    std::filesystem::create_directory_symlink(
+        std::filesystem::path(EDM_SOURCE_DIR) / "config/machines/fragments", link, ec);
+  }
+  if (ec) {
+    throw std::runtime_error("cannot link " + link.string() + ": " + ec.message());
+  }
+}
+#endif
+
 #ifdef EDM_TEST_DATA_DIR
 /// The text of tests/data/<name> with each `{{key}}` in it replaced by its value: for configs that
 /// several tests share or that differ only in a few values. Throws when the file is missing or

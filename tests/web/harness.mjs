@@ -8,7 +8,7 @@
 // machine time: 500 ms of wall time, what the default is on a real clock, and the figure the
 // dead-man tests measure against.
 import { spawn } from 'node:child_process';
-import { mkdtempSync, readFileSync, writeFileSync, chmodSync, mkdirSync } from 'node:fs';
+import { mkdtempSync, readFileSync, writeFileSync, chmodSync, mkdirSync, symlinkSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -68,6 +68,8 @@ export function makeMachine() {
   const withDeadman = withTokens.replace('manual: {}', `manual: {deadman: ${DEADMAN_MS}ms}`);
   if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob manual: {}');
   writeFileSync(config, withDeadman);
+  // The copy includes the machines' fragments (docs/config.md "Fragments"): link them beside it.
+  symlinkSync(join(ROOT, 'config/machines/fragments'), join(dir, 'fragments'));
   return { dir, tokens, op, vw, config, procs: [] };
 }
 

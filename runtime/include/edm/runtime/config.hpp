@@ -51,6 +51,8 @@ struct WireSpec {
   SourceLoc source_loc;
 };
 
+/// A program's blocks and wires are its own followed by those of the fragments it includes
+/// (`include:`, docs/config.md "Fragments"), in include order; each keeps its own file's location.
 struct ProgramSpec {
   std::string name;
   std::vector<BlockSpec> blocks;
@@ -218,8 +220,16 @@ struct RetainSpec {
   SourceLoc file_loc;  // of the `file:` value, for problems with the path itself
 };
 
+/// A fragment read through `include:`: the file as its locations name it, and the note appended
+/// to every message located in it, e.g. "included from config/machines/drill-sim.yaml:74:14".
+struct IncludedFile {
+  std::string file;
+  std::string note;
+};
+
 struct Config {
   std::string path;
+  std::vector<IncludedFile> includes;  // in the order they were read
   int version{1};
   MachineSpec machine;
   std::vector<ConditionSpec> conditions;
@@ -240,9 +250,15 @@ struct Config {
 /// The conditions and soft limits in the form part programs are checked against (machining/).
 machining::MachineTables to_machine_tables(const Config& cfg);
 
+/// Puts the diagnostics in file order (the config's own file, then its fragments in the order
+/// read; line, column within each) and appends "(included from F:L:C)" to those located in a
+/// fragment. parse_config_*() and Runtime::build() do this; for errors found later.
+std::vector<Diagnostic> with_include_notes(const Config& cfg, std::vector<Diagnostic> diags);
+
 /// Reads and checks a config file. Throws ConfigError listing every problem (file:line:col).
 Config parse_config_file(const std::string& path);
-/// Same, from text (path is used in messages only).
+/// Same, from text (`path` names it in messages, and fragments it includes are found relative to
+/// its directory).
 Config parse_config_text(const std::string& text, const std::string& path);
 
 }  // namespace edm::rt
