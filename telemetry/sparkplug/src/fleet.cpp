@@ -175,8 +175,11 @@ std::vector<std::pair<std::string, std::string>> FleetTable::take_rebirth_reques
 
 std::vector<FleetMachine> FleetTable::machines() const {
   std::vector<FleetMachine> out;
-  for (const auto& [key, n] : nodes_) {
-    const auto fill = [&, &k = key](FleetMachine m) {
+  for (const auto& entry : nodes_) {
+    const auto& key = entry.first;
+    const auto& n = entry.second;  // not a structured binding: clang 14 cannot capture those
+    const auto fill = [&](FleetMachine m) {
+      const auto& k = key;
       m.group = k.first;
       m.node = k.second;
       m.bdseq = n.bdseq;
