@@ -348,10 +348,12 @@ TEST_F(Bridge, auto_reconnect_after_the_server_drops_the_session) {
   ServerOptions o;
   o.read_timeout = 300ms;  // the server closes idle sessions fast
   start(o);
-  Client c;
+  // Declared before the client, so they outlive it: its thread calls the handler (down) while
+  // the client closes at the end of the test.
   std::mutex mu;
   std::condition_variable cv;
   int ups = 0;
+  Client c;
   c.set_connection_handler([&](bool up) {
     std::lock_guard lock(mu);
     ups += up ? 1 : 0;

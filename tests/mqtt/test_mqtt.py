@@ -270,8 +270,10 @@ class Flood(MqttCase):
         # The forged audit line is inside the quotes of a refusal, never a line of its own.
         self.assertFalse([l for l in added.splitlines() if l.startswith("[2025-01-01")])
         self.assertTrue(any('"p.level.k\\x0a[2025-01-01' in l for l in lines), lines[:3])
-        # Memory: libmosquitto reads one message at a time; nothing is kept or decoded.
-        self.assertLess(hwm - rss_before, 48 << 10, (rss_before, hwm))
+        # Memory: libmosquitto reads one message at a time; nothing is kept or decoded. Not under
+        # a sanitizer: its allocator keeps freed blocks in quarantine (256 MB by default).
+        if not os.environ.get("EDM_UNDER_SANITIZER"):
+            self.assertLess(hwm - rss_before, 48 << 10, (rss_before, hwm))
         with open(stats) as f:
             tasks = json.load(f)["tasks"]
         self.assertEqual([t["overruns"] for t in tasks], [0] * len(tasks), tasks)
