@@ -39,15 +39,15 @@ namespace fs = std::filesystem;
 namespace soak = edm::bench::soak;
 using edm::bench::read_file;
 using edm::bench::run_child;
-using soak::jobs_at_depth;
 using soak::JobRecord;
+using soak::jobs_at_depth;
 using soak::mem_figures;
+using soak::MemFigures;
 using soak::memory_report;
 using soak::mib;
-using soak::write_samples;
-using soak::MemFigures;
 using soak::Phase;
 using soak::TaskStats;
+using soak::write_samples;
 using Json = nlohmann::json;
 using namespace std::chrono_literals;
 
