@@ -102,16 +102,16 @@ void DeepHoleDrill::bind_self() {
   gap_.td_us.connect(td_.td_us);
   gap_.valid.connect(td_.valid);
   gap_.tdr_us.follow(tdr_us);
-  wear_.vz_in_mm_s.connect(vz_servo_cmd_mm_s);
+  wear_.vz_in_mm_s.claim();
   wear_.wear_ratio.follow(wear_ratio);
   wear_.area_ratio.follow(area_ratio);
   wear_.enable.follow(enable_wear_comp);
-  wear_.reset_wear.connect(reset_wear);
+  wear_.reset_wear.claim();
   retract_.z_mm.follow(z_mm);
-  retract_.short_detected.connect(short_now);
-  retract_.enable.connect(retract_enable);
+  retract_.short_detected.claim();
+  retract_.enable.claim();
   zloop_.x_ref_mm.connect(retract_.z_sp_mm);
-  zloop_.v_ff_mm_s.connect(retract_vff_mm_s);
+  zloop_.v_ff_mm_s.claim();
   zloop_.x_mm.follow(z_mm);
   zloop_.enable.connect(retract_.active);
 }
@@ -124,8 +124,8 @@ void DeepHoleDrill::activate_self() noexcept {
   target_depth_mm_ = params_.depth_default_mm;
   retract_to_z_mm_ = 0.0;
   safe_retract_ = false;
-  reset_wear.set(false);
-  vz_servo_cmd_mm_s.set(0.0);
+  wear_.reset_wear.drive(false);
+  wear_.vz_in_mm_s.drive(0.0);
   vz_cmd_mm_s.set(0.0);
   gen_on.set(false);
   depth_reached_mm.set(0.0);
@@ -135,8 +135,8 @@ void DeepHoleDrill::activate_self() noexcept {
   gap_short.set(false);
   cycle_short.set(false);
   short_now.set(false);
-  retract_enable.set(false);
-  retract_vff_mm_s.set(0.0);
+  retract_.enable.drive(false);
+  zloop_.v_ff_mm_s.drive(0.0);
   short_retracts.set(0);
   short_time_s.set(0.0);
   guard_.reset();
@@ -190,7 +190,7 @@ void DeepHoleDrill::begin_retract(double target_z) noexcept {
 
 void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcept {
   gen_on.set(false);
-  retract_enable.set(false);
+  retract_.enable.drive(false);
   if (state_value_ == State::kDrill && request.cause == rt::AlarmCode::kShortCircuit) {
     begin_retract(z_mm.get() + params_.short_backoff_mm);  // back off, then hold
     safe_retract_ = true;
@@ -210,36 +210,26 @@ void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcep
 
 bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
                                  rt::BlockStatus& status) noexcept {
-  retract_enable.set(true);
-  gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
-  cycle_short.set(ShortGuard::cycle_reads_short(td_, params_.shorts));
-  short_now.set(gap_short.get() || cycle_short.get());
-  status = rt::worst(status, step(retract_, ctx));
-  const bool active = retract_.active.get();
-  switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
-    case ShortGuard::Event::kNone:
-      break;
-    case ShortGuard::Event::kRetract:
-      short_retracts.set(short_retracts.get() + 1);
-      break;
-    case ShortGuard::Event::kBudgetSpent:
-      // Alarm 150: the machine goes to FAULT; the safe state backs Z off and holds.
-      if (machine_ != nullptr) {
-        guard_.raise_alarm(*machine_, ctx.release, source_);
-      } else {
-        safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
-      }
-      break;
+  const ShortStep s = guard_.step(ctx, td_, retract_, params_.shorts, machine_, source_,
+                                  [&](rt::Block& child) { return step(child, ctx); });
+  gap_short.set(s.gap_short);
+  cycle_short.set(s.cycle_short);
+  short_now.set(s.short_now);
+  status = rt::worst(status, s.status);
+  if (s.retract_began) short_retracts.set(short_retracts.get() + 1);
+  // Alarm 150 without a machine (a unit test): this block backs Z off and holds itself.
+  if (s.budget_spent && machine_ == nullptr) {
+    safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
   }
-  if (active || retract_.v_scale.get() < 1.0) {
+  if (s.retracting || retract_.v_scale.get() < 1.0) {
     short_time_s.set(short_time_s.get() + ctx.dt_s);
   }
-  if (!active) {
+  if (!s.retracting) {
     last_z_sp_mm_ = z;
     return false;
   }
   const double sp = retract_.z_sp_mm.get();
-  retract_vff_mm_s.set(ctx.dt_s > 0.0 ? (sp - last_z_sp_mm_) / ctx.dt_s : 0.0);
+  zloop_.v_ff_mm_s.drive(ctx.dt_s > 0.0 ? (sp - last_z_sp_mm_) / ctx.dt_s : 0.0);
   last_z_sp_mm_ = sp;
   status = rt::worst(status, step(zloop_, ctx));
   return true;
@@ -286,7 +276,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     spark_cycles_ = pulses.td_count.get() > 0 || shorted ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
       touch_z_mm.set(measured_ ? contact_z_mm_ : resume_ ? resume_touch_z_mm_ : z);
-      reset_wear.set(true);  // the wear estimate starts at the touch
+      wear_.reset_wear.drive(true);  // the wear estimate starts at the touch
       set_state(State::kDrill);
     } else {
       gen_on.set(true);
@@ -308,7 +298,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     // Measured: likewise until the front is back one working gap above the measured bottom
     // (it touched contact_offset_um lower than that).
     const bool above_bottom = measured_ && (contact_z_mm_ - z) < -params_.contact_offset_um * 1e-3;
-    if (above_done || above_bottom) reset_wear.set(true);
+    if (above_done || above_bottom) wear_.reset_wear.drive(true);
     if (!retracting) {
       // The servo's command into the wear compensator: the gap child's Vz, or the external
       // servo's clamped to the gap child's limits; ramped back in after a retract (v_scale
@@ -326,9 +316,9 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
       }
       v *= retract_.v_scale.get();
       v = std::max(v, -gap_.params().v_feed_max_mm_s * feed_scale());  // the override's cap
-      vz_servo_cmd_mm_s.set(feed_stopped() ? std::max(v, 0.0) : v);
+      wear_.vz_in_mm_s.drive(feed_stopped() ? std::max(v, 0.0) : v);
       status = rt::worst(status, step(wear_, ctx));
-      reset_wear.set(false);
+      wear_.reset_wear.drive(false);
     }
     // The electrode front is z − accumulated wear: the compensated axis travels further than the
     // front by the length the compensator has added for the wear, so the front has gone
@@ -363,8 +353,8 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     cycle_short.set(false);  // the generator is off: no pulses of this program's
     short_now.set(false);
   }
-  if (state_value_ != State::kDrill && retract_enable.get()) {
-    retract_enable.set(false);  // the history is the path of this hole's DRILL only
+  if (state_value_ != State::kDrill && retract_.enable.driven()) {
+    retract_.enable.drive(false);  // the history is the path of this hole's DRILL only
     status = rt::worst(status, step(retract_, ctx));
   }
 

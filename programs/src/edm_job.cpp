@@ -39,26 +39,6 @@ void EdmJobParams::visit(rt::ParamVisitor& v) {
           {.unit = "s",
            .description = "generator-off wait when a condition changes the polarity",
            .range = r::kSettleS});
-  v.param("probe_depth", probe_depth,
-          {.description = "measure a blind hole's depth by touch (bottom and surface) and drill "
-                          "the rest from the measurement"});
-  v.param("probe_margin_mm", probe_margin_mm,
-          {.unit = "mm",
-           .description = "the first drilling stops this much short of the depth (more than "
-                          "the wear estimate's error)",
-           .range = rt::open_closed(0.0, 5.0)});
-  v.param("probe_dx_mm", probe_dx_mm,
-          {.unit = "mm",
-           .description = "X of the surface touch relative to the hole (on the work)",
-           .range = rt::closed(-100.0, 100.0)});
-  v.param("probe_dy_mm", probe_dy_mm,
-          {.unit = "mm",
-           .description = "Y of the surface touch relative to the hole (on the work)",
-           .range = rt::closed(-100.0, 100.0)});
-  v.param("probe_clear_mm", probe_clear_mm,
-          {.unit = "mm",
-           .description = "a probe touch starts this far above the expected contact",
-           .range = rt::open_closed(0.0, 5.0)});
 }
 
 EdmJob::EdmJob()
@@ -69,7 +49,10 @@ EdmJob::EdmJob()
       px_(add_child<blocks::PositionLoop>("px")),
       py_(add_child<blocks::PositionLoop>("py")),
       pz_(add_child<blocks::PositionLoop>("pz")),
-      manual_(add_child<ManualMotion>("manual")) {}
+      manual_(add_child<ManualMotion>("manual")),
+      probe_(add_child<DepthProbe>("probe")),
+      axes_(add_child<AxisArbiter>("axes")),
+      cycles_{&drill_, &finish_} {}
 
 std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) {
   std::vector<rt::ParamError> errs;
@@ -98,69 +81,72 @@ void EdmJob::bind_self() {
   pulses.feed(drill_.pulses);
   pulses.feed(finish_.pulses);
   drill_.z_mm.follow(z_mm);
-  drill_.start.connect(drill_start);
-  drill_.depth_mm.connect(drill_depth_mm);
-  drill_.depth_done_mm.connect(drill_depth_done_mm);
-  drill_.resume_touch_z_mm.connect(drill_resume_touch_z_mm);
-  drill_.resume_wear_mm.connect(drill_resume_wear_mm);
-  drill_.contact_z_mm.connect(drill_contact_z_mm);
-  drill_.contact_depth_mm.connect(drill_contact_depth_mm);
-  manual_.enable.connect(manual_enable);
   manual_.x_mm.follow(x_mm);
   manual_.y_mm.follow(y_mm);
   manual_.z_mm.follow(z_mm);
-  drill_.wear_ratio.connect(wear_ratio);
-  drill_.area_ratio.connect(area_ratio);
-  drill_.tdr_us.connect(tdr_us);
-  drill_.hold.connect(feed_hold);
-  finish_.hold.connect(feed_hold);  // one hold for either child
   finish_.x_mm.follow(x_mm);
   finish_.y_mm.follow(y_mm);
-  finish_.start.connect(finish_start);
-  finish_.final_offset_mm.connect(finish_final_offset_mm);
-  finish_.start_offset_mm.connect(finish_start_offset_mm);
-  finish_.feed_mm_min.connect(finish_feed_mm_min);
-
-  lin_.start.connect(lin_start);
-  lin_.hold.connect(lin_hold);
-  lin_.load.connect(lin_load);
-  lin_.load_x_mm.connect(move_from_x_mm);
-  lin_.load_y_mm.connect(move_from_y_mm);
-  lin_.load_z_mm.connect(move_from_z_mm);
-  lin_.lx_mm.connect(lin_lx_mm);
-  lin_.ly_mm.connect(lin_ly_mm);
-  lin_.lz_mm.connect(lin_lz_mm);
-  lin_.feed_mm_min.connect(lin_feed_mm_min);
-  lin_.feed_override.connect(lin_override);
-  arc_.start.connect(arc_start);
-  arc_.hold.connect(arc_hold);
-  arc_.load.connect(arc_load);
-  arc_.load_x_mm.connect(move_from_x_mm);
-  arc_.load_y_mm.connect(move_from_y_mm);
-  arc_.cw.connect(arc_cw);
-  arc_.full_circle.connect(arc_full_circle);
-  arc_.turns.connect(arc_turns);
-  arc_.i_mm.connect(arc_i_mm);
-  arc_.j_mm.connect(arc_j_mm);
-  arc_.ex_mm.connect(arc_ex_mm);
-  arc_.ey_mm.connect(arc_ey_mm);
-  arc_.feed_mm_min.connect(arc_feed_mm_min);
-  arc_.feed_override.connect(feed_override);
-  drill_.feed_override.connect(feed_override);
-  finish_.feed_override.connect(feed_override);
-
-  px_.x_ref_mm.connect(x_ref_mm);
-  py_.x_ref_mm.connect(y_ref_mm);
-  pz_.x_ref_mm.connect(z_ref_mm);
-  px_.v_ff_mm_s.connect(vx_ff_mm_s);
-  py_.v_ff_mm_s.connect(vy_ff_mm_s);
-  pz_.v_ff_mm_s.connect(vz_ff_mm_s);
   px_.x_mm.follow(x_mm);
   py_.x_mm.follow(y_mm);
   pz_.x_mm.follow(z_mm);
-  for (blocks::PositionLoop* loop : {&px_, &py_, &pz_}) {
-    loop->enable.connect(loop_enable);
+  // The axes: manual motion and the loops by wire, the cycles' claims driven (command_axes()).
+  axes_.manual.connect(manual_.active);
+  axes_.manual_vx_mm_s.connect(manual_.vx_cmd_mm_s);
+  axes_.manual_vy_mm_s.connect(manual_.vy_cmd_mm_s);
+  axes_.manual_vz_mm_s.connect(manual_.vz_cmd_mm_s);
+  axes_.loop_vx_mm_s.connect(px_.v_cmd_mm_s);
+  axes_.loop_vy_mm_s.connect(py_.v_cmd_mm_s);
+  axes_.loop_vz_mm_s.connect(pz_.v_cmd_mm_s);
+  // Everything else a child reads is driven by the sequence (Input::drive), as an IEC 61131-3
+  // FB call passes its parameters: no output of this block exists only to feed a child.
+  for (rt::Input<bool>* in :
+       {&drill_.start, &drill_.hold, &finish_.start, &finish_.hold, &manual_.enable, &lin_.start,
+        &lin_.hold, &lin_.load, &arc_.start, &arc_.hold, &arc_.load, &arc_.cw, &arc_.full_circle,
+        &px_.enable, &py_.enable, &pz_.enable, &axes_.cycle_x, &axes_.cycle_y, &axes_.cycle_z}) {
+    in->claim();
   }
+  for (rt::Input<double>* in : {&drill_.depth_mm,
+                                &drill_.depth_done_mm,
+                                &drill_.resume_touch_z_mm,
+                                &drill_.resume_wear_mm,
+                                &drill_.contact_z_mm,
+                                &drill_.contact_depth_mm,
+                                &drill_.wear_ratio,
+                                &drill_.area_ratio,
+                                &drill_.tdr_us,
+                                &finish_.final_offset_mm,
+                                &finish_.start_offset_mm,
+                                &finish_.feed_mm_min,
+                                &lin_.load_x_mm,
+                                &lin_.load_y_mm,
+                                &lin_.load_z_mm,
+                                &lin_.lx_mm,
+                                &lin_.ly_mm,
+                                &lin_.lz_mm,
+                                &lin_.feed_mm_min,
+                                &arc_.load_x_mm,
+                                &arc_.load_y_mm,
+                                &arc_.i_mm,
+                                &arc_.j_mm,
+                                &arc_.ex_mm,
+                                &arc_.ey_mm,
+                                &arc_.feed_mm_min,
+                                &px_.x_ref_mm,
+                                &py_.x_ref_mm,
+                                &pz_.x_ref_mm,
+                                &px_.v_ff_mm_s,
+                                &py_.v_ff_mm_s,
+                                &pz_.v_ff_mm_s,
+                                &axes_.cycle_vx_mm_s,
+                                &axes_.cycle_vy_mm_s,
+                                &axes_.cycle_vz_mm_s}) {
+    in->claim();
+  }
+  for (rt::Input<double>* in :
+       {&drill_.feed_override, &finish_.feed_override, &arc_.feed_override, &lin_.feed_override}) {
+    in->claim(1.0);
+  }
+  arc_.turns.claim();
 }
 
 void EdmJob::activate_self() noexcept {
@@ -179,21 +165,37 @@ void EdmJob::activate_self() noexcept {
   rotation_on.set(false);
   state.set(0);
   jobs_finished.set(0);
-  set_probe(0);
-  probe_moving_ = false;
-  probe_failures.set(0);
-  measured_depth_mm.set(0.0);
+}
+
+rt::BlockStatus EdmJob::command_axes(const rt::CycleContext& ctx) noexcept {
+  AxisClaim claim;
+  for (const MachiningCycle* c : cycles_) {
+    if (!c->running()) continue;
+    const AxisClaim a = c->axes();
+    if (a.x && !claim.x) claim.x = true, claim.vx_mm_s = a.vx_mm_s;
+    if (a.y && !claim.y) claim.y = true, claim.vy_mm_s = a.vy_mm_s;
+    if (a.z && !claim.z) claim.z = true, claim.vz_mm_s = a.vz_mm_s;
+  }
+  axes_.cycle_x.drive(claim.x);
+  axes_.cycle_y.drive(claim.y);
+  axes_.cycle_z.drive(claim.z);
+  axes_.cycle_vx_mm_s.drive(claim.vx_mm_s);
+  axes_.cycle_vy_mm_s.drive(claim.vy_mm_s);
+  axes_.cycle_vz_mm_s.drive(claim.vz_mm_s);
+  return step(axes_, ctx);
+}
+
+void EdmJob::set_hold(bool hold) noexcept {
+  drill_.hold.drive(hold);
+  finish_.hold.drive(hold);  // one hold for either cycle
 }
 
 void EdmJob::stop_outputs() noexcept {
-  vx_cmd_mm_s.set(0.0);
-  vy_cmd_mm_s.set(0.0);
-  vz_cmd_mm_s.set(0.0);
   gen_on.set(false);
-  drill_start.set(false);
-  finish_start.set(false);
-  lin_start.set(false);
-  arc_start.set(false);
+  drill_.start.drive(false);
+  finish_.start.drive(false);
+  lin_.start.drive(false);
+  arc_.start.drive(false);
 }
 
 void EdmJob::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
@@ -213,15 +215,14 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
     manual_.abort_job_touch();
   }
   drill_returning_ = false;
-  set_probe(0);
-  probe_moving_ = false;
+  probe_.stop();
   if (outcome == rt::JobOutcome::kFinished) jobs_finished.set(jobs_finished.get() + 1);
   state_value_ = State::kIdle;
   state.set(0);
   step_ = Step::kEnter;
-  drill_start.set(false);
-  feed_hold.set(false);
-  finish_start.set(false);
+  drill_.start.drive(false);
+  set_hold(false);
+  finish_.start.drive(false);
   gen_arm.set(false);
   gen_on.set(false);
 }
@@ -233,9 +234,9 @@ void EdmJob::select_condition(int e) noexcept {
   on_time_us.set(condition_->on_time_us);
   off_time_us.set(condition_->off_time_us);
   servo_ref_v.set(condition_->servo_ref_v);
-  wear_ratio.set(condition_->wear_ratio);
-  area_ratio.set(condition_->area_ratio);
-  tdr_us.set(condition_->tdr_us);
+  drill_.wear_ratio.drive(condition_->wear_ratio);
+  drill_.area_ratio.drive(condition_->area_ratio);
+  drill_.tdr_us.drive(condition_->tdr_us);
 }
 
 bool EdmJob::in_position() const noexcept {
@@ -244,107 +245,114 @@ bool EdmJob::in_position() const noexcept {
 }
 
 void EdmJob::set_reference(double x, double y, double z, double vx, double vy, double vz) noexcept {
-  x_ref_mm.set(x);
-  y_ref_mm.set(y);
-  z_ref_mm.set(z);
-  vx_ff_mm_s.set(vx);
-  vy_ff_mm_s.set(vy);
-  vz_ff_mm_s.set(vz);
+  px_.x_ref_mm.drive(x);
+  py_.x_ref_mm.drive(y);
+  pz_.x_ref_mm.drive(z);
+  px_.v_ff_mm_s.drive(vx);
+  py_.v_ff_mm_s.drive(vy);
+  pz_.v_ff_mm_s.drive(vz);
 }
 
 void EdmJob::hold_position() noexcept { set_reference(hold_x_, hold_y_, hold_z_, 0.0, 0.0, 0.0); }
 
 void EdmJob::set_move_from() noexcept {
-  move_from_x_mm.set(hold_valid_ ? hold_x_ : x_mm.get());
-  move_from_y_mm.set(hold_valid_ ? hold_y_ : y_mm.get());
-  move_from_z_mm.set(hold_valid_ ? hold_z_ : z_mm.get());
+  move_from_x_ = hold_valid_ ? hold_x_ : x_mm.get();
+  move_from_y_ = hold_valid_ ? hold_y_ : y_mm.get();
+  move_from_z_ = hold_valid_ ? hold_z_ : z_mm.get();
+  lin_.load_x_mm.drive(move_from_x_);
+  lin_.load_y_mm.drive(move_from_y_);
+  lin_.load_z_mm.drive(move_from_z_);
+  arc_.load_x_mm.drive(move_from_x_);
+  arc_.load_y_mm.drive(move_from_y_);
 }
 
 bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                         rt::BlockStatus& status) noexcept {
   if (step_ == Step::kEnter) {  // sync the interpolator to where the move starts
     set_move_from();
-    lin_load.set(true);
+    lin_.load.drive(true);
     status = rt::worst(status, step(lin_, ctx));
     step_ = Step::kLoad;
     hold_position();
     return false;
   }
   if (step_ == Step::kLoad) {
-    lin_load.set(false);
-    lin_lx_mm.set(b.target.x - move_from_x_mm.get());
-    lin_ly_mm.set(b.target.y - move_from_y_mm.get());
-    lin_lz_mm.set(b.target.z - move_from_z_mm.get());
+    lin_.load.drive(false);
+    lin_.lx_mm.drive(b.target.x - move_from_x_);
+    lin_.ly_mm.drive(b.target.y - move_from_y_);
+    lin_.lz_mm.drive(b.target.z - move_from_z_);
     const double f = b.kind == MotionKind::kRapid
                          ? params_.rapid_speed_mm_s
                          : (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s);
-    lin_feed_mm_min.set(f * 60.0);
-    lin_start.set(true);
+    lin_.feed_mm_min.drive(f * 60.0);
+    lin_.start.drive(true);
     step_ = Step::kBusy;
   } else {
-    lin_start.set(false);
+    lin_.start.drive(false);
   }
-  lin_hold.set(hold);
+  lin_.hold.drive(hold);
   // Rapids are never sped beyond their programmed speed (the loops' margin is sized for it).
-  lin_override.set(b.kind == MotionKind::kRapid ? std::min(feed_override.get(), 1.0)
-                                                : feed_override.get());
+  lin_.feed_override.drive(b.kind == MotionKind::kRapid ? std::min(feed_override_, 1.0)
+                                                        : feed_override_);
   status = rt::worst(status, step(lin_, ctx));
   set_reference(lin_.rx_mm.get(), lin_.ry_mm.get(), lin_.rz_mm.get(), lin_.vx_mm_s.get(),
                 lin_.vy_mm_s.get(), lin_.vz_mm_s.get());
   hold_x_ = lin_.rx_mm.get();
   hold_y_ = lin_.ry_mm.get();
   hold_z_ = lin_.rz_mm.get();
-  return step_ == Step::kBusy && lin_.done.get() && !lin_start.get() && in_position();
+  return step_ == Step::kBusy && lin_.done.get() && !lin_.start.driven() && in_position();
 }
 
 bool EdmJob::run_arc(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                      rt::BlockStatus& status) noexcept {
   if (step_ == Step::kEnter) {
     set_move_from();
-    arc_load.set(true);
+    arc_.load.drive(true);
     status = rt::worst(status, step(arc_, ctx));
     step_ = Step::kLoad;
     hold_position();
     return false;
   }
   if (step_ == Step::kLoad) {
-    const double x = move_from_x_mm.get(), y = move_from_y_mm.get();
-    arc_load.set(false);
-    arc_cw.set(b.kind == MotionKind::kArcCw);
-    arc_i_mm.set(b.centre.x - x);
-    arc_j_mm.set(b.centre.y - y);
-    arc_ex_mm.set(b.target.x - x);
-    arc_ey_mm.set(b.target.y - y);
+    const double x = move_from_x_, y = move_from_y_;
+    arc_.load.drive(false);
+    arc_.cw.drive(b.kind == MotionKind::kArcCw);
+    arc_.i_mm.drive(b.centre.x - x);
+    arc_.j_mm.drive(b.centre.y - y);
+    arc_.ex_mm.drive(b.target.x - x);
+    arc_.ey_mm.drive(b.target.y - y);
     const bool full = b.target.x == x && b.target.y == y;
-    arc_full_circle.set(full && b.turns > 0);
-    arc_turns.set(1 + b.turns);
-    arc_feed_mm_min.set((b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s) * 60.0);
-    arc_start.set(true);
+    arc_.full_circle.drive(full && b.turns > 0);
+    arc_.turns.drive(1 + b.turns);
+    arc_.feed_mm_min.drive((b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s) * 60.0);
+    arc_.start.drive(true);
     step_ = Step::kBusy;
   } else {
-    arc_start.set(false);
+    arc_.start.drive(false);
   }
-  arc_hold.set(hold);
+  arc_.hold.drive(hold);
   status = rt::worst(status, step(arc_, ctx));
   set_reference(arc_.rx_mm.get(), arc_.ry_mm.get(), hold_z_, arc_.vx_mm_s.get(), arc_.vy_mm_s.get(),
                 0.0);
   hold_x_ = arc_.rx_mm.get();
   hold_y_ = arc_.ry_mm.get();
-  return step_ == Step::kBusy && arc_.done.get() && !arc_start.get() && in_position();
+  return step_ == Step::kBusy && arc_.done.get() && !arc_.start.driven() && in_position();
 }
 
 bool EdmJob::run_finish(const MotionBlock& b, bool hold) noexcept {
   hold_position();
   if (step_ == Step::kEnter) {
-    finish_final_offset_mm.set(b.final_radius_mm - params_.orbit_radius_offset_mm);
-    finish_start_offset_mm.set(std::min(0.01, b.final_radius_mm - params_.orbit_radius_offset_mm));
-    finish_feed_mm_min.set(b.feed_mm_s > 0.0 ? b.feed_mm_s * 60.0 : 0.0);  // G160's F (0: default)
-    finish_start.set(true);
+    finish_.final_offset_mm.drive(b.final_radius_mm - params_.orbit_radius_offset_mm);
+    finish_.start_offset_mm.drive(
+        std::min(0.01, b.final_radius_mm - params_.orbit_radius_offset_mm));
+    finish_.feed_mm_min.drive(b.feed_mm_s > 0.0 ? b.feed_mm_s * 60.0
+                                                : 0.0);  // G160's F (0: default)
+    finish_.start.drive(true);
     step_ = Step::kBusy;
     return false;
   }
-  finish_start.set(false);
-  feed_hold.set(hold);
+  finish_.start.drive(false);
+  set_hold(hold);
   const bool done = finish_.state.get() == static_cast<std::int64_t>(WallFinish::State::kDone);
   if (done) {
     hold_x_ = x_mm.get();
@@ -404,7 +412,11 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
 rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
   // The operator's feed override, read once a cycle for every child that moves.
-  feed_override.set(machine_ != nullptr ? machine_->feed_override() : 1.0);
+  feed_override_ = machine_ != nullptr ? machine_->feed_override() : 1.0;
+  for (rt::Input<double>* in :
+       {&drill_.feed_override, &finish_.feed_override, &arc_.feed_override}) {
+    in->drive(feed_override_);
+  }
   const double x = x_mm.get(), y = y_mm.get(), z = z_mm.get();
   const double still_mm = kStillSpeedMmS * ctx.dt_s;
   const bool still = std::abs(x - last_x_) <= still_mm && std::abs(y - last_y_) <= still_mm &&
@@ -443,7 +455,7 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
     finish_job(rt::JobOutcome::kAborted);  // stop, fault or E-stop
   }
 
-  loop_enable.set(!rt::is_safe_state(ms));
+  for (blocks::PositionLoop* loop : {&px_, &py_, &pz_}) loop->enable.drive(!rt::is_safe_state(ms));
   if (state_value_ == State::kRun) {
     figures_.count(ctx.release, {pulses.n_open.get(), n_normal.get(), n_transient_arc.get(),
                                  n_stable_arc.get(), pulses.n_short.get()});
@@ -473,7 +485,7 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   }
 
   // The children that run every cycle (they idle when not started).
-  manual_enable.set(ms == rt::MachineState::kReady && state_value_ == State::kIdle);
+  manual_.enable.drive(ms == rt::MachineState::kReady && state_value_ == State::kIdle);
   status = rt::worst(status, step(manual_, ctx));
   const bool manual = manual_.active.get();
   if (manual) hold_valid_ = false;  // after it the loops hold where the axes are
@@ -483,25 +495,13 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   status = rt::worst(status, step(py_, ctx));
   status = rt::worst(status, step(pz_, ctx));
 
-  // Outputs: who drives which axis.
-  const std::int64_t ds = drill_.state.get();
-  const bool drilling = ds != static_cast<std::int64_t>(DeepHoleDrill::State::kIdle) &&
-                        ds != static_cast<std::int64_t>(DeepHoleDrill::State::kDone);
-  const std::int64_t fs = finish_.state.get();
-  const bool finishing = fs != static_cast<std::int64_t>(WallFinish::State::kIdle) &&
-                         fs != static_cast<std::int64_t>(WallFinish::State::kDone);
-  vx_cmd_mm_s.set(manual      ? manual_.vx_cmd_mm_s.get()
-                  : finishing ? finish_.vx_cmd_mm_s.get()
-                              : px_.v_cmd_mm_s.get());
-  vy_cmd_mm_s.set(manual      ? manual_.vy_cmd_mm_s.get()
-                  : finishing ? finish_.vy_cmd_mm_s.get()
-                              : py_.v_cmd_mm_s.get());
-  vz_cmd_mm_s.set(manual     ? manual_.vz_cmd_mm_s.get()
-                  : drilling ? drill_.vz_cmd_mm_s.get()
-                             : pz_.v_cmd_mm_s.get());
-  if (drilling) hold_z_ = z;
-  gen_on.set(gen_arm.get() && (drill_.gen_on.get() || finish_.gen_on.get()));
-  polarity_positive.set(finishing ? finish_.polarity_positive.get() : polarity_positive_value_);
+  status = rt::worst(status, command_axes(ctx));
+  if (drill_.running()) hold_z_ = z;
+  bool generator = false;
+  for (const MachiningCycle* c : cycles_) generator = generator || c->generator_on();
+  gen_on.set(gen_arm.get() && generator);
+  polarity_positive.set(finish_.running() ? finish_.polarity_positive.get()
+                                          : polarity_positive_value_);
   return status;
 }
 

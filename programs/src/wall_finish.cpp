@@ -92,39 +92,28 @@ std::vector<rt::ParamError> WallFinish::configure_self(const rt::BlockSetup& set
 }
 
 void WallFinish::bind_self() {
-  pol_.request_positive.connect(polarity_request);
-  pol_.generator_on_request.connect(generator_request);
   pulses.feed(td_);
-  orbit_.start.connect(orbit_start);
-  orbit_.r0_mm.connect(orbit_r0_mm);
-  orbit_.final_radius_mm.connect(orbit_final_mm);
-  orbit_.enable.connect(orbit_enable);
-  orbit_.rev_pulse.connect(rev_pulse);
   orbit_.td_us.connect(td_.td_us);
   orbit_.valid.connect(td_.valid);
-  arc_.start.connect(arc_start);
-  arc_.load.connect(arc_load);
-  arc_.load_x_mm.connect(arc_load_x_mm);
-  arc_.load_y_mm.connect(arc_load_y_mm);
-  arc_.i_mm.connect(arc_i_mm);
   arc_.j_mm.set_constant(0.0);
   arc_.cw.set_constant(false);  // G03
   arc_.full_circle.set_constant(true);
   arc_.turns.set_constant(blocks::CircularInterpolator::kMaxTurns);
-  arc_.feed_mm_min.connect(arc_feed_mm_min);
   arc_.feed_override.follow(feed_override);
-  px_.x_ref_mm.connect(x_ref_mm);
-  px_.v_ff_mm_s.connect(vx_ff_mm_s);
   px_.x_mm.follow(x_mm);
-  px_.enable.connect(loop_enable);
-  py_.x_ref_mm.connect(y_ref_mm);
-  py_.v_ff_mm_s.connect(vy_ff_mm_s);
   py_.x_mm.follow(y_mm);
-  py_.enable.connect(loop_enable);
-  retract_.x_mm.connect(x_ref_mm);  // the contour as commanded
-  retract_.y_mm.connect(y_ref_mm);
-  retract_.short_detected.connect(short_now);
-  retract_.enable.connect(retract_enable);
+  // Driven each cycle by the sequence (Input::drive).
+  for (rt::Input<bool>* in :
+       {&pol_.request_positive, &pol_.generator_on_request, &orbit_.start, &orbit_.enable,
+        &orbit_.rev_pulse, &arc_.start, &arc_.load, &px_.enable, &py_.enable}) {
+    in->claim();
+  }
+  for (rt::Input<double>* in :
+       {&orbit_.r0_mm, &orbit_.final_radius_mm, &arc_.load_x_mm, &arc_.load_y_mm, &arc_.i_mm,
+        &arc_.feed_mm_min, &px_.x_ref_mm, &px_.v_ff_mm_s, &py_.x_ref_mm, &py_.v_ff_mm_s,
+        &retract_.x_mm, &retract_.y_mm}) {  // retract: the contour as commanded
+    in->claim();
+  }
 }
 
 void WallFinish::activate_self() noexcept {
@@ -132,17 +121,17 @@ void WallFinish::activate_self() noexcept {
   x0_ = y0_ = 0.0;
   rho_ = theta_ = r_base_ = 0.0;
   arc_turns_ = 0;
-  arc_start.set(false);
-  arc_load.set(false);
+  arc_.start.drive(false);
+  arc_.load.drive(false);
   revs_ = 0;
   spark_out_left_ = 0;
   spark_out_ = false;
-  polarity_request.set(false);
-  generator_request.set(false);
-  orbit_start.set(false);
-  orbit_enable.set(false);
-  rev_pulse.set(false);
-  loop_enable.set(false);
+  pol_.request_positive.drive(false);
+  pol_.generator_on_request.drive(false);
+  orbit_.start.drive(false);
+  orbit_.enable.drive(false);
+  orbit_.rev_pulse.drive(false);
+  enable_loops(false);
   stop_outputs();
   polarity_positive.set(pol_.polarity_positive.get());
   offset_mm.set(0.0);
@@ -152,7 +141,7 @@ void WallFinish::activate_self() noexcept {
   gap_short.set(false);
   cycle_short.set(false);
   short_now.set(false);
-  retract_enable.set(false);
+  retract_.enable.drive(false);
   short_retracts.set(0);
   guard_.reset();
   set_state(State::kIdle);
@@ -172,15 +161,22 @@ void WallFinish::stop_outputs() noexcept {
 void WallFinish::set_reference(double x, double y) noexcept {
   x_ref_ = x;
   y_ref_ = y;
-  x_ref_mm.set(x);
-  y_ref_mm.set(y);
+  px_.x_ref_mm.drive(x);
+  py_.x_ref_mm.drive(y);
+  retract_.x_mm.drive(x);
+  retract_.y_mm.drive(y);
+}
+
+void WallFinish::enable_loops(bool on) noexcept {
+  px_.enable.drive(on);
+  py_.enable.drive(on);
 }
 
 void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexcept {
   // The children (pol, loops) have had their own safe state; the generator request drops too.
-  generator_request.set(false);
-  loop_enable.set(false);
-  orbit_enable.set(false);
+  pol_.generator_on_request.drive(false);
+  enable_loops(false);
+  orbit_.enable.drive(false);
   stop_outputs();
   if (state_value_ != State::kIdle && state_value_ != State::kDone) {
     done.set(false);
@@ -189,29 +185,18 @@ void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexce
 }
 
 bool WallFinish::handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept {
-  retract_enable.set(true);
-  gap_short.set(ShortGuard::reads_short(td_, params_.shorts));
-  cycle_short.set(ShortGuard::cycle_reads_short(td_, params_.shorts));
-  short_now.set(gap_short.get() || cycle_short.get());
-  status = rt::worst(status, step(retract_, ctx));
-  switch (guard_.after_retract_step(ctx.release, retract_, params_.shorts)) {
-    case ShortGuard::Event::kNone:
-      break;
-    case ShortGuard::Event::kRetract:
-      short_retracts.set(short_retracts.get() + 1);
-      break;
-    case ShortGuard::Event::kBudgetSpent:
-      // Alarm 150: the machine goes to FAULT and the safe state stops the orbit (without a
-      // machine, as in unit tests, this block stops it itself and reports a fault).
-      if (machine_ != nullptr) {
-        guard_.raise_alarm(*machine_, ctx.release, source_.c_str());
-      } else {
-        safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
-        status = rt::BlockStatus::kFault;
-      }
-      break;
+  const ShortStep s = guard_.step(ctx, td_, retract_, params_.shorts, machine_, source_.c_str(),
+                                  [&](rt::Block& child) { return step(child, ctx); });
+  gap_short.set(s.gap_short);
+  cycle_short.set(s.cycle_short);
+  short_now.set(s.short_now);
+  status = rt::worst(status, s.status);
+  if (s.retract_began) short_retracts.set(short_retracts.get() + 1);
+  // Alarm 150 without a machine (a unit test): this block stops the orbit itself.
+  if (s.budget_spent && machine_ == nullptr) {
+    safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
   }
-  return retract_.active.get();
+  return s.retracting;
 }
 
 rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
@@ -240,9 +225,9 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     dark_s_ = 0.0;
     no_spark.set(false);
     const double r0 = start_offset_mm.get();
-    orbit_r0_mm.set(r0);
-    orbit_final_mm.set(std::max(final_offset_mm.get(), r0));
-    polarity_request.set(true);
+    orbit_.r0_mm.drive(r0);
+    orbit_.final_radius_mm.drive(std::max(final_offset_mm.get(), r0));
+    pol_.request_positive.drive(true);
     done.set(false);
     revolutions.set(0);
     set_state(State::kPolarity);
@@ -253,27 +238,27 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
   const bool held = hold.get() && !safe && state_value_ == State::kOrbit;
 
   // The polarity switch runs every cycle (it times the generator-off periods).
-  generator_request.set(state_value_ == State::kOrbit && !safe && !held);
+  pol_.generator_on_request.drive(state_value_ == State::kOrbit && !safe && !held);
   status = rt::worst(status, step(pol_, ctx));
   const bool positive = pol_.polarity_positive.get();
   polarity_positive.set(positive);
 
   if (state_value_ == State::kPolarity && positive && !pol_.switching.get()) {
-    orbit_start.set(true);  // rising edge for the orbit child: latches r0 and final
-    orbit_enable.set(false);
-    rev_pulse.set(false);
-    generator_request.set(true);
+    orbit_.start.drive(true);  // rising edge for the orbit child: latches r0 and final
+    orbit_.enable.drive(false);
+    orbit_.rev_pulse.drive(false);
+    pol_.generator_on_request.drive(true);
     // The arc: full circles of radius R_b (the final offset) about the centre, from angle 0.
-    r_base_ = std::max(orbit_final_mm.get(), kMinBaseRadiusMm);
-    arc_load_x_mm.set(x0_ + r_base_);
-    arc_load_y_mm.set(y0_);
-    arc_i_mm.set(-r_base_);
+    r_base_ = std::max(orbit_.final_radius_mm.driven(), kMinBaseRadiusMm);
+    arc_.load_x_mm.drive(x0_ + r_base_);
+    arc_.load_y_mm.drive(y0_);
+    arc_.i_mm.drive(-r_base_);
     const double fr = feed_mm_min.get();
-    arc_feed_mm_min.set(fr > 0.0 && std::isfinite(fr) ? fr : params_.feed_default_mm_min);
-    arc_load.set(true);
-    arc_start.set(false);
+    arc_.feed_mm_min.drive(fr > 0.0 && std::isfinite(fr) ? fr : params_.feed_default_mm_min);
+    arc_.load.drive(true);
+    arc_.start.drive(false);
     status = rt::worst(status, step(arc_, ctx));  // at the load point
-    arc_load.set(false);
+    arc_.load.drive(false);
     arc_turns_ = 0;
     theta_ = 0.0;
     set_state(State::kOrbit);
@@ -299,14 +284,14 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       // Revolutions count (and Td is collected) only once the reference radius has reached the
       // orbit radius: the entry from the centre is not a machining revolution.
       const bool on_radius = rho_ == radius;
-      arc_start.set(true);  // a rising edge the first time: the arc latches its circle
+      arc_.start.drive(true);  // a rising edge the first time: the arc latches its circle
       status = rt::worst(status, step(arc_, ctx));
       theta_ = arc_.angle_rad.get();
       const auto turns_done = static_cast<std::int64_t>(std::floor(arc_.swept_rad.get() / kTwoPi));
       const bool wrapped = turns_done > arc_turns_;
       arc_turns_ = turns_done;
-      orbit_enable.set(on_radius);
-      rev_pulse.set(wrapped && on_radius);
+      orbit_.enable.drive(on_radius);
+      orbit_.rev_pulse.drive(wrapped && on_radius);
       if (wrapped && on_radius) {
         ++revs_;
         if (spark_out_ && spark_out_left_ > 0) {
@@ -314,7 +299,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
         }
       }
       status = rt::worst(status, step(orbit_, ctx));
-      orbit_start.set(false);
+      orbit_.start.drive(false);
       if (!spark_out_ && orbit_.done.get() && orbit_.radius_mm.get() == rho_) {
         spark_out_ = true;  // the final radius is reached: spark out for spark_out_revs more
       }
@@ -331,8 +316,8 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     cycle_short.set(false);  // the generator is off outside the orbit
     short_now.set(false);
   }
-  if (state_value_ != State::kOrbit && retract_enable.get()) {
-    retract_enable.set(false);  // the history is this orbit's contour only
+  if (state_value_ != State::kOrbit && retract_.enable.driven()) {
+    retract_.enable.drive(false);  // the history is this orbit's contour only
     status = rt::worst(status, step(retract_, ctx));
   }
 
@@ -351,10 +336,10 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       xr = arc_.rx_mm.get() + (rho_ - r_base_) * std::cos(theta_);
       yr = arc_.ry_mm.get() + (rho_ - r_base_) * std::sin(theta_);
     }
-    vx_ff_mm_s.set(dt > 0.0 ? (xr - x_ref_) / dt : 0.0);
-    vy_ff_mm_s.set(dt > 0.0 ? (yr - y_ref_) / dt : 0.0);
+    px_.v_ff_mm_s.drive(dt > 0.0 ? (xr - x_ref_) / dt : 0.0);
+    py_.v_ff_mm_s.drive(dt > 0.0 ? (yr - y_ref_) / dt : 0.0);
     set_reference(xr, yr);
-    loop_enable.set(true);
+    enable_loops(true);
     status = rt::worst(status, step(px_, ctx));
     status = rt::worst(status, step(py_, ctx));
     double vx = px_.v_cmd_mm_s.get();
@@ -380,7 +365,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
   }
 
   if (state_value_ == State::kBack) {
-    generator_request.set(false);
+    pol_.generator_on_request.drive(false);
     if (rho_ == 0.0 && std::hypot(x - x0_, y - y0_) <= params_.centre_tol_mm) {
       set_state(State::kDone);
       done.set(true);
@@ -393,7 +378,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     gen_on.set(false);
   }
   if (state_value_ != State::kOrbit && state_value_ != State::kBack) {
-    loop_enable.set(false);
+    enable_loops(false);
     set_reference(x, y);
     vx_cmd_mm_s.set(0.0);
     vy_cmd_mm_s.set(0.0);

@@ -386,6 +386,7 @@ class RuntimeBuilder {
                       "'" + w.dest + "' is an output: a wire goes into an input (dest: source)");
           continue;
         }
+        wired_.push_back({dest->ref, &w});
         if (!w.source_is_name) {
           connect_constant(w, *dest);
           continue;
@@ -531,6 +532,21 @@ class RuntimeBuilder {
     }
   }
 
+  // A composite drives some of its children's inputs itself (Input::claim, bind time): a YAML
+  // wire into one would be silently replaced, so it is an error at the wire.
+  void refuse_driven_wires() {
+    for (const auto& [ref, w] : wired_) {
+      const bool claimed = ref.type == PinType::kBool  ? ref.as_input<bool>()->claimed()
+                           : ref.type == PinType::kInt ? ref.as_input<std::int64_t>()->claimed()
+                                                       : ref.as_input<double>()->claimed();
+      if (claimed) {
+        diag_.error(w->dest_loc, "'" + w->dest +
+                                     "' is driven by the program block that owns it; it cannot "
+                                     "be wired (wire that block's own inputs instead)");
+      }
+    }
+  }
+
   void finish() {
     // bind() after the wiring: a C++ PROGRAM connects its children seeing its final inputs.
     if (rt_->driver_) {
@@ -541,6 +557,7 @@ class RuntimeBuilder {
         e.block->bind();
       }
     }
+    refuse_driven_wires();
     if (rt_->driver_) {
       rt_->driver_->commit_params();
       rt_->driver_->activate();
@@ -564,6 +581,7 @@ class RuntimeBuilder {
   Task* io_task_{nullptr};
   std::map<std::string, PinEntry> pins_;
   std::map<std::string, std::vector<std::string>> block_pin_names_;
+  std::vector<std::pair<PinRef, const WireSpec*>> wired_;  // every YAML wire's destination
   std::map<std::string, std::string> block_types_by_name_;
 };
 

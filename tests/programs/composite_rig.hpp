@@ -70,6 +70,7 @@ struct CompositeRig {
   T out(const std::string& n) {
     return pins.at(n).as_output<T>()->get();
   }
+
   std::int64_t state() { return out<std::int64_t>("state"); }
   bool gen() { return out<bool>("gen_on"); }
   /// `n` sparks this cycle at a mean delay `td_us`.

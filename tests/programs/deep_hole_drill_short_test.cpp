@@ -34,6 +34,7 @@ struct ContactRun {
   std::int64_t first_short_cycle{-1};  // the detection: retract.short_cycles cycles reading short
   std::int64_t run_length{0};
   std::int64_t first_retract_cycle{-1};
+  std::int64_t fault_cycles{0};  // cycles whose update() returned kFault
 
   std::int64_t short_cycles{rig.drill.read_param(param_index(rig.drill, "retract.short_cycles")).i};
 
@@ -57,6 +58,7 @@ struct ContactRun {
       rig.n_short.set(0);
     }
     rig.step();
+    if (rig.last == rt::BlockStatus::kFault) ++fault_cycles;
     rig.ctx.release += 1ms;
     const bool reads_short = rig.out<bool>("short_now");  // the window or the cycle
     if (reads_short) {
@@ -116,6 +118,9 @@ TEST(DeepHoleDrillShort, APersistentContactGivesNRetractsThenHoldsBackedOff) {
   }
   EXPECT_EQ(run.rig.out<std::int64_t>("short_retracts"), n) << "exactly N retracts";
   EXPECT_EQ(run.rig.state(), 3) << "backing off";
+  // Without a machine to raise alarm 150 on, the cycle that spends the budget reports a fault
+  // (ShortGuard::step, as WallFinish does: the two no longer differ).
+  EXPECT_EQ(run.fault_cycles, 1);
   EXPECT_FALSE(run.rig.gen());
   for (int k = 0; k < 2000 && run.rig.state() == 3; ++k) run.cycle();
   EXPECT_EQ(run.rig.state(), 0) << "holds (IDLE) after the back-off, the hole not done";

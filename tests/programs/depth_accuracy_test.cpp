@@ -92,8 +92,8 @@ Hole drill(int seed, double depth_mm, bool probe) {
           td_sq += e * e;
           ++td_n;
         }
-        h.measured_mm = v.read("cnc.job.measured_depth_mm").value();
-        h.probe_failures = static_cast<std::int64_t>(v.read("cnc.job.probe_failures").value());
+        h.measured_mm = v.read("cnc.job.probe.measured_depth_mm").value();
+        h.probe_failures = static_cast<std::int64_t>(v.read("cnc.job.probe.failures").value());
         state = st;
         const bool now = st != 0.0;
         const double z = v.read("io.z_mm").value();
@@ -102,7 +102,7 @@ Hole drill(int seed, double depth_mm, bool probe) {
         if (st == 2.0) z_min = std::min(z_min, z);  // the drilling's own travel (not the touches)
       },
       [probe](rt::Runtime& r) {
-        ASSERT_TRUE(r.variables().write("cnc.job.probe_depth", rt::ParamValue::of_bool(probe)));
+        ASSERT_TRUE(r.variables().write("cnc.job.probe.enable", rt::ParamValue::of_bool(probe)));
       });
   h.finished = j.finished;
   h.depth_mm = j.depth_mm;

@@ -46,7 +46,7 @@ struct Seen {
 };
 
 Seen watch(const rt::VariableRegistry& v, Seen& s, bool& touch_before) {
-  const auto step = static_cast<std::int64_t>(v.read("cnc.job.probe_step").value());
+  const auto step = static_cast<std::int64_t>(v.read("cnc.job.probe.step").value());
   if (s.steps.empty() || s.steps.back() != step) s.steps.push_back(step);
   const bool touch = v.read("cnc.job.manual.touch_mode").value() != 0.0;
   if (touch && !touch_before) ++s.touches;
@@ -78,12 +78,12 @@ TEST(DepthProbe, MeasuresBottomAndSurfaceThenFinishesFromTheContact) {
       7, blind_hole(hx, hy, depth), {0, 0, 0.1}, kMachine,
       [&](const rt::VariableRegistry& v) {
         watch(v, s, touch_before);
-        measured = v.read("cnc.job.measured_depth_mm").value();
-        failures = static_cast<std::int64_t>(v.read("cnc.job.probe_failures").value());
+        measured = v.read("cnc.job.probe.measured_depth_mm").value();
+        failures = static_cast<std::int64_t>(v.read("cnc.job.probe.failures").value());
       },
       [](rt::Runtime& r) {
-        ASSERT_TRUE(r.variables().write("cnc.job.probe_dx_mm", 0.0));
-        ASSERT_TRUE(r.variables().write("cnc.job.probe_dy_mm", -3.0));
+        ASSERT_TRUE(r.variables().write("cnc.job.probe.dx_mm", 0.0));
+        ASSERT_TRUE(r.variables().write("cnc.job.probe.dy_mm", -3.0));
       });
   ASSERT_TRUE(j.finished);
   const std::vector<std::int64_t> expected = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 0};
@@ -114,10 +114,10 @@ TEST(DepthProbe, SurfaceOffTheWorkFallsBackToTheEstimate) {
       3, blind_hole(0.0, 0.0, 4.0), {0, 0, 0.1}, kMachine,
       [&](const rt::VariableRegistry& v) {
         watch(v, s, touch_before);
-        measured = v.read("cnc.job.measured_depth_mm").value();
-        failures = static_cast<std::int64_t>(v.read("cnc.job.probe_failures").value());
+        measured = v.read("cnc.job.probe.measured_depth_mm").value();
+        failures = static_cast<std::int64_t>(v.read("cnc.job.probe.failures").value());
       },
-      [](rt::Runtime& r) { ASSERT_TRUE(r.variables().write("cnc.job.probe_dx_mm", 60.0)); });
+      [](rt::Runtime& r) { ASSERT_TRUE(r.variables().write("cnc.job.probe.dx_mm", 60.0)); });
   ASSERT_TRUE(j.finished);
   EXPECT_EQ(failures, 1);
   EXPECT_EQ(measured, 0.0);
@@ -147,7 +147,7 @@ void stop_during_touch(rt::MachineCommand command, rt::MachineState after) {
     motion.run_cycle(t, clock);
     if (k % 10 == 0) supervisor.run_cycle(t, clock);
     const bool touching = vars.read("cnc.job.manual.touch_mode").value() != 0.0;
-    if (stopped_at < 0 && touching && vars.read("cnc.job.probe_step").value() == 3.0 &&
+    if (stopped_at < 0 && touching && vars.read("cnc.job.probe.step").value() == 3.0 &&
         vars.read("cnc.job.manual.vz_cmd_mm_s").value() < -0.5) {  // on the way down, fast
       r->machine().command(command, t);
       stopped_at = k;
@@ -159,7 +159,7 @@ void stop_during_touch(rt::MachineCommand command, rt::MachineState after) {
   EXPECT_EQ(r->job().progress().outcome, rt::JobOutcome::kAborted);
   EXPECT_EQ(vars.read("cnc.job.manual.touch_mode").value(), 0.0) << "touch mode ends";
   EXPECT_EQ(vars.read("cnc.job.manual.active").value(), 0.0) << "the touch gives the axes back";
-  EXPECT_EQ(vars.read("cnc.job.probe_step").value(), 0.0);
+  EXPECT_EQ(vars.read("cnc.job.probe.step").value(), 0.0);
   EXPECT_EQ(vars.read("io.gen_on").value(), 0.0);
   EXPECT_NEAR(vars.read("io.vz_cmd").value(), 0.0, 0.01) << "Z no longer moves down";
 }

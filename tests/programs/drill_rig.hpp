@@ -36,9 +36,10 @@ struct Rig : CompositeRig<programs::DeepHoleDrill> {
     for (int k = 0; k < cycles; ++k) step();
   }
   void step() {
-    drill.update(ctx);
+    last = drill.update(ctx);
     ++ctx.cycle;
   }
+  rt::BlockStatus last{rt::BlockStatus::kOk};  // the last update()'s status
 };
 
 }  // namespace edm::test

@@ -91,7 +91,7 @@ TEST_F(SafeStateForces, ForcedMotionAndGeneratorAreReleasedByFaultAndStayOffThro
 TEST_F(SafeStateForces, EstopReleasesForcedProgramOutputsToo) {
   // Forcing the program's output that is wired to io.vz_cmd is the same fault by another road.
   run_for(50ms);
-  ASSERT_TRUE(m.vars().force("cnc.job.vz_cmd_mm_s", -20.0));
+  ASSERT_TRUE(m.vars().force("cnc.job.axes.vz_cmd_mm_s", -20.0));
   run_for(5ms);
   ASSERT_EQ(m.vars().read("io.vz_cmd"), -20.0);
   m.runtime->machine().command(rt::MachineCommand::kEstop);

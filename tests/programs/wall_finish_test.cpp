@@ -164,7 +164,8 @@ TEST(WallFinish, OrbitReferenceRunsAtTheFeedOnTheFinalRadius) {
     bool have = false;
     for (int k = 0; k < 20000 && rig.state() != 3; ++k) {
       rig.step();
-      const double xr = rig.out<double>("x_ref_mm"), yr = rig.out<double>("y_ref_mm");
+      const double xr = rig.in<double>("px.x_ref_mm").get(),
+                   yr = rig.in<double>("py.x_ref_mm").get();
       const bool on_radius = rig.state() == 2 && rig.out<double>("rho_mm") == 0.02;
       if (on_radius && have) {
         const double speed = std::hypot(xr - px, yr - py) / 1e-3;  // chord per 1 ms cycle

@@ -90,13 +90,12 @@
 // The children are connected by member in bind_self():
 //   td.{td_sum_ns,td_count,n_open,n_short} ← this block's inputs
 //   gap.td_us, gap.valid ← td;   gap.tdr_us ← tdr_us
-//   wear.vz_in_mm_s ← vz_servo_cmd_mm_s (gap.vz_mm_s, or the external servo's when
-//                     vz_servo_mm_s is wired: bind() sees the YAML wiring)
-//   wear.wear_ratio ← wear_ratio;  wear.area_ratio ← area_ratio;  wear.enable ← enable_wear_comp;
-//   wear.reset_wear ← reset_wear
-// Extra outputs: reset_wear (true in the cycle the wear estimate restarts, at the touch) and
-// vz_servo_cmd_mm_s (the servo command into wear: clamped, ramped after a retract, never down
-// while the gap reads short).
+//   wear.wear_ratio ← wear_ratio;  wear.area_ratio ← area_ratio;  wear.enable ← enable_wear_comp
+// and driven each cycle (Input::drive, no mirror output): wear.vz_in_mm_s, the servo command
+// into the compensator (gap.vz_mm_s, or the external servo's when vz_servo_mm_s is wired:
+// clamped, ramped after a retract, never down while the gap reads short); wear.reset_wear (true
+// in the cycle the wear estimate restarts, at the touch); retract.enable, retract.short_detected
+// (ShortGuard::step) and zloop.v_ff_mm_s (the retract setpoint's feed-forward).
 //
 // Accuracy on the simulator (drill preset, 20 mm, tests/programs): the hole ends ≈ 0.25 mm short
 // with wear compensation (≈ 9 mm short without): eq. (8) estimates the wear from the bottom feed
@@ -115,6 +114,7 @@
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
 #include "edm/blocks/wear_compensator.hpp"
+#include "edm/programs/machining_cycle.hpp"
 #include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
@@ -140,12 +140,21 @@ struct DeepHoleDrillParams {
   void visit(rt::ParamVisitor& v);
 };
 
-class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::CompositeBlock> {
+class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::CompositeBlock>,
+                            public MachiningCycle {
  public:
   /// The job was stopped by the operator (not a safe state): as the safe state does, the
   /// generator goes off and an approach or drilling cycle retracts (to the touch height plus
   /// clearance_mm) and ends in IDLE, done false — never left creeping down dark. RT-safe.
-  void abort() noexcept { safe_state_self(rt::SafeStateRequest{}); }
+  void abort() noexcept override { safe_state_self(rt::SafeStateRequest{}); }
+  /// MachiningCycle: from the start to DONE or IDLE it commands Z.
+  [[nodiscard]] bool running() const noexcept override {
+    return state_value_ != State::kIdle && state_value_ != State::kDone;
+  }
+  [[nodiscard]] AxisClaim axes() const noexcept override {
+    return {.z = true, .vz_mm_s = vz_cmd_mm_s.get()};
+  }
+  [[nodiscard]] bool generator_on() const noexcept override { return gen_on.get(); }
   enum class State : std::int64_t {
     kIdle = 0,
     kApproach = 1,
@@ -196,14 +205,8 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<double> wear_mm{pins_, "wear_mm", "mm"};
   rt::Output<bool> done{pins_, "done"};
   rt::Output<bool> breakthrough{pins_, "breakthrough"};
-  rt::Output<bool> reset_wear{pins_, "reset_wear"};
-  rt::Output<double> vz_servo_cmd_mm_s{pins_, "vz_servo_cmd_mm_s", "mm/s"};
   rt::Output<bool> gap_short{pins_,
                              "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable{
-      pins_, "retract_enable"};  // the short retract records and acts (DRILL only)
-  rt::Output<double> retract_vff_mm_s{pins_, "retract_vff_mm_s",
-                                      "mm/s"};  // feed-forward of the retract setpoint into zloop
   rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this hole
   rt::Output<double> short_time_s{pins_, "short_time_s",
                                   "s"};  // time spent retracting and resuming in this hole

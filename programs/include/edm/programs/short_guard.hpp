@@ -1,8 +1,8 @@
 #pragma once
 // The short-circuit handling DeepHoleDrill and WallFinish share (issue 19):
 //   ShortLimits  their parameters: when the Td window reads short, and the retract budget;
-//   ShortGuard   per cycle: reads the window, counts the retract child's retracts against the
-//                budget, raises alarm 150 when it is spent.
+//   ShortGuard   per cycle (step()): reads the window, drives and steps the retract child,
+//                counts its retracts against the budget, raises alarm 150 when it is spent.
 //
 // Two readings (issue 31, DESIGN §11 "never a feed toward the work while the gap reads short"):
 //   reads_short        the Td window: short_ratio ≥ short_ratio_limit. It takes ~window cycles to
@@ -31,6 +31,7 @@
 
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
+#include "edm/runtime/block.hpp"
 #include "edm/runtime/machine.hpp"
 #include "edm/runtime/param.hpp"
 #include "edm/runtime/time.hpp"
@@ -81,9 +82,57 @@ struct ShortLimits {
   void visit(rt::ParamVisitor& v);
 };
 
+/// What one cycle of ShortGuard::step() found (the cycle shows the readings on its own pins).
+struct ShortStep {
+  bool gap_short{false};      // the Td window reads short
+  bool cycle_short{false};    // this cycle's own pulses read short
+  bool short_now{false};      // either: no feed toward the work; the retract counts it
+  bool retract_began{false};  // a retract began this cycle (count it)
+  bool retracting{false};     // the retract child owns the command this cycle
+  // The budget is spent. With a machine, alarm 150 is raised (its safe state follows); without
+  // one (a unit test) the cycle must enter its own safe state: `status` is then kFault.
+  bool budget_spent{false};
+  rt::BlockStatus status{rt::BlockStatus::kOk};
+};
+
 class ShortGuard {
  public:
   enum class Event : std::uint8_t { kNone, kRetract, kBudgetSpent };
+
+  /// One machining cycle of the short handling both cycles share (issue 32): reads the window
+  /// and this cycle's pulses, drives the retract child's short_detected and enable (claimed by
+  /// the owner's bind), steps it with `step_child` (the owner's CompositeBlock::step), counts a
+  /// retract that began against the budget and, when it is spent, raises alarm 150 from
+  /// `source` on `machine`. RT-safe.
+  template <class StepChild>
+  ShortStep step(const rt::CycleContext& ctx, const blocks::TdDetector& td,
+                 blocks::ShortRetract& retract, const ShortLimits& p, rt::Machine* machine,
+                 const char* source, StepChild&& step_child) noexcept {
+    ShortStep s;
+    s.gap_short = reads_short(td, p);
+    s.cycle_short = cycle_reads_short(td, p);
+    s.short_now = s.gap_short || s.cycle_short;
+    retract.enable.drive(true);
+    retract.short_detected.drive(s.short_now);
+    s.status = step_child(retract);
+    switch (after_retract_step(ctx.release, retract, p)) {
+      case Event::kNone:
+        break;
+      case Event::kRetract:
+        s.retract_began = true;
+        break;
+      case Event::kBudgetSpent:
+        s.budget_spent = true;
+        if (machine != nullptr) {
+          raise_alarm(*machine, ctx.release, source);
+        } else {
+          s.status = rt::BlockStatus::kFault;
+        }
+        break;
+    }
+    s.retracting = retract.active.get();
+    return s;
+  }
 
   /// The window reads short: it holds a measurement and enough of it is shorts. RT-safe.
   [[nodiscard]] static bool reads_short(const blocks::TdDetector& td,
@@ -95,6 +144,12 @@ class ShortGuard {
                                               const ShortLimits& p) noexcept {
     return td.cycle_short_ratio.get() >= p.short_ratio_limit;
   }
+  void reset() noexcept {
+    budget_.reset();
+    last_retracts_ = 0;
+  }
+
+ private:
   /// After the retract child's step: did a retract begin, and is the budget spent? RT-safe.
   Event after_retract_step(rt::TimePoint now, const blocks::ShortRetract& r,
                            const ShortLimits& p) noexcept {
@@ -113,12 +168,6 @@ class ShortGuard {
              "short circuit: too many retracts within the window",
              static_cast<double>(budget_.count())});
   }
-  void reset() noexcept {
-    budget_.reset();
-    last_retracts_ = 0;
-  }
-
- private:
   RetractBudget budget_;
   std::int64_t last_retracts_{0};
 };

@@ -43,11 +43,14 @@
 // 0.002 mm limit clamped every step), orbit.samples_per_rev = 0 (revolutions come from the
 // orbit phase: another value is refused), pol.initial_positive = false, px/py.v_max_mm_s = 5.
 // Connected by member in bind_self(): td's counters and px/py's positions follow this block's
-// inputs; orbit.td_us/valid ← td; the rest come from this block's outputs below.
+// inputs; orbit.td_us/valid ← td; the sequence drives the rest (Input::drive: pol's requests,
+// orbit's start/enable/rev_pulse/r0/final radius, arc's load point and feed, the loops'
+// references, feed-forwards and enables, the retract's contour), readable as those children's
+// inputs (`finish.px.x_ref_mm`, …).
 // Short circuits in ORBIT: td pools shorts as Td ≈ 0, so Tdm and the growth Δr = kr·Tdm shrink
 // by themselves. While the window reads short (gap_short: td.short_ratio ≥ short_ratio_limit)
 // the phase and the radius wait (no advance toward the wall); a retract child (ShortRetract on
-// the commanded reference x_ref_mm/y_ref_mm) backs the electrode along the contour already
+// the commanded reference px/py.x_ref_mm) backs the electrode along the contour already
 // travelled and walks it forward again, the loops following its setpoint; then the orbit
 // continues from where it stopped. Too many retracts without progress: alarm 150 (fault); the
 // safe state stops the orbit. cycle_short (td.cycle_short_ratio ≥ short_ratio_limit: this
@@ -55,9 +58,6 @@
 // while either reads short (short_now = gap_short || cycle_short, which the retract child
 // counts) the X/Y command has no component toward the wall: its part along the electrode's
 // radius from the hole centre, outward, is removed.
-// Extra outputs (the signals the sequence gives its children): polarity_request,
-// generator_request, orbit_start, orbit_enable, rev_pulse, orbit_r0_mm, orbit_final_mm,
-// x_ref_mm, y_ref_mm, vx_ff_mm_s, vy_ff_mm_s, loop_enable.
 //
 // RT-safety: update() and enter_safe_state() are RT-safe (noexcept, no allocation, no locks).
 // Not thread-safe: the owning task calls every member except the pins (see pin.hpp).
@@ -72,6 +72,7 @@
 #include "edm/blocks/position_loop.hpp"
 #include "edm/blocks/short_retract.hpp"
 #include "edm/blocks/td_detector.hpp"
+#include "edm/programs/machining_cycle.hpp"
 #include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/short_guard.hpp"
 #include "edm/runtime/block.hpp"
@@ -94,14 +95,23 @@ struct WallFinishParams {
   void visit(rt::ParamVisitor& v);
 };
 
-class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::CompositeBlock> {
+class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::CompositeBlock>,
+                         public MachiningCycle {
  public:
   enum class State : std::int64_t { kIdle = 0, kPolarity = 1, kOrbit = 2, kBack = 3, kDone = 4 };
 
   WallFinish();
   /// The job was stopped by the operator: the orbit stops as in the safe state (IDLE, done
   /// false). RT-safe.
-  void abort() noexcept { safe_state_self(rt::SafeStateRequest{}); }
+  void abort() noexcept override { safe_state_self(rt::SafeStateRequest{}); }
+  /// MachiningCycle: from the start to DONE or IDLE it commands X and Y.
+  [[nodiscard]] bool running() const noexcept override {
+    return state_value_ != State::kIdle && state_value_ != State::kDone;
+  }
+  [[nodiscard]] AxisClaim axes() const noexcept override {
+    return {.x = true, .y = true, .vx_mm_s = vx_cmd_mm_s.get(), .vy_mm_s = vy_cmd_mm_s.get()};
+  }
+  [[nodiscard]] bool generator_on() const noexcept override { return gen_on.get(); }
 
   // Pins, listed in declaration order.
   PulseInputs pulses{pins_};  // td_sum_ns, td_count, n_open, n_short
@@ -123,29 +133,8 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<double> rho_mm{pins_, "rho_mm", "mm"};  // reference radius actually commanded
   rt::Output<std::int64_t> revolutions{pins_, "revolutions"};
   rt::Output<bool> done{pins_, "done"};
-  // The signals the sequence gives its children.
-  rt::Output<bool> polarity_request{pins_, "polarity_request"};
-  rt::Output<bool> generator_request{pins_, "generator_request"};
-  rt::Output<bool> orbit_start{pins_, "orbit_start"};
-  rt::Output<bool> orbit_enable{pins_, "orbit_enable"};
-  rt::Output<bool> rev_pulse{pins_, "rev_pulse"};
-  rt::Output<double> orbit_r0_mm{pins_, "orbit_r0_mm", "mm"};
-  rt::Output<double> orbit_final_mm{pins_, "orbit_final_mm", "mm"};
-  rt::Output<bool> arc_start{pins_, "arc_start"};
-  rt::Output<bool> arc_load{pins_, "arc_load"};
-  rt::Output<double> arc_load_x_mm{pins_, "arc_load_x_mm", "mm"};
-  rt::Output<double> arc_load_y_mm{pins_, "arc_load_y_mm", "mm"};
-  rt::Output<double> arc_i_mm{pins_, "arc_i_mm", "mm"};
-  rt::Output<double> arc_feed_mm_min{pins_, "arc_feed_mm_min", "mm/min"};
-  rt::Output<double> x_ref_mm{pins_, "x_ref_mm", "mm"};
-  rt::Output<double> y_ref_mm{pins_, "y_ref_mm", "mm"};
-  rt::Output<double> vx_ff_mm_s{pins_, "vx_ff_mm_s", "mm/s"};
-  rt::Output<double> vy_ff_mm_s{pins_, "vy_ff_mm_s", "mm/s"};
-  rt::Output<bool> loop_enable{pins_, "loop_enable"};
   rt::Output<bool> gap_short{pins_,
                              "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<bool> retract_enable{
-      pins_, "retract_enable"};  // the short retract records the contour (ORBIT only)
   rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this cycle
   rt::Output<bool> cycle_short{
       pins_, "cycle_short"};  // this cycle's own pulses read short: nothing toward the wall
@@ -163,7 +152,9 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
  private:
   void set_state(State s) noexcept;
   void stop_outputs() noexcept;
+  /// The loops' and the retract's reference point. RT-safe.
   void set_reference(double x, double y) noexcept;
+  void enable_loops(bool on) noexcept;
   /// One ORBIT cycle of the short handling; true while the retract owns the reference.
   bool handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept;
 

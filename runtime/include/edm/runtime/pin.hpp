@@ -20,8 +20,9 @@
 // above a force: get() returns the supervised value, then the forced one, then the wire.
 // requested() is what the input would read without the supervisor.
 //
-// RT-safe: get(), set(). Non-RT: connect(), follow(), set_constant(). force()/unforce() may be
-// called from any thread. Pins are neither copyable nor movable (wires point at them).
+// RT-safe: get(), set(), drive(). Non-RT: connect(), follow(), claim(), set_constant().
+// force()/unforce() may be called from any thread. Pins are neither copyable nor movable (wires
+// point at them).
 
 #include <atomic>
 #include <cstdint>
@@ -138,19 +139,38 @@ class Input {
     src_ = &source.cell();
     via_ = nullptr;
     connected_ = true;
+    driven_ = false;
   }
   /// Reads whatever `outer` reads: its wire, its constant, or its forced value. A composite
   /// hands one of its own inputs to a child this way. Non-RT (bind time).
   void follow(const Input& outer) noexcept {
     via_ = &outer;
     connected_ = true;
+    driven_ = false;
   }
+  /// Makes this input the owner's to drive (drive() below): it reads its own cell, which only
+  /// the composite that owns the child writes, the way an IEC 61131-3 FB call passes a
+  /// parameter. Replaces any wire or constant YAML gave it. Non-RT (bind time).
+  void claim(T initial = T{}) noexcept {
+    constant_.store(initial, std::memory_order_relaxed);
+    src_ = &constant_;
+    via_ = nullptr;
+    connected_ = true;
+    driven_ = true;
+  }
+  /// Writes the value a claimed input reads (forced and supervised values still rank above
+  /// it). RT-safe; only the owning composite's task calls it.
+  void drive(T v) noexcept { constant_.store(v, std::memory_order_relaxed); }
+  /// The value last driven, whatever a force makes get() return. RT-safe.
+  [[nodiscard]] T driven() const noexcept { return constant_.load(std::memory_order_relaxed); }
+  [[nodiscard]] bool claimed() const noexcept { return driven_; }
   /// Makes this input read a constant. Non-RT (load time only).
   void set_constant(T v) noexcept {
     constant_.store(v, std::memory_order_relaxed);
     src_ = &constant_;
     via_ = nullptr;
     connected_ = false;
+    driven_ = false;
   }
   [[nodiscard]] bool connected() const noexcept { return connected_; }
 
@@ -196,6 +216,7 @@ class Input {
   std::atomic<T> supervised_value_{};
   std::atomic<std::uint8_t> mode_{0};  // kForced | kSupervised; one load when neither is set
   bool connected_{false};
+  bool driven_{false};  // claim(): the owning composite drives it
 };
 
 enum class PinDir : std::uint8_t { kInput, kOutput };
