@@ -132,12 +132,9 @@ void DeepHoleDrill::activate_self() noexcept {
   touch_z_mm.set(0.0);
   wear_mm.set(0.0);
   done.set(false);
-  gap_short.set(false);
-  cycle_short.set(false);
-  short_now.set(false);
+  short_pins.reset();
   retract_.enable.drive(false);
   zloop_.v_ff_mm_s.drive(0.0);
-  short_retracts.set(0);
   short_time_s.set(0.0);
   guard_.reset();
   set_state(State::kIdle);
@@ -177,7 +174,7 @@ void DeepHoleDrill::begin_cycle() noexcept {
   breakthrough.set(false);
   depth_reached_mm.set(0.0);
   wear_mm.set(0.0);
-  short_retracts.set(0);
+  short_pins.short_retracts.set(0);
   short_time_s.set(0.0);
   guard_.reset();
   set_state(State::kApproach);
@@ -210,13 +207,9 @@ void DeepHoleDrill::safe_state_self(const rt::SafeStateRequest& request) noexcep
 
 bool DeepHoleDrill::handle_short(const rt::CycleContext& ctx, double z,
                                  rt::BlockStatus& status) noexcept {
-  const ShortStep s = guard_.step(ctx, td_, retract_, params_.shorts, machine_, source_,
+  const ShortStep s = guard_.step(ctx, td_, retract_, params_.shorts, machine_, source_, short_pins,
                                   [&](rt::Block& child) { return step(child, ctx); });
-  gap_short.set(s.gap_short);
-  cycle_short.set(s.cycle_short);
-  short_now.set(s.short_now);
   status = rt::worst(status, s.status);
-  if (s.retract_began) short_retracts.set(short_retracts.get() + 1);
   // Alarm 150 without a machine (a unit test): this block backs Z off and holds itself.
   if (s.budget_spent && machine_ == nullptr) {
     safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
@@ -271,8 +264,8 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     // A cycle whose own pulses read short has closed the gap too: it counts as a touch, and it
     // feeds no further (the P law then backs off from Td ≈ 0, the short handling from there on).
     const bool shorted = ShortGuard::cycle_reads_short(td_, params_.shorts);
-    cycle_short.set(shorted);
-    short_now.set(shorted);
+    short_pins.cycle_short.set(shorted);
+    short_pins.short_now.set(shorted);
     spark_cycles_ = pulses.td_count.get() > 0 || shorted ? spark_cycles_ + 1 : 0;
     if (spark_cycles_ >= params_.touch_cycles) {
       touch_z_mm.set(measured_ ? contact_z_mm_ : resume_ ? resume_touch_z_mm_ : z);
@@ -350,8 +343,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
     }
   }
   if (state_value_ != State::kApproach && state_value_ != State::kDrill) {
-    cycle_short.set(false);  // the generator is off: no pulses of this program's
-    short_now.set(false);
+    short_pins.clear_now();  // the generator is off: no pulses of this program's
   }
   if (state_value_ != State::kDrill && retract_.enable.driven()) {
     retract_.enable.drive(false);  // the history is the path of this hole's DRILL only

@@ -138,11 +138,8 @@ void WallFinish::activate_self() noexcept {
   rho_mm.set(0.0);
   revolutions.set(0);
   done.set(false);
-  gap_short.set(false);
-  cycle_short.set(false);
-  short_now.set(false);
+  short_pins.reset();
   retract_.enable.drive(false);
-  short_retracts.set(0);
   guard_.reset();
   set_state(State::kIdle);
 }
@@ -186,12 +183,8 @@ void WallFinish::safe_state_self(const rt::SafeStateRequest& /*request*/) noexce
 
 bool WallFinish::handle_short(const rt::CycleContext& ctx, rt::BlockStatus& status) noexcept {
   const ShortStep s = guard_.step(ctx, td_, retract_, params_.shorts, machine_, source_.c_str(),
-                                  [&](rt::Block& child) { return step(child, ctx); });
-  gap_short.set(s.gap_short);
-  cycle_short.set(s.cycle_short);
-  short_now.set(s.short_now);
+                                  short_pins, [&](rt::Block& child) { return step(child, ctx); });
   status = rt::worst(status, s.status);
-  if (s.retract_began) short_retracts.set(short_retracts.get() + 1);
   // Alarm 150 without a machine (a unit test): this block stops the orbit itself.
   if (s.budget_spent && machine_ == nullptr) {
     safe_state_self({rt::MachineState::kFault, rt::AlarmCode::kShortCircuit});
@@ -277,7 +270,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
       status = rt::BlockStatus::kFault;
     }
     retracting = handle_short(ctx, status);
-    if (retracting || short_now.get()) {
+    if (retracting || short_pins.short_now.get()) {
       rho_target = rho_;  // a short: the phase and the radius wait
     } else {
       const double radius = orbit_.radius_mm.get();
@@ -313,8 +306,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     }
   }
   if (state_value_ != State::kOrbit) {
-    cycle_short.set(false);  // the generator is off outside the orbit
-    short_now.set(false);
+    short_pins.clear_now();  // the generator is off outside the orbit
   }
   if (state_value_ != State::kOrbit && retract_.enable.driven()) {
     retract_.enable.drive(false);  // the history is this orbit's contour only
@@ -344,7 +336,7 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     status = rt::worst(status, step(py_, ctx));
     double vx = px_.v_cmd_mm_s.get();
     double vy = py_.v_cmd_mm_s.get();
-    if (state_value_ == State::kOrbit && short_now.get()) {
+    if (state_value_ == State::kOrbit && short_pins.short_now.get()) {
       // Reading short: nothing toward the wall, i.e. no outward part along the electrode's
       // radius from the hole centre (at the centre itself, where every way is outward: stop).
       const double rx = x - x0_, ry = y - y0_;

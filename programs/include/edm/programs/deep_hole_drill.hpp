@@ -205,15 +205,10 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   rt::Output<double> wear_mm{pins_, "wear_mm", "mm"};
   rt::Output<bool> done{pins_, "done"};
   rt::Output<bool> breakthrough{pins_, "breakthrough"};
-  rt::Output<bool> gap_short{pins_,
-                             "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this hole
   rt::Output<double> short_time_s{pins_, "short_time_s",
                                   "s"};  // time spent retracting and resuming in this hole
-  rt::Output<bool> cycle_short{
-      pins_, "cycle_short"};  // this cycle's own pulses read short: no feed toward the work
-  rt::Output<bool> short_now{
-      pins_, "short_now"};  // gap_short || cycle_short: no feed down; the retract counts it
+  // gap_short, short_retracts (retracts in this hole), cycle_short, short_now.
+  ShortPins short_pins{pins_};
 
  protected:
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
@@ -227,7 +222,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   /// The feed override input, clamped to [0, 1.5]; not finite: 0 (stop feeding). RT-safe.
   [[nodiscard]] double feed_scale() const noexcept;
   /// The window (gap_short) or this cycle's own pulses (cycle_short) read short. RT-safe.
-  [[nodiscard]] bool feed_stopped() const noexcept { return short_now.get(); }
+  [[nodiscard]] bool feed_stopped() const noexcept { return short_pins.short_now.get(); }
   void set_state(State s) noexcept;
   void begin_cycle() noexcept;
   void begin_retract(double target_z) noexcept;

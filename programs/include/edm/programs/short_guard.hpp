@@ -82,7 +82,32 @@ struct ShortLimits {
   void visit(rt::ParamVisitor& v);
 };
 
-/// What one cycle of ShortGuard::step() found (the cycle shows the readings on its own pins).
+/// The short readings a cycle shows, declared in its pin table (as "gap_short", …).
+struct ShortPins {
+  explicit ShortPins(rt::PinTable& owner)
+      : gap_short{owner, "gap_short"},
+        short_retracts{owner, "short_retracts"},
+        cycle_short{owner, "cycle_short"},
+        short_now{owner, "short_now"} {}
+  rt::Output<bool> gap_short;               // the Td window reads short (short_ratio ≥ the limit)
+  rt::Output<std::int64_t> short_retracts;  // retracts in this cycle (hole, orbit)
+  rt::Output<bool> cycle_short;  // this cycle's own pulses read short: nothing toward the work
+  rt::Output<bool> short_now;    // gap_short || cycle_short: no feed; the retract counts it
+
+  /// Not machining: no pulses of this cycle's, nothing reads short. RT-safe.
+  void clear_now() noexcept {
+    cycle_short.set(false);
+    short_now.set(false);
+  }
+  /// A new cycle (hole, orbit) or activation: every reading and the count at 0. RT-safe.
+  void reset() noexcept {
+    gap_short.set(false);
+    short_retracts.set(0);
+    clear_now();
+  }
+};
+
+/// What one cycle of ShortGuard::step() found (also shown on the cycle's ShortPins).
 struct ShortStep {
   bool gap_short{false};      // the Td window reads short
   bool cycle_short{false};    // this cycle's own pulses read short
@@ -100,18 +125,21 @@ class ShortGuard {
   enum class Event : std::uint8_t { kNone, kRetract, kBudgetSpent };
 
   /// One machining cycle of the short handling both cycles share (issue 32): reads the window
-  /// and this cycle's pulses, drives the retract child's short_detected and enable (claimed by
-  /// the owner's bind), steps it with `step_child` (the owner's CompositeBlock::step), counts a
-  /// retract that began against the budget and, when it is spent, raises alarm 150 from
-  /// `source` on `machine`. RT-safe.
+  /// and this cycle's pulses (shown on `pins`), drives the retract child's short_detected and
+  /// enable (claimed by the owner's bind), steps it with `step_child` (the owner's
+  /// CompositeBlock::step), counts a retract that began against the budget and, when it is spent,
+  /// raises alarm 150 from `source` on `machine`. RT-safe.
   template <class StepChild>
   ShortStep step(const rt::CycleContext& ctx, const blocks::TdDetector& td,
                  blocks::ShortRetract& retract, const ShortLimits& p, rt::Machine* machine,
-                 const char* source, StepChild&& step_child) noexcept {
+                 const char* source, ShortPins& pins, StepChild&& step_child) noexcept {
     ShortStep s;
     s.gap_short = reads_short(td, p);
     s.cycle_short = cycle_reads_short(td, p);
     s.short_now = s.gap_short || s.cycle_short;
+    pins.gap_short.set(s.gap_short);
+    pins.cycle_short.set(s.cycle_short);
+    pins.short_now.set(s.short_now);
     retract.enable.drive(true);
     retract.short_detected.drive(s.short_now);
     s.status = step_child(retract);
@@ -120,6 +148,7 @@ class ShortGuard {
         break;
       case Event::kRetract:
         s.retract_began = true;
+        pins.short_retracts.set(pins.short_retracts.get() + 1);
         break;
       case Event::kBudgetSpent:
         s.budget_spent = true;

@@ -133,13 +133,8 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
   rt::Output<double> rho_mm{pins_, "rho_mm", "mm"};  // reference radius actually commanded
   rt::Output<std::int64_t> revolutions{pins_, "revolutions"};
   rt::Output<bool> done{pins_, "done"};
-  rt::Output<bool> gap_short{pins_,
-                             "gap_short"};  // the Td window reads short (short_ratio ≥ the limit)
-  rt::Output<std::int64_t> short_retracts{pins_, "short_retracts"};  // retracts in this cycle
-  rt::Output<bool> cycle_short{
-      pins_, "cycle_short"};  // this cycle's own pulses read short: nothing toward the wall
-  rt::Output<bool> short_now{
-      pins_, "short_now"};  // gap_short || cycle_short: the orbit waits; the retract counts it
+  // gap_short, short_retracts (retracts in this orbit), cycle_short, short_now.
+  ShortPins short_pins{pins_};
 
  protected:
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
