@@ -1,14 +1,12 @@
 #include "edm/sim/params.hpp"
 
-// The simulator's parameter schema (visit, in parts: params_visit.hpp) and its validation. The
-// presets are presets.cpp, the thickness-profile parser thickness_profile.cpp.
+// The simulator's parameter schema (visit, whose parts are params_schema.cpp) and its validation.
+// The presets are presets.cpp, the thickness-profile parser thickness_profile.cpp.
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include "params_visit.hpp"
 
 namespace edm::sim {
 
@@ -35,17 +33,17 @@ class LoadTimeOnly final : public rt::ParamVisitor {
 
 void SimParams::visit(rt::ParamVisitor& outer) {
   LoadTimeOnly v(outer);
-  visit_generator(*this, v);
-  visit_ignition(*this, v);
-  visit_shorts(*this, v);
-  visit_arcs(*this, v);
-  visit_removal(*this, v);
-  visit_electrode(*this, v, outer);
-  visit_work(*this, v, outer);
-  visit_flushing(*this, v);
-  visit_axes(*this, v);
-  visit_wire(*this, v);
-  visit_sensors(*this, v);
+  visit_generator(v);
+  visit_ignition(v);
+  visit_shorts(v);
+  visit_arcs(v);
+  visit_removal(v);
+  visit_electrode(v, outer);
+  visit_work(v, outer);
+  visit_flushing(v);
+  visit_axes(v);
+  visit_wire(v);
+  visit_sensors(v);
 }
 
 std::vector<rt::ParamError> SimParams::validate() const {
