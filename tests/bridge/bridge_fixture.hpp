@@ -23,6 +23,7 @@
 #include "edm/bridge/server.hpp"
 #include "support/bridge_test_config.hpp"
 #include "support/runtime_fixture.hpp"
+#include "support/runtime_thread.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::bridge::test {
@@ -162,25 +163,11 @@ class BridgeFixture : public ::testing::Test {
     opt.port = 0;
     server_ = std::make_unique<Server>(*rt_, opt);
     server_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kReal;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    // run() powers the machine on (OFF → READY) on its thread: wait for that, not for a time.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
-    ASSERT_NE(rt_->machine().state(), rt::MachineState::kOff) << "the runtime did not start";
+    runner_.start(*rt_);  // the real clock
+    ASSERT_TRUE(runner_.wait_until_powered_on()) << "the runtime did not start";
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) {
-      runner_.join();
-    }
+    runner_.stop();
     if (server_) {
       server_->stop();
     }
@@ -202,8 +189,7 @@ class BridgeFixture : public ::testing::Test {
   edm::test::TempDir dir_{"edm-bridge"};
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<Server> server_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  edm::test::RuntimeThread runner_;
 };
 
 /// A watchdog warning from `source` (static strings, as the RT side raises alarms).

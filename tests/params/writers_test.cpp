@@ -20,6 +20,7 @@
 #include "edm/bridge/server.hpp"
 #include "edm/modbus/server.hpp"
 #include "params/params_rig.hpp"
+#include "support/runtime_thread.hpp"
 
 namespace edm::test {
 namespace {
@@ -74,24 +75,11 @@ class RunningMachine : public ::testing::Test {
     cfg.map.push_back(e);
     modbus_ = std::make_unique<modbus::Server>(rt_->variables(), cfg);
     modbus_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kReal;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
-    ASSERT_NE(rt_->machine().state(), rt::MachineState::kOff) << "the runtime did not start";
+    runner_.start(*rt_);  // the real clock
+    ASSERT_TRUE(runner_.wait_until_powered_on()) << "the runtime did not start";
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) {
-      runner_.join();
-    }
+    runner_.stop();
     if (modbus_) {
       modbus_->stop();
     }
@@ -104,8 +92,7 @@ class RunningMachine : public ::testing::Test {
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<bridge::Server> bridge_;
   std::unique_ptr<modbus::Server> modbus_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  RuntimeThread runner_;
 };
 
 TEST_F(RunningMachine, TheBridgeRefusesGapKgAt2To63AsOutOfRangeAndKeepsTheValue) {
