@@ -14,6 +14,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <string_view>
 #include <thread>
@@ -155,14 +156,29 @@ inline void write_token(const std::string& path, const std::string& token, mode_
   ::chmod(path.c_str(), mode);
 }
 
+/// A bridge server for `rt` on an ephemeral loopback port (whatever opt.port says), started.
+inline std::unique_ptr<Server> start_server(rt::Runtime& rt, ServerOptions opt = {}) {
+  opt.port = 0;
+  auto server = std::make_unique<Server>(rt, opt);
+  server->start();
+  return server;
+}
+
+/// How a test client reaches `server`: its port, `token`, 10 s timeouts.
+inline ClientOptions client_options(const Server& server, const std::string& token = "") {
+  ClientOptions o;
+  o.port = server.port();
+  o.token = token;
+  o.timeout = std::chrono::seconds(10);
+  return o;
+}
+
 class BridgeFixture : public ::testing::Test {
  protected:
   /// Builds the runtime and starts the server with `opt` (port 0), then runs the tasks.
   void start(ServerOptions opt = {}) {
     rt_ = edm::test::build_from_text(kBridgeTestConfig, "bridge-test.yaml");
-    opt.port = 0;
-    server_ = std::make_unique<Server>(*rt_, opt);
-    server_->start();
+    server_ = start_server(*rt_, opt);
     runner_.start(*rt_);  // the real clock
     ASSERT_TRUE(runner_.wait_until_powered_on()) << "the runtime did not start";
   }
@@ -179,11 +195,7 @@ class BridgeFixture : public ::testing::Test {
     return c.connect(client_opts());
   }
   ClientOptions client_opts(const std::string& token = "") const {
-    ClientOptions o;
-    o.port = server_->port();
-    o.token = token;
-    o.timeout = std::chrono::seconds(10);
-    return o;
+    return client_options(*server_, token);
   }
 
   edm::test::TempDir dir_{"edm-bridge"};

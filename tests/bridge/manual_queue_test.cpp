@@ -84,20 +84,11 @@ class ManualInOneWrite : public ::testing::Test {
   void SetUp() override {
     rt_ = edm::test::build_sim_machine(
         rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
-    ServerOptions o;
-    o.port = 0;
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    rt::RunOptions ro;
-    ro.clock = rt::ClockKind::kVirtual;
-    ro.speed = 10.0;
-    runner_.start(*rt_, ro);
+    server_ = start_server(*rt_);
+    runner_.start(*rt_, edm::test::paced_virtual_clock(10.0));
     runner_.wait_until_powered_on();
     ASSERT_EQ(rt_->machine().state(), rt::MachineState::kReady);
-    ClientOptions co;
-    co.port = server_->port();
-    co.timeout = 10s;
-    ASSERT_EQ(watch_.connect(co), Role::kOperator);
+    ASSERT_EQ(watch_.connect(client_options(*server_)), Role::kOperator);
   }
   void TearDown() override {
     runner_.stop();

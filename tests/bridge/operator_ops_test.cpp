@@ -30,17 +30,12 @@ class OperatorOps : public ::testing::Test {
     rt_ = edm::test::build_sim_machine(rt::parse_config_text(
         text, std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
     ServerOptions o;
-    o.port = 0;
     o.token_file = dir_.file("op.token");
     o.viewer_token_file = dir_.file("viewer.token");
     write_token(o.token_file, kOp, 0600);
     write_token(o.viewer_token_file, kViewer, 0600);
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    rt::RunOptions ro;
-    ro.clock = rt::ClockKind::kVirtual;
-    ro.speed = 10.0;
-    runner_.start(*rt_, ro);
+    server_ = start_server(*rt_, o);
+    runner_.start(*rt_, edm::test::paced_virtual_clock(10.0));
     runner_.wait_until_powered_on();
     ASSERT_EQ(op_.connect(opts(kOp)), Role::kOperator);
     ASSERT_EQ(viewer_.connect(opts(kViewer)), Role::kViewer);
@@ -49,13 +44,7 @@ class OperatorOps : public ::testing::Test {
     runner_.stop();
     if (server_) server_->stop();
   }
-  ClientOptions opts(const std::string& token) const {
-    ClientOptions o;
-    o.port = server_->port();
-    o.token = token;
-    o.timeout = 10s;
-    return o;
-  }
+  ClientOptions opts(const std::string& token) const { return client_options(*server_, token); }
   /// Polls manual.status until the request `seq` is done; returns the final status.
   Json wait_manual(std::uint64_t seq) {
     Json st;

@@ -11,6 +11,14 @@
 
 namespace edm::test {
 
+/// The virtual clock paced to `speed` × wall time: deterministic, yet followable from outside.
+inline rt::RunOptions paced_virtual_clock(double speed) {
+  rt::RunOptions o;
+  o.clock = rt::ClockKind::kVirtual;
+  o.speed = speed;
+  return o;
+}
+
 class RuntimeThread {
  public:
   RuntimeThread() = default;
