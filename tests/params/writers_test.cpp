@@ -21,21 +21,13 @@
 #include "edm/modbus/server.hpp"
 #include "params/params_rig.hpp"
 #include "support/runtime_thread.hpp"
+#include "support/test_machine.hpp"
 
 namespace edm::test {
 namespace {
 
-constexpr const char* kGapMachine = R"(version: 1
-machine:
-  name: gap-only
-  io: {driver: loopback, task: t, params: {channels: 1}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Y, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
+const std::string kGapMachine =
+    test_machine("gap-only", "{driver: loopback, task: t, params: {channels: 1}}") + R"(tasks:
   - {name: t, interval: 1ms, priority: 0, programs: [cnc]}
 programs:
   - name: cnc
