@@ -120,26 +120,34 @@ void BM_WearCompensator(benchmark::State& state) {
   run_cycles(state, block_cycle(block, "vz_out_mm_s", ctx, inputs));
 }
 
-// Seed 004 eq. 12-13: a linear move in progress at 600 mm/min, the override changing each cycle;
-// `start` toggles every cycle (ignored while busy), so a move that ends is followed by the next.
+// The inputs of an interpolator in these benchmarks: `start` toggling every cycle (ignored while
+// busy, so a move that ends is followed by the next) and the override changing each cycle.
+struct MoveDrive {
+  rt::Output<bool> go;
+  rt::Output<double> ovr;
+  explicit MoveDrive(rt::Block& b) {
+    wire(b, "start", go);
+    wire(b, "override", ovr);
+  }
+  void set(std::uint64_t cycle) {
+    go.set((cycle & 1) == 0);
+    ovr.set(table_in(cycle, 0.5, 1.5));
+  }
+};
+
+// Seed 004 eq. 12-13: a linear move in progress at 600 mm/min (MoveDrive's start and override).
 void BM_LinearInterpolator(benchmark::State& state) {
   LinearInterpolator block;
   if (!start(state, block, LinearInterpolatorParams{})) {
     return;
   }
-  rt::Output<bool> go;
-  rt::Output<double> ovr;
-  wire(block, "start", go);
-  wire(block, "override", ovr);
+  MoveDrive drive(block);
   set_input(block, "lx_mm", 300.0);
   set_input(block, "ly_mm", -200.0);
   set_input(block, "lz_mm", -50.0);
   set_input(block, "feed_mm_min", 600.0);
   rt::CycleContext ctx = running_context();
-  const auto inputs = [&] {
-    go.set((ctx.cycle & 1) == 0);
-    ovr.set(table_in(ctx.cycle, 0.5, 1.5));
-  };
+  const auto inputs = [&] { drive.set(ctx.cycle); };
   run_cycles(state, block_cycle(block, "rx_mm", ctx, inputs));
 }
 
@@ -149,20 +157,14 @@ void BM_CircularInterpolator(benchmark::State& state) {
   if (!start(state, block, CircularInterpolatorParams{})) {
     return;
   }
-  rt::Output<bool> go;
-  rt::Output<double> ovr;
-  wire(block, "start", go);
-  wire(block, "override", ovr);
+  MoveDrive drive(block);
   set_input(block, "i_mm", -1.0);
   set_input(block, "j_mm", 0.0);
   set_input(block, "full_circle", true);
   set_input<std::int64_t>(block, "turns", 100);
   set_input(block, "feed_mm_min", 600.0);
   rt::CycleContext ctx = running_context();
-  const auto inputs = [&] {
-    go.set((ctx.cycle & 1) == 0);
-    ovr.set(table_in(ctx.cycle, 0.5, 1.5));
-  };
+  const auto inputs = [&] { drive.set(ctx.cycle); };
   run_cycles(state, block_cycle(block, "rx_mm", ctx, inputs));
 }
 
