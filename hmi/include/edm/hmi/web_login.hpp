@@ -6,10 +6,10 @@
 // browsers are throttled here, each by its own address, with edmplc's schedule (FailureBackoff,
 // the one both use): after n failed log-ins from an address within kForgetAfter of each other,
 // its next log-in is not checked before kBaseDelay·2^(n−1) (at most kMaxDelay) has passed since
-// the last failure, and one log-in per address is checked at a time — the rest wait, on any number of sockets, so an address
-// guesses at most once per delay however many sockets it opens. A right token is delayed, never
-// refused, and does not forget the failures. The browser's address also goes to edmplc in the
-// hello ("peer"), whose own throttle keys on it the same way.
+// the last failure, and one log-in per address is checked at a time — the rest wait, on any number
+// of sockets, so an address guesses at most once per delay however many sockets it opens. A right
+// token is delayed, never refused, and does not forget the failures. The browser's address also
+// goes to edmplc in the hello ("peer"), whose own throttle keys on it the same way.
 //
 // Non-RT. Thread-safety: none (the server's I/O thread only). Time is passed in (tests).
 
