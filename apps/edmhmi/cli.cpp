@@ -25,6 +25,12 @@ bool connect(edm::bridge::Client& client, const edm::hmi::ConnectionSettings& s,
   }
 }
 
+std::optional<edm::hmi::MachineView> connect_and_fetch_machine(
+    edm::bridge::Client& client, const edm::hmi::ConnectionSettings& settings) {
+  if (!connect(client, settings, /*auto_reconnect=*/true)) return std::nullopt;
+  return fetch([&] { return edm::hmi::fetch_machine(client); });
+}
+
 int report_error(std::string_view op, const edm::bridge::Reply& r) {
   const std::string code = r.code ? std::string(edm::bridge::to_string(*r.code)) : "transport";
   std::fprintf(stderr, "edmhmi: %s: %s: %s\n", std::string(op).c_str(), code.c_str(),

@@ -3,6 +3,7 @@
 // (DESIGN §4: exit 0 ok, 1 runtime failure or alarm, 2 bad input.)
 
 #include <atomic>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -11,6 +12,7 @@
 #include "edm/apps/cli.hpp"
 #include "edm/bridge/client.hpp"
 #include "edm/hmi/connection.hpp"
+#include "edm/hmi/job_runner.hpp"
 
 namespace edmhmi {
 
@@ -81,6 +83,24 @@ int usage(const std::string& message);
 /// Connects and says hello; prints why on failure and returns false.
 bool connect(edm::bridge::Client& client, const edm::hmi::ConnectionSettings& settings,
              bool auto_reconnect = false);
+
+/// Runs one of edm::hmi's fetch_* calls (they throw bridge::ClientError when a request is
+/// refused or its reply malformed); prints why it failed and returns nullopt.
+template <class Fetch>
+auto fetch(Fetch&& f) -> std::optional<decltype(f())> {
+  try {
+    return f();
+  } catch (const edm::bridge::ClientError& e) {
+    std::fprintf(stderr, "edmhmi: %s\n", e.what());
+    return std::nullopt;
+  }
+}
+
+/// Connects, reconnecting while a job runs, and fetches the machine a program is interpreted
+/// against (tables, work frames, where the electrode is); prints why on failure and returns
+/// nullopt.
+std::optional<edm::hmi::MachineView> connect_and_fetch_machine(
+    edm::bridge::Client& client, const edm::hmi::ConnectionSettings& settings);
 
 /// Prints a refused reply ("edmhmi: op: code: message") and returns the exit code for it.
 int report_error(std::string_view op, const edm::bridge::Reply& reply);

@@ -11,14 +11,9 @@ namespace edmhmi {
 
 int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& settings) {
   edm::bridge::Client client;
-  if (!connect(client, settings, /*auto_reconnect=*/true)) return kExitFailure;
-  edm::hmi::MachineView machine;
-  try {
-    machine = edm::hmi::fetch_machine(client);
-  } catch (const edm::bridge::ClientError& e) {
-    std::fprintf(stderr, "edmhmi: %s\n", e.what());
-    return kExitFailure;
-  }
+  const std::optional<edm::hmi::MachineView> fetched = connect_and_fetch_machine(client, settings);
+  if (!fetched) return kExitFailure;
+  const edm::hmi::MachineView& machine = *fetched;
   const edm::hmi::GcodeResult g =
       edm::hmi::interpret_mdi(line, machine.tables, machine.offsets, machine.position);
   if (!g.ok()) {

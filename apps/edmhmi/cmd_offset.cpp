@@ -74,13 +74,10 @@ int cmd_offset(const OffsetArgs& args, const edm::hmi::ConnectionSettings& setti
                 static_cast<unsigned long long>(r.body.value("generation", std::uint64_t{0})));
     return kExitOk;
   }
-  edm::hmi::WorkOffsets offsets;
-  try {
-    offsets = edm::hmi::fetch_offsets(client);
-  } catch (const edm::bridge::ClientError& e) {
-    std::fprintf(stderr, "edmhmi: %s\n", e.what());
-    return kExitFailure;
-  }
+  const std::optional<edm::hmi::WorkOffsets> fetched =
+      fetch([&] { return edm::hmi::fetch_offsets(client); });
+  if (!fetched) return kExitFailure;
+  const edm::hmi::WorkOffsets& offsets = *fetched;
   if (args.json) {
     std::printf("%s\n", edm::hmi::to_json(offsets).dump(2).c_str());
     return kExitOk;

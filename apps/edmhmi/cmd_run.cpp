@@ -129,14 +129,9 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
   if (!read_text_file(part, text)) return kExitBadInput;
 
   edm::bridge::Client client;
-  if (!connect(client, settings, /*auto_reconnect=*/true)) return kExitFailure;
-  edm::hmi::MachineView machine;
-  try {
-    machine = edm::hmi::fetch_machine(client);
-  } catch (const edm::bridge::ClientError& e) {
-    std::fprintf(stderr, "edmhmi: %s\n", e.what());
-    return kExitFailure;
-  }
+  const std::optional<edm::hmi::MachineView> fetched = connect_and_fetch_machine(client, settings);
+  if (!fetched) return kExitFailure;
+  const edm::hmi::MachineView& machine = *fetched;
   // The program starts where the electrode is now, against the conditions and limits of the
   // machine it runs on.
   // In work coordinates: the frames are the machine's (offset.get).

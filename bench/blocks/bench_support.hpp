@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <random>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "edm/runtime/block.hpp"
@@ -106,6 +107,14 @@ class BatchHistogram {
   double max_ns_{0.0};
 };
 
+// Adds the figures of a histogram (BatchHistogram, CallHistogram) to the benchmark's counters.
+template <class Histogram>
+void report_percentiles(benchmark::State& state, const Histogram& hist) {
+  state.counters["p50_ns"] = hist.percentile(0.50);
+  state.counters["p99_ns"] = hist.percentile(0.99);
+  state.counters["max_ns"] = hist.max_ns();
+}
+
 // Runs one_cycle once per benchmark iteration; see the file comment for what is reported.
 template <class Fn>
 void run_cycles(benchmark::State& state, Fn&& one_cycle) {
@@ -121,9 +130,7 @@ void run_cycles(benchmark::State& state, Fn&& one_cycle) {
       in_batch = 0;
     }
   }
-  state.counters["p50_ns"] = hist.percentile(0.50);
-  state.counters["p99_ns"] = hist.percentile(0.99);
-  state.counters["max_ns"] = hist.max_ns();
+  report_percentiles(state, hist);
 }
 
 // Per-call times: 1 ns buckets up to 64 µs, the exact maximum beyond (allocated before timing).
@@ -166,9 +173,19 @@ void run_timed(benchmark::State& state, Fn&& one_call) {
     const auto t1 = std::chrono::steady_clock::now();
     hist.add(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
   }
-  state.counters["p50_ns"] = hist.percentile(0.50);
-  state.counters["p99_ns"] = hist.percentile(0.99);
-  state.counters["max_ns"] = hist.max_ns();
+  report_percentiles(state, hist);
+}
+
+// Times one_call on its own as this iteration's manual time (a benchmark with UseManualTime(),
+// whose iteration does untimed work besides), into hist.
+template <class Fn>
+void time_manually(benchmark::State& state, CallHistogram& hist, Fn&& one_call) {
+  const auto t0 = std::chrono::steady_clock::now();
+  one_call();
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0);
+  hist.add(ns.count());
+  state.SetIterationTime(std::chrono::duration<double>(ns).count());
 }
 
 /// A cycle context for a 1 ms task in RUNNING.
@@ -178,6 +195,19 @@ inline rt::CycleContext running_context() {
   ctx.dt_s = 1e-3;
   ctx.state = rt::MachineState::kRunning;
   return ctx;
+}
+
+/// One cycle of block b, for run_cycles or run_timed: inputs() sets the cycle's inputs (from
+/// ctx.cycle, say), then b.update(ctx), then output `out` is read (neither is optimised away),
+/// then ctx.cycle counts on. b and ctx outlive the returned callable.
+template <class Inputs>
+auto block_cycle(rt::Block& b, std::string_view out, rt::CycleContext& ctx, Inputs inputs) {
+  return [&b, &ctx, pin = pin_of(b, out), inputs = std::move(inputs)]() mutable {
+    inputs();
+    benchmark::DoNotOptimize(b.update(ctx));
+    benchmark::DoNotOptimize(rt::read_pin_as_double(pin));
+    ++ctx.cycle;
+  };
 }
 
 /// Connects the input `name` of b to `source` (false if b has no such input of type T).

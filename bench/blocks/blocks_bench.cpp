@@ -40,20 +40,15 @@ using namespace edm::bench;
 // Runs block b once per iteration with `source` fed from the random table; `per_cycle(cycle)`
 // sets any further inputs before each update.
 template <class PerCycle>
-void run_block(benchmark::State& state, rt::Block& b, rt::Output<double>& source,
-               const rt::PinRef& out, PerCycle&& per_cycle) {
+void run_fed(benchmark::State& state, rt::Block& b, rt::Output<double>& source,
+             std::string_view out, PerCycle&& per_cycle) {
   const auto& table = input_table();
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
-  run_cycles(state, [&] {
+  rt::CycleContext ctx = running_context();
+  const auto inputs = [&] {
     source.set(table[ctx.cycle & (kTableSize - 1)]);
     per_cycle(ctx.cycle);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(b, out, ctx, inputs));
 }
 
 // One block with its "in" pin fed from the random table.
@@ -67,7 +62,7 @@ void bench_single(benchmark::State& state, const typename B::Params& p) {
   if (auto* in = pin_of(block, "in").template as_input<double>()) {
     in->connect(source);
   }
-  run_block(state, block, source, pin_of(block, "out"), [](auto /*cycle*/) {});
+  run_fed(state, block, source, "out", [](auto /*cycle*/) {});
 }
 
 void BM_Gain(benchmark::State& state) { bench_single<Gain>(state, {.k = 1.5, .offset = 0.25}); }
@@ -99,8 +94,7 @@ void BM_Select(benchmark::State& state) {
   pin_of(block, "in0").as_input<double>()->set_constant(0.5);
   pin_of(block, "in1").as_input<double>()->connect(source);
   pin_of(block, "g").as_input<bool>()->connect(g);
-  run_block(state, block, source, pin_of(block, "out"),
-            [&g](auto cycle) { g.set(((cycle >> 6) & 1) != 0); });
+  run_fed(state, block, source, "out", [&g](auto cycle) { g.set(((cycle >> 6) & 1) != 0); });
 }
 
 // JumpCycle with a short period (100 ms: 4 up, 5 down): the servo pass-through and the jump
@@ -118,7 +112,7 @@ void BM_JumpCycle(benchmark::State& state) {
   rt::Output<double> source;
   pin_of(block, "vz_in_mm_s").as_input<double>()->connect(source);
   pin_of(block, "z_mm").as_input<double>()->connect(source);
-  run_block(state, block, source, pin_of(block, "vz_out_mm_s"), [](auto /*cycle*/) {});
+  run_fed(state, block, source, "vz_out_mm_s", [](auto /*cycle*/) {});
 }
 
 // The realistic chain: five blocks, four wires, one task cycle each.
@@ -145,10 +139,7 @@ void BM_Chain(benchmark::State& state) {
     in->connect(*out);
   }
   const rt::PinRef out = pin_of(gain, "out");
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
+  rt::CycleContext ctx = running_context();
   run_cycles(state, [&] {
     for (rt::Block* b : chain) {
       benchmark::DoNotOptimize(b->update(ctx));
@@ -188,21 +179,14 @@ void BM_FuzzyServoLUT(benchmark::State& state) {
   rt::Output<std::int64_t> shorts;
   pin_of(block, "open_count").as_input<std::int64_t>()->connect(open);
   pin_of(block, "short_count").as_input<std::int64_t>()->connect(shorts);
-  const rt::PinRef out = pin_of(block, "v_mm_s");
   const auto& pairs = count_pairs();
-  rt::Block& b = block;
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
-  run_cycles(state, [&] {
+  rt::CycleContext ctx = running_context();
+  const auto inputs = [&] {
     const CountPair& c = pairs[ctx.cycle & (kTableSize - 1)];
     open.set(c.open);
     shorts.set(c.shorts);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(block, "v_mm_s", ctx, inputs));
 }
 
 // The lookup alone, as update() makes it (address open·64 + short, int16 code × lsb), without
@@ -262,22 +246,15 @@ void BM_DischargeStateCounter(benchmark::State& state) {
     const auto shorts = static_cast<std::uint32_t>(r >> 32) & ~open;
     m = {open, shorts & 0x5555'5555U, shorts & 0xAAAA'AAAAU};
   }
-  const rt::PinRef out = pin_of(block, "open_count");
-  rt::Block& b = block;
-  rt::CycleContext ctx;
-  ctx.period = kPeriod;
-  ctx.dt_s = 1e-3;
-  ctx.state = rt::MachineState::kRunning;
+  rt::CycleContext ctx = running_context();
   src[4].set(26);
-  run_cycles(state, [&] {
+  const auto inputs = [&] {
     const auto& m = masks[ctx.cycle & (kTableSize - 1)];
     src[0].set(m[0]);
     src[1].set(m[1]);
     src[2].set(m[2]);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(block, "open_count", ctx, inputs));
 }
 
 BENCHMARK(BM_Gain);

@@ -253,17 +253,10 @@ void BM_DrillScan_EdmJob(benchmark::State& state) {
     ctx.cycle = m.cycle++;
     ctx.state = m.runtime->machine().state();
     io.read_inputs(ctx);
-    const auto t0 = std::chrono::steady_clock::now();
-    m.cnc->run(ctx);
-    const auto t1 = std::chrono::steady_clock::now();
+    time_manually(state, hist, [&] { m.cnc->run(ctx); });
     io.write_outputs(ctx);
-    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0);
-    hist.add(ns.count());
-    state.SetIterationTime(std::chrono::duration<double>(ns).count());
   }
-  state.counters["p50_ns"] = hist.percentile(0.50);
-  state.counters["p99_ns"] = hist.percentile(0.99);
-  state.counters["max_ns"] = hist.max_ns();
+  report_percentiles(state, hist);
   if (!m.drilling()) {
     state.SkipWithError(("left DRILL during the timed loop: " + m.state_text()).c_str());
   }

@@ -73,19 +73,15 @@ void BM_TdDetector(benchmark::State& state) {
   wire(block, "td_count", count);
   wire(block, "n_open", open);
   wire(block, "n_short", shorts);
-  const rt::PinRef out = pin_of(block, "td_us");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
+  const auto inputs = [&] {
     const PulseCounts& c = pulse_table()[ctx.cycle & (kTableSize - 1)];
     sum.set(c.td_sum_ns);
     count.set(c.td_count);
     open.set(c.n_open);
     shorts.set(c.n_short);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(block, "td_us", ctx, inputs));
 }
 
 // Seed 004 eq. 1: Vz = Kg·(Tdr − Td), Td 2-20 µs around Tdr 8 µs (both clamps hit sometimes).
@@ -99,15 +95,9 @@ void BM_GapControllerP(benchmark::State& state) {
   set_input(block, "valid", true);
   set_input(block, "enable", true);
   set_input(block, "tdr_us", 8.0);
-  const rt::PinRef out = pin_of(block, "vz_mm_s");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
-    td.set(table_in(ctx.cycle, 2.0, 20.0));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  const auto inputs = [&] { td.set(table_in(ctx.cycle, 2.0, 20.0)); };
+  run_cycles(state, block_cycle(block, "vz_mm_s", ctx, inputs));
 }
 
 // Seed 004 eq. 8 with drill-sim's E1 (θ 0.6189, A_hole/A_e 1.3297): a servo that mostly feeds
@@ -122,43 +112,43 @@ void BM_WearCompensator(benchmark::State& state) {
   set_input(block, "wear_ratio", 0.6189);
   set_input(block, "area_ratio", 1.3297);
   set_input(block, "enable", true);
-  const rt::PinRef out = pin_of(block, "vz_out_mm_s");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
+  const auto inputs = [&] {
     ctx.release += kPeriod;  // it integrates over the time between releases
     vz.set(table_in(ctx.cycle, -0.8, 0.2));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(block, "vz_out_mm_s", ctx, inputs));
 }
 
-// Seed 004 eq. 12-13: a linear move in progress at 600 mm/min, the override changing each cycle;
-// `start` toggles every cycle (ignored while busy), so a move that ends is followed by the next.
+// The inputs of an interpolator in these benchmarks: `start` toggling every cycle (ignored while
+// busy, so a move that ends is followed by the next) and the override changing each cycle.
+struct MoveDrive {
+  rt::Output<bool> go;
+  rt::Output<double> ovr;
+  explicit MoveDrive(rt::Block& b) {
+    wire(b, "start", go);
+    wire(b, "override", ovr);
+  }
+  void set(std::uint64_t cycle) {
+    go.set((cycle & 1) == 0);
+    ovr.set(table_in(cycle, 0.5, 1.5));
+  }
+};
+
+// Seed 004 eq. 12-13: a linear move in progress at 600 mm/min (MoveDrive's start and override).
 void BM_LinearInterpolator(benchmark::State& state) {
   LinearInterpolator block;
   if (!start(state, block, LinearInterpolatorParams{})) {
     return;
   }
-  rt::Output<bool> go;
-  rt::Output<double> ovr;
-  wire(block, "start", go);
-  wire(block, "override", ovr);
+  MoveDrive drive(block);
   set_input(block, "lx_mm", 300.0);
   set_input(block, "ly_mm", -200.0);
   set_input(block, "lz_mm", -50.0);
   set_input(block, "feed_mm_min", 600.0);
-  const rt::PinRef out = pin_of(block, "rx_mm");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
-    go.set((ctx.cycle & 1) == 0);
-    ovr.set(table_in(ctx.cycle, 0.5, 1.5));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  const auto inputs = [&] { drive.set(ctx.cycle); };
+  run_cycles(state, block_cycle(block, "rx_mm", ctx, inputs));
 }
 
 // Seed 004 eq. 14-19: full circles of radius 1 mm at 600 mm/min (sin/cos every cycle).
@@ -167,25 +157,15 @@ void BM_CircularInterpolator(benchmark::State& state) {
   if (!start(state, block, CircularInterpolatorParams{})) {
     return;
   }
-  rt::Output<bool> go;
-  rt::Output<double> ovr;
-  wire(block, "start", go);
-  wire(block, "override", ovr);
+  MoveDrive drive(block);
   set_input(block, "i_mm", -1.0);
   set_input(block, "j_mm", 0.0);
   set_input(block, "full_circle", true);
   set_input<std::int64_t>(block, "turns", 100);
   set_input(block, "feed_mm_min", 600.0);
-  const rt::PinRef out = pin_of(block, "rx_mm");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
-    go.set((ctx.cycle & 1) == 0);
-    ovr.set(table_in(ctx.cycle, 0.5, 1.5));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  const auto inputs = [&] { drive.set(ctx.cycle); };
+  run_cycles(state, block_cycle(block, "rx_mm", ctx, inputs));
 }
 
 // Seed 004 eq. 20-21: the orbit radius grown from each revolution's mean Td (a revolution every
@@ -205,17 +185,11 @@ void BM_OrbitExpander(benchmark::State& state) {
   set_input(block, "final_radius_mm", 1e6);
   set_input(block, "enable", true);
   set_input(block, "valid", true);
-  const rt::PinRef out = pin_of(block, "radius_mm");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
   go.set(true);
-  benchmark::DoNotOptimize(b.update(ctx));
-  run_cycles(state, [&] {
-    td.set(table_in(ctx.cycle, 2.0, 20.0));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  benchmark::DoNotOptimize(static_cast<rt::Block&>(block).update(ctx));
+  const auto inputs = [&] { td.set(table_in(ctx.cycle, 2.0, 20.0)); };
+  run_cycles(state, block_cycle(block, "radius_mm", ctx, inputs));
 }
 
 // One axis loop as EdmJob's px/py/pz run it (P + feed-forward, in-position window), following a
@@ -230,18 +204,14 @@ void BM_PositionLoop(benchmark::State& state) {
   wire(block, "x_mm", x);
   wire(block, "v_ff_mm_s", vff);
   set_input(block, "enable", true);
-  const rt::PinRef out = pin_of(block, "v_cmd_mm_s");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
+  const auto inputs = [&] {
     const double r = 1e-3 * static_cast<double>(ctx.cycle & 0xFFFF);
     ref.set(r);
     x.set(r - table_in(ctx.cycle, 0.0, 0.05));
     vff.set(table_in(ctx.cycle + 7, -1.0, 1.0));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_cycles(state, block_cycle(block, "v_cmd_mm_s", ctx, inputs));
 }
 
 // Seed 001: one STR sample (sink-str-sim's parameters, the loops alternating): the five gap-state
@@ -268,10 +238,8 @@ void BM_SelfTuningRegulator(benchmark::State& state) {
   wire(block, "ratio_transient_arc", transient);
   wire(block, "ratio_stable_arc", stable);
   wire(block, "ratio_short", shorts);
-  const rt::PinRef out = pin_of(block, "servo_ref_v");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_timed(state, [&] {
+  const auto inputs = [&] {
     const double tr = table_in(ctx.cycle, 0.0, 0.15);
     const double st = ctx.cycle % 50 == 0 ? 0.05 : 0.0;
     const double sh = table_in(ctx.cycle + 11, 0.0, 0.1);
@@ -279,10 +247,8 @@ void BM_SelfTuningRegulator(benchmark::State& state) {
     stable.set(st);
     shorts.set(sh);
     normal.set(0.8 - tr - st - sh);
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_timed(state, block_cycle(block, "servo_ref_v", ctx, inputs));
 }
 
 // Seed 000: one step of the self-tuning fuzzy PI (wire-stfpi-sim's parameters): predicted and
@@ -307,16 +273,12 @@ void BM_SelfTuningFuzzyPI(benchmark::State& state) {
   rt::Output<double> rab_p, rab_f;
   wire(block, "rab_p", rab_p);
   wire(block, "rab_f", rab_f);
-  const rt::PinRef out = pin_of(block, "arc_off_time_us");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_timed(state, [&] {
+  const auto inputs = [&] {
     rab_p.set(table_in(ctx.cycle, 0.2, 0.7));
     rab_f.set(table_in(ctx.cycle + 3, 0.3, 0.6));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  };
+  run_timed(state, block_cycle(block, "arc_off_time_us", ctx, inputs));
 }
 
 // Seed 000 eq. 1: the GM(1,1) grey predictor, window 5, horizon 37, as wire-stfpi-sim runs it.
@@ -333,15 +295,9 @@ void BM_GreyPredictorGM11(benchmark::State& state) {
   }
   rt::Output<double> in;
   wire(block, "in", in);
-  const rt::PinRef out = pin_of(block, "out");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
-    in.set(table_in(ctx.cycle, 0.3, 0.6));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  const auto inputs = [&] { in.set(table_in(ctx.cycle, 0.3, 0.6)); };
+  run_cycles(state, block_cycle(block, "out", ctx, inputs));
 }
 
 // Seed 000: the 2nd-order Butterworth low-pass (cutoff 0.012 of Nyquist, wire-stfpi-sim's).
@@ -354,15 +310,9 @@ void BM_ButterworthLowPass(benchmark::State& state) {
   }
   rt::Output<double> in;
   wire(block, "in", in);
-  const rt::PinRef out = pin_of(block, "out");
-  rt::Block& b = block;
   rt::CycleContext ctx = running_context();
-  run_cycles(state, [&] {
-    in.set(table_in(ctx.cycle, 0.0, 1.0));
-    benchmark::DoNotOptimize(b.update(ctx));
-    benchmark::DoNotOptimize(rt::read_pin_as_double(out));
-    ++ctx.cycle;
-  });
+  const auto inputs = [&] { in.set(table_in(ctx.cycle, 0.0, 1.0)); };
+  run_cycles(state, block_cycle(block, "out", ctx, inputs));
 }
 
 // Seed 002's ILC with sink-ilc-sim's parameters (N = 1500 samples a jump cycle, Q pole 0.9, warm
@@ -444,16 +394,9 @@ void BM_ILCCycleUpdate(benchmark::State& state) {
     while (static_cast<std::int64_t>(rig.ctx.cycle) % rig.n != 0) {
       rig.sample();
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    rig.sample();
-    const auto t1 = std::chrono::steady_clock::now();
-    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0);
-    hist.add(ns.count());
-    state.SetIterationTime(std::chrono::duration<double>(ns).count());
+    time_manually(state, hist, [&] { rig.sample(); });
   }
-  state.counters["p50_ns"] = hist.percentile(0.50);
-  state.counters["p99_ns"] = hist.percentile(0.99);
-  state.counters["max_ns"] = hist.max_ns();
+  report_percentiles(state, hist);
 }
 
 BENCHMARK(BM_TdDetector);

@@ -10,7 +10,7 @@ std::optional<LoginThrottle::Clock::time_point> LoginThrottle::admit_at(const st
   if (it == peers_.end()) return now;
   Peer& p = it->second;
   if (p.checking) return std::nullopt;
-  if (p.failures == 0 || now - p.last_failure > kForgetAfter) {
+  if (p.failures == 0 || p.forgotten(now)) {
     peers_.erase(it);
     return now;
   }
@@ -33,13 +33,7 @@ std::chrono::milliseconds LoginThrottle::on_failure(const std::string& address,
   ++failures_;
   Peer& p = peer(address);
   p.checking = false;
-  if (p.failures > 0 && now - p.last_failure > kForgetAfter) p.failures = 0;
-  ++p.failures;
-  p.last_failure = now;
-  const int shift = static_cast<int>(std::min<std::uint32_t>(p.failures - 1, 16));
-  const auto delay = std::min<std::chrono::milliseconds>(kBaseDelay * (1LL << shift), kMaxDelay);
-  p.admit_at = now + delay;
-  return delay;
+  return p.fail(now);
 }
 
 void LoginThrottle::on_success(const std::string& address) {

@@ -8,15 +8,11 @@
 #include <set>
 #include <utility>
 
+#include "protocol_limits.hpp"
+
 namespace edm::modbus {
 
 namespace {
-
-// Modbus application protocol v1.1b3 §6: the most a single request may carry.
-constexpr std::uint16_t kMaxReadBits = 2000;
-constexpr std::uint16_t kMaxWriteBits = 1968;
-constexpr std::uint16_t kMaxReadRegisters = 125;
-constexpr std::uint16_t kMaxWriteRegisters = 123;
 
 constexpr const char* kStaleText =
     "modbus: the remote I/O's process image is older than stale_cycles (value: its age, cycles)";

@@ -6,8 +6,8 @@
 #include <map>
 #include <sstream>
 
-#include "edm/machining/bounded_read.hpp"
 #include "edm/machining/located_yaml.hpp"
+#include "edm/runtime/config_section.hpp"
 #include "edm/runtime/diagnostics.hpp"
 #include "edm/runtime/time.hpp"
 
@@ -243,21 +243,14 @@ class SectionParser {
 
 std::optional<ServerConfig> parse_server_text(const std::string& text, const std::string& path,
                                               const rt::VariableRegistry& vars) {
-  rt::DiagnosticSink sink;
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw rt::ConfigError({{{path, e.mark.line + 1, e.mark.column + 1}, "YAML: " + e.msg}});
-  }
-  if (!root.IsMap() || !root["modbus_server"]) {
+  const std::optional<y::Value> section = rt::config_section(text, path, "modbus_server");
+  if (!section) {
     return std::nullopt;
   }
-  const YAML::Node node = root["modbus_server"];
+  rt::DiagnosticSink sink;
   SectionParser p(path, sink, vars);
-  y::Reader loc_reader(path, sink);
   ServerConfig c;
-  p.parse(y::Value{node, loc_reader.loc(node), "modbus_server"}, c);
+  p.parse(*section, c);
   sink.throw_if_any();
   return c;
 }
@@ -267,12 +260,7 @@ std::optional<ServerConfig> load_server_config(const rt::Config& cfg,
   if (cfg.modbus_server_loc.line == 0) {
     return std::nullopt;
   }
-  const machining::BoundedRead file =
-      machining::read_bounded_file(cfg.path, machining::kMaxConfigBytes, "config");
-  if (!file.ok()) {
-    throw rt::ConfigError({{{cfg.path, 1, 1}, file.problem}});
-  }
-  return parse_server_text(file.text, cfg.path, vars);
+  return parse_server_text(rt::read_config_text(cfg), cfg.path, vars);
 }
 
 std::string format_register_map(const ServerConfig& c) {

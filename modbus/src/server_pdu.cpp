@@ -3,15 +3,11 @@
 #include <array>
 #include <cstring>
 
+#include "protocol_limits.hpp"
+
 namespace edm::modbus {
 
 namespace {
-
-// The protocol's quantity limits (MODBUS Application Protocol 1.1b3, §6.1-6.4, 6.11, 6.12).
-constexpr std::uint16_t kMaxReadBits = 2000;
-constexpr std::uint16_t kMaxReadRegisters = 125;
-constexpr std::uint16_t kMaxWriteBits = 1968;
-constexpr std::uint16_t kMaxWriteRegisters = 123;
 
 constexpr std::uint8_t kReadCoils = 0x01;
 constexpr std::uint8_t kReadDiscreteInputs = 0x02;

@@ -19,30 +19,7 @@ class PrefixedPins final : public PinVisitor {
   PinVisitor& inner_;
 };
 
-// Forwards a child's parameters with "<child>." in front of each name (non-RT).
-class PrefixedParams final : public ParamVisitor {
- public:
-  PrefixedParams(const std::string& prefix, ParamVisitor& inner) : prefix_(prefix), inner_(inner) {}
-
- protected:
-  void on_param(std::string_view name, ParamRef ref, ParamSpec spec) override {
-    inner_.forward(prefix_ + "." + std::string(name), ref, spec);
-  }
-
- private:
-  const std::string& prefix_;
-  ParamVisitor& inner_;
-};
-
 }  // namespace
-
-void append_prefixed(std::vector<ParamError>& errs, std::string_view prefix,
-                     std::vector<ParamError> more) {
-  for (ParamError& e : more) {
-    errs.push_back({e.field.empty() ? std::string(prefix) : std::string(prefix) + "." + e.field,
-                    std::move(e.message)});
-  }
-}
 
 void CompositeBlock::visit_pins(PinVisitor& v) {
   visit_own_pins(v);
@@ -52,69 +29,29 @@ void CompositeBlock::visit_pins(PinVisitor& v) {
   }
 }
 
-void CompositeBlock::visit_params(ParamVisitor& v) {
-  for (Child& c : children_) {
-    PrefixedParams p(c.name, v);
-    c.block->visit_params(p);
-  }
-}
+void CompositeBlock::visit_params(ParamVisitor& v) { child_params_.visit(v); }
 
-std::vector<ParamError> CompositeBlock::validate() const {
-  std::vector<ParamError> errs;
-  for (const Child& c : children_) {
-    append_prefixed(errs, c.name, c.block->validate());
+std::vector<ParamError> CompositeBlock::validate() const { return child_params_.validate(); }
+
+std::size_t CompositeBlock::param_count() { return child_params_.count(); }
+
+std::vector<ParamError> CompositeBlock::stage_param(std::size_t index, const ParamValue& v) {
+  const ChildParams::Owner o = child_params_.owner(index);
+  if (o.block == nullptr) {
+    return Block::stage_param(o.index, v);
   }
+  std::vector<ParamError> errs;
+  append_prefixed(errs, *o.prefix, o.block->stage_param(o.index, v));
   return errs;
 }
 
-std::size_t CompositeBlock::param_count() {
-  std::size_t n = 0;
-  for (Child& c : children_) {
-    n += c.block->param_count();
-  }
-  return n;
-}
-
-std::vector<ParamError> CompositeBlock::stage_param(std::size_t index, const ParamValue& v) {
-  for (Child& c : children_) {
-    const std::size_t n = c.block->param_count();
-    if (index < n) {
-      std::vector<ParamError> errs;
-      append_prefixed(errs, c.name, c.block->stage_param(index, v));
-      return errs;
-    }
-    index -= n;
-  }
-  return Block::stage_param(index, v);
-}
-
 void CompositeBlock::apply_param(std::size_t index, const ParamValue& v) noexcept {
-  for (Child& c : children_) {
-    const std::size_t n = c.block->param_count();
-    if (index < n) {
-      c.block->apply_param(index, v);
-      return;
-    }
-    index -= n;
-  }
+  child_params_.apply(index, v);
 }
 
-ParamValue CompositeBlock::read_param(std::size_t index) const {
-  for (const Child& c : children_) {
-    const std::size_t n = c.block->param_count();
-    if (index < n) {
-      return c.block->read_param(index);
-    }
-    index -= n;
-  }
-  return {};
-}
+ParamValue CompositeBlock::read_param(std::size_t index) const { return child_params_.read(index); }
 
-void CompositeBlock::commit_params() {
-  for (Child& c : children_) {
-    c.block->commit_params();
-  }
-}
+void CompositeBlock::commit_params() { child_params_.commit(); }
 
 std::vector<ParamError> CompositeBlock::configure(const BlockSetup& setup) {
   std::vector<ParamError> errs;

@@ -126,20 +126,13 @@ void Parser::include_one(const Value& item, ProgramSpec& out) {
 }
 
 void Parser::parse_fragment(const YAML::Node& root, ProgramSpec& out) {
-  Value top{root, r_.loc(root), ""};
-  if (top.loc.line == 0) {
-    top.loc = {r_.file(), 1, 1};
-  }
-  if (root.IsNull()) {
-    r_.error(top, "the fragment is empty (expected a map with blocks, wires or include)");
+  const std::optional<Value> top =
+      root_map(root, "the fragment is empty (expected a map with blocks, wires or include)",
+               "a fragment must be a map (blocks, wires, include), got ");
+  if (!top) {
     return;
   }
-  if (!root.IsMap()) {
-    r_.error(top,
-             "a fragment must be a map (blocks, wires, include), got " + Reader::describe(root));
-    return;
-  }
-  auto m = r_.map(top, {"blocks", "wires", "include"});
+  auto m = r_.map(*top, {"blocks", "wires", "include"});
   if (!m) {
     return;
   }

@@ -20,24 +20,34 @@ namespace edm::rt {
 
 namespace config_detail {
 
-void Parser::parse_document(const YAML::Node& root, Config& cfg) {
+std::optional<Value> Parser::root_map(const YAML::Node& root, const char* empty,
+                                      const char* not_map) {
   Value top{root, r_.loc(root), ""};
   if (top.loc.line == 0) {
     top.loc = {r_.file(), 1, 1};
   }
   if (root.IsNull()) {
-    r_.error(top, "the file is empty (expected a map with version, machine, tasks and programs)");
-    return;
+    r_.error(top, empty);
+    return std::nullopt;
   }
   if (!root.IsMap()) {
-    r_.error(top, "the top level must be a map (version, machine, tasks, programs, ...), got " +
-                      Reader::describe(root));
+    r_.error(top, not_map + Reader::describe(root));
+    return std::nullopt;
+  }
+  return top;
+}
+
+void Parser::parse_document(const YAML::Node& root, Config& cfg) {
+  const std::optional<Value> top =
+      root_map(root, "the file is empty (expected a map with version, machine, tasks and programs)",
+               "the top level must be a map (version, machine, tasks, programs, ...), got ");
+  if (!top) {
     return;
   }
   // `mqtt` is read by the telemetry library (telemetry/, docs/mqtt.md), `modbus_server` by the
   // modbus library (modbus/, docs/modbus.md); only their places are kept.
-  auto m = r_.map(top, {"version", "machine", "conditions", "tasks", "programs", "trace", "bridge",
-                        "retain", "mqtt", "modbus_server"});
+  auto m = r_.map(*top, {"version", "machine", "conditions", "tasks", "programs", "trace", "bridge",
+                         "retain", "mqtt", "modbus_server"});
   if (const Field* f = r_.require(*m, "version")) {
     auto v = r_.integer(f->value, 0, INT64_MAX);
     if (!v) {

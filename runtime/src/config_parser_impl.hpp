@@ -74,6 +74,9 @@ class Parser {
   void parse_document(const YAML::Node& root, Config& cfg);
 
  private:
+  // A file's root, located (1:1 when yaml-cpp has no mark) and checked to be a map: nullopt after
+  // reporting `empty` for an empty file, or `not_map` + what it is instead.
+  std::optional<Value> root_map(const YAML::Node& root, const char* empty, const char* not_map);
   void parse_machine(const Value& v, MachineSpec& out);
   void parse_io(const Value& v, IoSpec& out);
   // config_io.cpp: a driver's pin map and a composite's drivers.

@@ -22,4 +22,14 @@ inline std::atomic<std::size_t> g_allocations{0};
 /// Every allocation through operator new, any thread, counted or not (guards the guard).
 inline std::atomic<std::size_t> g_all_allocations{0};
 
+/// Runs fn() with this thread's allocations counted; how many it made.
+template <class Fn>
+std::size_t allocations_in(Fn&& fn) {
+  g_allocations = 0;
+  t_counting = true;
+  fn();
+  t_counting = false;
+  return g_allocations.load();
+}
+
 }  // namespace edm::test

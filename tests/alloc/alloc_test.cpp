@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "alloc/alloc_counter.hpp"
+#include "alloc/drill_job.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "edm/programs/register.hpp"
 #include "edm/sim/sim_driver.hpp"
@@ -25,6 +26,7 @@
 // escape (allocation DCE) and the guard would see one allocation of its two.
 namespace {
 
+using edm::test::allocations_in;
 using edm::test::g_all_allocations;
 using edm::test::g_allocations;
 using edm::test::t_counting;
@@ -138,18 +140,16 @@ TEST(Allocations, NoneInsideCyclesOfARealisticProgram) {
     ASSERT_TRUE(r->variables().write("gap.probe.gain", 3.0 + round));
     ASSERT_TRUE(r->variables().write("gap.meas.tau", 0.001 * (round + 1)));
     ASSERT_TRUE(r->variables().force("gap.err.out", 0.5 * round));
-    g_allocations = 0;
-    t_counting = true;
-    for (int k = 0; k < 500; ++k) {
-      const rt::TimePoint release{1ms * (round * 500 + k)};
-      clock.advance_to(release);
-      tasks[0]->run_cycle(release, clock);
-      if (k % 10 == 0) {
-        tasks[1]->run_cycle(release, clock);
+    total += allocations_in([&] {
+      for (int k = 0; k < 500; ++k) {
+        const rt::TimePoint release{1ms * (round * 500 + k)};
+        clock.advance_to(release);
+        tasks[0]->run_cycle(release, clock);
+        if (k % 10 == 0) {
+          tasks[1]->run_cycle(release, clock);
+        }
       }
-    }
-    t_counting = false;
-    total += g_allocations.load();
+    });
     r->trace().drain(sink);
   }
   EXPECT_EQ(total, 0u);
@@ -189,11 +189,7 @@ std::size_t allocations_in_cycles(rt::Runtime& r, int cycles) {
   for (int k = 0; k < cycles; ++k) {
     const rt::TimePoint release{1ms * k};
     clock.advance_to(release);
-    g_allocations = 0;
-    t_counting = true;
-    task.run_cycle(release, clock);
-    t_counting = false;
-    total += g_allocations.load();
+    total += allocations_in([&] { task.run_cycle(release, clock); });
     if (k % 500 == 499) {
       r.trace().drain(sink);
     }
@@ -216,17 +212,8 @@ TEST_P(DrillMachines, NoAllocationInsideCyclesWhileAJobDrills) {
   // drill-fuzzy-sim seed 003's counter and fuzzy LUT servo drive it) and the simulator inside the
   // I/O task's input latch. 3 s of drilling, ~60 000 pulses.
   auto r = build_shipped(GetParam());
-  std::vector<machining::MotionBlock> job(4);
-  job[0].kind = machining::MotionKind::kRapid;
-  job[0].target = {0, 0, 0.1};
-  job[1].kind = machining::MotionKind::kCondition;
-  job[1].condition = 1;
-  job[2].kind = machining::MotionKind::kDrill;
-  job[2].target = {0, 0, -5};
-  job[2].condition = 1;
-  job[2].z_travel_mm = 8;
-  job[3].kind = machining::MotionKind::kEnd;
-  ASSERT_EQ(r->job().load(job), rt::LoadResult::kOk);  // non-RT, before the counted cycles
+  // Loaded non-RT, before the counted cycles.
+  ASSERT_EQ(r->job().load(edm::test::drill_job()), rt::LoadResult::kOk);
   ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   EXPECT_EQ(allocations_in_cycles(*r, 3000), 0u);
   EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.1) << "it really drilled";
@@ -255,11 +242,7 @@ TEST(Allocations, NoneInsideCyclesOfTheManualMotion) {
     for (int n = 0; n < max_cycles; ++n, ++k) {
       const rt::TimePoint release{1ms * k};
       clock.advance_to(release);
-      g_allocations = 0;
-      t_counting = true;
-      task.run_cycle(release, clock);
-      t_counting = false;
-      total += g_allocations.load();
+      total += allocations_in([&] { task.run_cycle(release, clock); });
       const rt::ManualStatus st = r->manual().status();
       if (st.seen_seq >= seq && !st.busy) break;
     }

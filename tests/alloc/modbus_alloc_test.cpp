@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "alloc/alloc_counter.hpp"
+#include "alloc/drill_job.hpp"
 #include "edm/blocks/register.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "edm/modbus/driver.hpp"
@@ -244,14 +245,12 @@ class Cycles {
     for (int i = 0; i < n; ++i, ++k_) {
       const rt::TimePoint release{1ms * k_};
       clock_.advance_to(release);
-      g_allocations = 0;
-      t_counting = true;
-      r_.tasks()[0]->run_cycle(release, clock_);
-      if (k_ % 10 == 0) {
-        r_.tasks()[1]->run_cycle(release, clock_);
-      }
-      t_counting = false;
-      total += g_allocations.load();
+      total += allocations_in([&] {
+        r_.tasks()[0]->run_cycle(release, clock_);
+        if (k_ % 10 == 0) {
+          r_.tasks()[1]->run_cycle(release, clock_);
+        }
+      });
       if (k_ % 500 == 499) {
         r_.trace().drain(sink_);
         sink_.str("");
@@ -301,24 +300,6 @@ bool run_paced(Cycles& c, modbus::ModbusDriver& d, LibmodbusRemoteIo& io, int n,
   return true;
 }
 
-// DrillMachines' job of alloc_test.cpp with M08 before the drilling: the flushing pump, a coil
-// of the remote I/O (io.flush_pump), is switched on by the job.
-std::vector<machining::MotionBlock> drill_job() {
-  std::vector<machining::MotionBlock> job(5);
-  job[0].kind = machining::MotionKind::kRapid;
-  job[0].target = {0, 0, 0.1};
-  job[1].kind = machining::MotionKind::kCondition;
-  job[1].condition = 1;
-  job[2].kind = machining::MotionKind::kFlushing;
-  job[2].on = true;
-  job[3].kind = machining::MotionKind::kDrill;
-  job[3].target = {0, 0, -5};
-  job[3].condition = 1;
-  job[3].z_travel_mm = 8;
-  job[4].kind = machining::MotionKind::kEnd;
-  return job;
-}
-
 // The remote I/O of a machine ready to drill: door closed, E-stop chain closed (both normally
 // closed contacts), 2.50 bar of flushing pressure, the pump's coil left on by someone.
 void machine_ready(LibmodbusRemoteIo& io) {
@@ -349,7 +330,8 @@ TEST(AllocationsModbus, NoneInsideCyclesWhileAJobDrillsWithTheRemoteIoExchanging
   ASSERT_EQ(r->machine().state(), rt::MachineState::kReady);
 
   // A job from the JobStore (non-RT, between cycles), drilled for 3 s with the exchange running.
-  ASSERT_EQ(r->job().load(drill_job()), rt::LoadResult::kOk);
+  // With M08: the job switches the flushing pump, a coil of the remote I/O (io.flush_pump), on.
+  ASSERT_EQ(r->job().load(drill_job(/*flushing=*/true)), rt::LoadResult::kOk);
   ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   ASSERT_TRUE(run_paced(c, d, io, 1500, allocations));
   io.set_input_register(0, 310);  // the pressure rises on the remote side
@@ -383,7 +365,8 @@ TEST(AllocationsModbus, NoneInsideCyclesWhenTheRemoteIoGoesAwayMidJob) {
   ASSERT_TRUE(wait_for_image(d, io, 0)) << "the first image (start() tries it itself)";
   Cycles c(*r);
   std::size_t allocations = 0;
-  ASSERT_EQ(r->job().load(drill_job()), rt::LoadResult::kOk);
+  // With M08: the job switches the flushing pump, a coil of the remote I/O (io.flush_pump), on.
+  ASSERT_EQ(r->job().load(drill_job(/*flushing=*/true)), rt::LoadResult::kOk);
   ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
   ASSERT_TRUE(run_paced(c, d, io, 1500, allocations));
   ASSERT_EQ(r->variables().read("io.remote_io_ok"), 1.0);

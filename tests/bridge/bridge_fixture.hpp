@@ -14,6 +14,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <string_view>
 #include <thread>
@@ -23,6 +24,7 @@
 #include "edm/bridge/server.hpp"
 #include "support/bridge_test_config.hpp"
 #include "support/runtime_fixture.hpp"
+#include "support/runtime_thread.hpp"
 #include "support/temp_dir.hpp"
 
 namespace edm::bridge::test {
@@ -154,33 +156,34 @@ inline void write_token(const std::string& path, const std::string& token, mode_
   ::chmod(path.c_str(), mode);
 }
 
+/// A bridge server for `rt` on an ephemeral loopback port (whatever opt.port says), started.
+inline std::unique_ptr<Server> start_server(rt::Runtime& rt, ServerOptions opt = {}) {
+  opt.port = 0;
+  auto server = std::make_unique<Server>(rt, opt);
+  server->start();
+  return server;
+}
+
+/// How a test client reaches `server`: its port, `token`, 10 s timeouts.
+inline ClientOptions client_options(const Server& server, const std::string& token = "") {
+  ClientOptions o;
+  o.port = server.port();
+  o.token = token;
+  o.timeout = std::chrono::seconds(10);
+  return o;
+}
+
 class BridgeFixture : public ::testing::Test {
  protected:
   /// Builds the runtime and starts the server with `opt` (port 0), then runs the tasks.
   void start(ServerOptions opt = {}) {
     rt_ = edm::test::build_from_text(kBridgeTestConfig, "bridge-test.yaml");
-    opt.port = 0;
-    server_ = std::make_unique<Server>(*rt_, opt);
-    server_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kReal;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    // run() powers the machine on (OFF → READY) on its thread: wait for that, not for a time.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
-    ASSERT_NE(rt_->machine().state(), rt::MachineState::kOff) << "the runtime did not start";
+    server_ = start_server(*rt_, opt);
+    runner_.start(*rt_);  // the real clock
+    ASSERT_TRUE(runner_.wait_until_powered_on()) << "the runtime did not start";
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) {
-      runner_.join();
-    }
+    runner_.stop();
     if (server_) {
       server_->stop();
     }
@@ -192,18 +195,13 @@ class BridgeFixture : public ::testing::Test {
     return c.connect(client_opts());
   }
   ClientOptions client_opts(const std::string& token = "") const {
-    ClientOptions o;
-    o.port = server_->port();
-    o.token = token;
-    o.timeout = std::chrono::seconds(10);
-    return o;
+    return client_options(*server_, token);
   }
 
   edm::test::TempDir dir_{"edm-bridge"};
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<Server> server_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  edm::test::RuntimeThread runner_;
 };
 
 /// A watchdog warning from `source` (static strings, as the RT side raises alarms).

@@ -38,8 +38,7 @@ TEST_F(CheckConsistency, bridge_settings_the_runtime_refuses_fail_the_check_at_t
   write_token(short_tok, "abc", 0600);
   // The bridge map's first key, the line after `bridge:`.
   const int bridge_line =
-      2 + static_cast<int>(std::count(kBridgeTestConfig,
-                                      kBridgeTestConfig + std::strlen(kBridgeTestConfig), '\n'));
+      2 + static_cast<int>(std::count(kBridgeTestConfig.begin(), kBridgeTestConfig.end(), '\n'));
   struct Case {
     std::string bridge;
     std::string why;

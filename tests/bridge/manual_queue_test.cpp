@@ -9,6 +9,7 @@
 #include "bridge_fixture.hpp"
 #include "edm/runtime/manual.hpp"
 #include "programs/sim_machine.hpp"
+#include "support/runtime_thread.hpp"
 
 namespace edm::bridge::test {
 namespace {
@@ -83,31 +84,14 @@ class ManualInOneWrite : public ::testing::Test {
   void SetUp() override {
     rt_ = edm::test::build_sim_machine(
         rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
-    ServerOptions o;
-    o.port = 0;
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kVirtual;
-      ro.speed = 10.0;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    const auto deadline = std::chrono::steady_clock::now() + 10s;
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
+    server_ = start_server(*rt_);
+    runner_.start(*rt_, edm::test::paced_virtual_clock(10.0));
+    runner_.wait_until_powered_on();
     ASSERT_EQ(rt_->machine().state(), rt::MachineState::kReady);
-    ClientOptions co;
-    co.port = server_->port();
-    co.timeout = 10s;
-    ASSERT_EQ(watch_.connect(co), Role::kOperator);
+    ASSERT_EQ(watch_.connect(client_options(*server_)), Role::kOperator);
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) runner_.join();
+    runner_.stop();
     if (server_) server_->stop();
   }
   /// Polls manual.status until request `seq` is taken and nothing runs; the status.
@@ -126,8 +110,7 @@ class ManualInOneWrite : public ::testing::Test {
 
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<Server> server_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  edm::test::RuntimeThread runner_;
   Client watch_;
 };
 

@@ -25,14 +25,8 @@ class OpStates : public ::testing::Test {
   void SetUp() override {
     rt_ = edm::test::build_sim_machine(
         rt::parse_config_file(std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
-    ServerOptions o;
-    o.port = 0;
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    ClientOptions co;
-    co.port = server_->port();
-    co.timeout = std::chrono::seconds(10);
-    ASSERT_EQ(c_.connect(co), Role::kOperator);
+    server_ = start_server(*rt_);
+    ASSERT_EQ(c_.connect(client_options(*server_)), Role::kOperator);
     for (const rt::Variable& v : rt_->variables().all()) {
       if (param_.empty() && !v.is_pin() && !v.load_time_only &&
           v.param_type == rt::ParamType::kReal && v.name.ends_with(".jog_v_max_mm_s")) {

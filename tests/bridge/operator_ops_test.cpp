@@ -7,6 +7,7 @@
 #include "bridge_fixture.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "programs/sim_machine.hpp"
+#include "support/runtime_thread.hpp"
 
 namespace edm::bridge::test {
 namespace {
@@ -29,40 +30,21 @@ class OperatorOps : public ::testing::Test {
     rt_ = edm::test::build_sim_machine(rt::parse_config_text(
         text, std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml"));
     ServerOptions o;
-    o.port = 0;
     o.token_file = dir_.file("op.token");
     o.viewer_token_file = dir_.file("viewer.token");
     write_token(o.token_file, kOp, 0600);
     write_token(o.viewer_token_file, kViewer, 0600);
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kVirtual;
-      ro.speed = 10.0;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    const auto deadline = std::chrono::steady_clock::now() + 10s;
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
+    server_ = start_server(*rt_, o);
+    runner_.start(*rt_, edm::test::paced_virtual_clock(10.0));
+    runner_.wait_until_powered_on();
     ASSERT_EQ(op_.connect(opts(kOp)), Role::kOperator);
     ASSERT_EQ(viewer_.connect(opts(kViewer)), Role::kViewer);
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) runner_.join();
+    runner_.stop();
     if (server_) server_->stop();
   }
-  ClientOptions opts(const std::string& token) const {
-    ClientOptions o;
-    o.port = server_->port();
-    o.token = token;
-    o.timeout = 10s;
-    return o;
-  }
+  ClientOptions opts(const std::string& token) const { return client_options(*server_, token); }
   /// Polls manual.status until the request `seq` is done; returns the final status.
   Json wait_manual(std::uint64_t seq) {
     Json st;
@@ -89,8 +71,7 @@ class OperatorOps : public ::testing::Test {
   edm::test::TempDir dir_{"edm-operator-ops"};
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<Server> server_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  edm::test::RuntimeThread runner_;
   Client op_, viewer_;
 };
 

@@ -37,14 +37,8 @@ class RetainFailure : public ::testing::Test {
         bo);
     ASSERT_NE(rt_->retain(), nullptr);
     rt_->machine().command(rt::MachineCommand::kPowerOn);
-    ServerOptions o;
-    o.port = 0;
-    server_ = std::make_unique<Server>(*rt_, o);
-    server_->start();
-    ClientOptions co;
-    co.port = server_->port();
-    co.timeout = std::chrono::seconds(10);
-    ASSERT_EQ(c_.connect(co), Role::kOperator);
+    server_ = start_server(*rt_);
+    ASSERT_EQ(c_.connect(client_options(*server_)), Role::kOperator);
   }
   void shut() {
     c_.close();

@@ -18,6 +18,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "modbus/remote_io.hpp"
+#include "support/runtime_thread.hpp"
 
 namespace edm::modbus {
 namespace {
@@ -61,8 +62,7 @@ programs:
 
 struct Running {
   std::unique_ptr<rt::Runtime> rt;
-  std::atomic<bool> stop{false};
-  std::thread thread;
+  edm::test::RuntimeThread thread;
 
   explicit Running(const std::string& text) {
     rt::BlockRegistry blocks;
@@ -71,16 +71,9 @@ struct Running {
     rt::register_runtime_drivers(drivers);
     register_modbus_driver(drivers);
     rt = rt::Runtime::build(rt::parse_config_text(text, "mbtest.yaml"), blocks, drivers);
-    thread = std::thread([this] {
-      rt::RunOptions o;
-      o.stop = &stop;
-      rt->run(o);
-    });
+    thread.start(*rt);
   }
-  ~Running() {
-    stop = true;
-    thread.join();
-  }
+  ~Running() { thread.stop(); }
   double read(const std::string& name) { return rt->variables().read(name).value_or(NAN); }
   bool has_alarm(rt::AlarmCode code) {
     std::array<rt::ActiveAlarm, 64> a{};

@@ -13,6 +13,7 @@
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
 #include "edm/sim/sim_driver.hpp"
+#include "support/test_machine.hpp"
 
 namespace edm::test {
 
@@ -41,17 +42,9 @@ inline std::unique_ptr<rt::Runtime> build_with_every_registry(const std::string&
 
 /// The config of the machine with every type (default parameters, nothing wired).
 inline std::string every_type_config() {
-  std::string yaml = R"(version: 1
-machine:
-  name: every-type
-  io: {driver: sim, task: t, params: {preset: drill, seed: 1}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Y, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
+  std::string yaml =
+      test_machine("every-type", "{driver: sim, task: t, params: {preset: drill, seed: 1}}") +
+      R"(tasks:
   - {name: t, interval: 1ms, priority: 0, programs: [every]}
 programs:
   - name: every

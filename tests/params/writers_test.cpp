@@ -20,21 +20,14 @@
 #include "edm/bridge/server.hpp"
 #include "edm/modbus/server.hpp"
 #include "params/params_rig.hpp"
+#include "support/runtime_thread.hpp"
+#include "support/test_machine.hpp"
 
 namespace edm::test {
 namespace {
 
-constexpr const char* kGapMachine = R"(version: 1
-machine:
-  name: gap-only
-  io: {driver: loopback, task: t, params: {channels: 1}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Y, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
+const std::string kGapMachine =
+    test_machine("gap-only", "{driver: loopback, task: t, params: {channels: 1}}") + R"(tasks:
   - {name: t, interval: 1ms, priority: 0, programs: [cnc]}
 programs:
   - name: cnc
@@ -74,24 +67,11 @@ class RunningMachine : public ::testing::Test {
     cfg.map.push_back(e);
     modbus_ = std::make_unique<modbus::Server>(rt_->variables(), cfg);
     modbus_->start();
-    runner_ = std::thread([this] {
-      rt::RunOptions ro;
-      ro.clock = rt::ClockKind::kReal;
-      ro.stop = &stop_;
-      rt_->run(ro);
-    });
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (rt_->machine().state() == rt::MachineState::kOff &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::yield();
-    }
-    ASSERT_NE(rt_->machine().state(), rt::MachineState::kOff) << "the runtime did not start";
+    runner_.start(*rt_);  // the real clock
+    ASSERT_TRUE(runner_.wait_until_powered_on()) << "the runtime did not start";
   }
   void TearDown() override {
-    stop_ = true;
-    if (runner_.joinable()) {
-      runner_.join();
-    }
+    runner_.stop();
     if (modbus_) {
       modbus_->stop();
     }
@@ -104,8 +84,7 @@ class RunningMachine : public ::testing::Test {
   std::unique_ptr<rt::Runtime> rt_;
   std::unique_ptr<bridge::Server> bridge_;
   std::unique_ptr<modbus::Server> modbus_;
-  std::atomic<bool> stop_{false};
-  std::thread runner_;
+  RuntimeThread runner_;
 };
 
 TEST_F(RunningMachine, TheBridgeRefusesGapKgAt2To63AsOutOfRangeAndKeepsTheValue) {

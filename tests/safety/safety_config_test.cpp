@@ -10,26 +10,8 @@ namespace edm::test {
 namespace {
 
 std::string first_error(const std::string& safety) {
-  const std::string yaml = R"(version: 1
-machine:
-  name: m
-  io: {driver: loopback, params: {channels: 1}}
-  axes:
-    - {name: Z, min_mm: -60, max_mm: 20}
-  safety:
-)" + safety + R"(
-tasks:
-  - {name: fast, interval: 1ms, programs: [p]}
-programs:
-  - name: p
-    blocks: [{name: g, type: Gain}]
-)";
-  try {
-    SafetyRig rig(yaml, "m.yaml");
-  } catch (const rt::ConfigError& e) {
-    return e.diagnostics().front().str();
-  }
-  return "accepted";
+  const std::string yaml = safety_machine(1) + safety + kGainTask;
+  return first_build_error(yaml, "m.yaml");
 }
 
 TEST(SafetyConfig, VelocityMustBeAnLrealInputOfTheDriver) {

@@ -48,6 +48,30 @@ inline std::string edited(std::string text, const std::string& from, const std::
   return text;
 }
 
+/// The start of a config test about the safety section, up to its `safety:` key: a loopback
+/// machine with `channels` channels of each kind and a Z axis. The section follows on line 8.
+inline std::string safety_machine(int channels) {
+  return R"(version: 1
+machine:
+  name: m
+  io: {driver: loopback, params: {channels: )" +
+         std::to_string(channels) + R"(}}
+  axes:
+    - {name: Z, min_mm: -60, max_mm: 20}
+  safety:
+)";
+}
+
+/// What follows the `machine:` section of a config test about the safety section: one 1 ms task
+/// running one Gain block.
+inline constexpr const char* kGainTask = R"(
+tasks:
+  - {name: fast, interval: 1ms, programs: [p]}
+programs:
+  - name: p
+    blocks: [{name: g, type: Gain}]
+)";
+
 struct SafetyRig {
   std::unique_ptr<rt::Runtime> runtime;
   rt::VirtualClock clock;
@@ -120,5 +144,15 @@ struct SafetyRig {
     return {};
   }
 };
+
+/// The first problem building `yaml` into a SafetyRig ("file:line:col: message"), or "accepted".
+inline std::string first_build_error(const std::string& yaml, const std::string& path) {
+  try {
+    SafetyRig rig(yaml, path);
+  } catch (const rt::ConfigError& e) {
+    return e.diagnostics().front().str();
+  }
+  return "accepted";
+}
 
 }  // namespace edm::test

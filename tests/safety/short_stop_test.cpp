@@ -149,28 +149,11 @@ TEST_F(ShortStopUnit, ABrokenCounterReadsShortAndAForceIsCutToo) {
 // --- Config ------------------------------------------------------------------------------------
 
 std::string first_error(const std::string& short_stop, const std::string& retract = "positive") {
-  const std::string yaml = R"(version: 1
-machine:
-  name: m
-  io: {driver: loopback, params: {channels: 2}}
-  axes:
-    - {name: Z, min_mm: -60, max_mm: 20}
-  safety:
-    axes: [{name: Z, velocity: io.ao0, position: io.ai0, retract: )" +
+  const std::string yaml = safety_machine(2) +
+                           R"(    axes: [{name: Z, velocity: io.ao0, position: io.ai0, retract: )" +
                            retract + R"(}]
-)" + short_stop + R"(
-tasks:
-  - {name: fast, interval: 1ms, programs: [p]}
-programs:
-  - name: p
-    blocks: [{name: g, type: Gain}]
-)";
-  try {
-    SafetyRig rig(yaml, "m.yaml");
-  } catch (const rt::ConfigError& e) {
-    return e.diagnostics().front().str();
-  }
-  return "accepted";
+)" + short_stop + kGainTask;
+  return first_build_error(yaml, "m.yaml");
 }
 
 TEST(ShortStopConfig, TheCountersMustBeLintOutputsOfTheDriver) {

@@ -2,19 +2,14 @@
 // The small machine the bridge tests and the protocol fuzzer serve: loopback I/O, one 1 kHz task,
 // one Gain block (chain.g) between io.ai0 and io.ao0.
 
+#include <string>
+
+#include "support/test_machine.hpp"
+
 namespace edm::test {
 
-inline constexpr const char* kBridgeTestConfig = R"(version: 1
-machine:
-  name: bridge-test
-  io: {driver: loopback, task: fast, params: {channels: 2}}
-  axes:
-    - {name: X, min_mm: -100, max_mm: 100}
-    - {name: Y, min_mm: -100, max_mm: 100}
-    - {name: Z, min_mm: -60, max_mm: 20}
-conditions:
-  - {E: 1, name: rough}
-tasks:
+inline const std::string kBridgeTestConfig =
+    test_machine("bridge-test", "{driver: loopback, task: fast, params: {channels: 2}}") + R"(tasks:
   - name: fast
     interval: 1ms
     priority: 0

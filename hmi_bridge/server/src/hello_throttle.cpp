@@ -34,7 +34,7 @@ HelloThrottle::Clock::time_point HelloThrottle::admit_at(const std::string& addr
   Clock::time_point at = aggregate_at(address, now);
   const auto it = keys_.find(key_of(address, peer));
   if (it == keys_.end()) return at;
-  if (now - it->second.last_failure > kForgetAfter) {
+  if (it->second.forgotten(now)) {
     keys_.erase(it);
     return at;
   }
@@ -51,12 +51,7 @@ std::chrono::milliseconds HelloThrottle::on_failure(const std::string& address,
     it = keys_.emplace(k, Key{}).first;
   }
   Key& p = it->second;
-  if (p.failures > 0 && now - p.last_failure > kForgetAfter) p.failures = 0;
-  ++p.failures;
-  p.last_failure = now;
-  const int shift = static_cast<int>(std::min<std::uint32_t>(p.failures - 1, 16));
-  const auto delay = std::min<std::chrono::milliseconds>(kBaseDelay * (1LL << shift), kMaxDelay);
-  p.admit_at = now + delay;
+  p.fail(now);
 
   auto a = addresses_.find(address);
   if (a == addresses_.end()) {

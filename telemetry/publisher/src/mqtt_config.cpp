@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "edm/machining/bounded_read.hpp"
 #include "edm/machining/located_yaml.hpp"
+#include "edm/runtime/config_section.hpp"
 #include "edm/runtime/diagnostics.hpp"
 #include "edm/runtime/time.hpp"
 
@@ -267,19 +267,12 @@ class SectionParser {
 std::optional<MqttConfig> parse_mqtt_text(const std::string& text, const std::string& path,
                                           const std::string& machine_name,
                                           const rt::VariableRegistry& vars) {
+  const std::optional<y::Value> section = rt::config_section(text, path, "mqtt");
+  if (!section) return std::nullopt;
   rt::DiagnosticSink sink;
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw rt::ConfigError({{{path, e.mark.line + 1, e.mark.column + 1}, "YAML: " + e.msg}});
-  }
-  if (!root.IsMap() || !root["mqtt"]) return std::nullopt;
-  const YAML::Node node = root["mqtt"];
   SectionParser p(path, sink, vars);
-  y::Reader loc_reader(path, sink);
   MqttConfig c;
-  p.parse(y::Value{node, loc_reader.loc(node), "mqtt"}, machine_name, c);
+  p.parse(*section, machine_name, c);
   sink.throw_if_any();
   for (MetricSpec& m : c.metrics) {
     if (m.deadband < 0.0) m.deadband = c.deadband;
@@ -290,10 +283,7 @@ std::optional<MqttConfig> parse_mqtt_text(const std::string& text, const std::st
 std::optional<MqttConfig> load_mqtt_config(const rt::Config& cfg,
                                            const rt::VariableRegistry& vars) {
   if (cfg.mqtt_loc.line == 0) return std::nullopt;
-  const machining::BoundedRead file =
-      machining::read_bounded_file(cfg.path, machining::kMaxConfigBytes, "config");
-  if (!file.ok()) throw rt::ConfigError({{{cfg.path, 1, 1}, file.problem}});
-  return parse_mqtt_text(file.text, cfg.path, cfg.machine.name, vars);
+  return parse_mqtt_text(rt::read_config_text(cfg), cfg.path, cfg.machine.name, vars);
 }
 
 }  // namespace edm::telemetry

@@ -3,13 +3,13 @@
 // edmplc throttles failed hellos per peer address, and every browser's log-in reaches it from
 // edmhmi's one address: without a throttle here, one page's wrong tokens would lock every other
 // page out (issue 31: 40 wrong tokens in a second kept the right one out for minutes). So the
-// browsers are throttled here, each by its own address, with edmplc's schedule: after n failed
-// log-ins from an address within kForgetAfter of each other, its next log-in is not checked
-// before kBaseDelay·2^(n−1) (at most kMaxDelay) has passed since the last failure, and one log-in
-// per address is checked at a time — the rest wait, on any number of sockets, so an address
-// guesses at most once per delay however many sockets it opens. A right token is delayed, never
-// refused, and does not forget the failures. The browser's address also goes to edmplc in the
-// hello ("peer"), whose own throttle keys on it the same way.
+// browsers are throttled here, each by its own address, with edmplc's schedule (FailureBackoff,
+// the one both use): after n failed log-ins from an address within kForgetAfter of each other,
+// its next log-in is not checked before kBaseDelay·2^(n−1) (at most kMaxDelay) has passed since
+// the last failure, and one log-in per address is checked at a time — the rest wait, on any number
+// of sockets, so an address guesses at most once per delay however many sockets it opens. A right
+// token is delayed, never refused, and does not forget the failures. The browser's address also
+// goes to edmplc in the hello ("peer"), whose own throttle keys on it the same way.
 //
 // Non-RT. Thread-safety: none (the server's I/O thread only). Time is passed in (tests).
 
@@ -20,14 +20,16 @@
 #include <string>
 #include <unordered_map>
 
+#include "edm/bridge/failure_backoff.hpp"
+
 namespace edm::hmi {
 
 class LoginThrottle {
  public:
   using Clock = std::chrono::steady_clock;
-  static constexpr std::chrono::milliseconds kBaseDelay{250};
-  static constexpr std::chrono::milliseconds kMaxDelay{10'000};
-  static constexpr std::chrono::seconds kForgetAfter{60};
+  static constexpr auto kBaseDelay = bridge::FailureBackoff::kBaseDelay;
+  static constexpr auto kMaxDelay = bridge::FailureBackoff::kMaxDelay;
+  static constexpr auto kForgetAfter = bridge::FailureBackoff::kForgetAfter;
   static constexpr std::size_t kMaxAddresses = 4096;
 
   explicit LoginThrottle(std::size_t max_addresses = kMaxAddresses)
@@ -50,10 +52,7 @@ class LoginThrottle {
   [[nodiscard]] std::size_t addresses() const noexcept { return peers_.size(); }
 
  private:
-  struct Peer {
-    std::uint32_t failures{0};
-    Clock::time_point last_failure{};
-    Clock::time_point admit_at{};
+  struct Peer : bridge::FailureBackoff {
     bool checking{false};
   };
   Peer& peer(const std::string& address);

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "edm/runtime/block.hpp"
+#include "edm/runtime/child_params.hpp"
 
 namespace edm::rt {
 
@@ -63,6 +64,7 @@ class CompositeBlock : public Block {
   B& add_child(std::string name) {
     auto block = std::make_unique<B>();
     B& ref = *block;
+    child_params_.add(name, ref);
     children_.push_back({std::move(name), {}, std::move(block)});
     return ref;
   }
@@ -85,11 +87,8 @@ class CompositeBlock : public Block {
     std::unique_ptr<Block> block;
   };
   std::vector<Child> children_;
+  ChildParams child_params_;  // the children's parameters, "<child>.<param>"
   const char* fault_source_{nullptr};
 };
-
-/// Appends `more` to `errs` with "<prefix>." in front of each field. Non-RT.
-void append_prefixed(std::vector<ParamError>& errs, std::string_view prefix,
-                     std::vector<ParamError> more);
 
 }  // namespace edm::rt

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "edm/runtime/child_params.hpp"
 #include "edm/runtime/io_driver.hpp"
 
 namespace edm::rt {
@@ -29,7 +30,7 @@ class CompositeDriver final : public IoDriver {
   /// Adds a configured child. Non-RT, build time (before bind()).
   void add(std::string name, std::unique_ptr<IoDriver> driver);
   [[nodiscard]] std::size_t size() const noexcept { return children_.size(); }
-  [[nodiscard]] IoDriver& child(std::size_t i) noexcept { return *children_[i].driver; }
+  [[nodiscard]] IoDriver& child(std::size_t i) noexcept { return *children_[i]; }
 
   void visit_pins(PinVisitor& v) override;
   void visit_params(ParamVisitor& v) override;
@@ -53,14 +54,8 @@ class CompositeDriver final : public IoDriver {
   [[nodiscard]] bool wall_time_io() const noexcept override;
 
  private:
-  struct Child {
-    std::string name;
-    std::unique_ptr<IoDriver> driver;
-  };
-  // The child that owns parameter `index`, and the index within it; nullptr past the end.
-  IoDriver* param_owner(std::size_t& index) const noexcept;
-
-  std::vector<Child> children_;
+  std::vector<std::unique_ptr<IoDriver>> children_;
+  ChildParams params_;  // io.<param>, or io.<name>.<param> for a named child
 };
 
 }  // namespace edm::rt

@@ -248,6 +248,34 @@ struct SimParams {
   [[nodiscard]] std::vector<edm::rt::ParamError> cross_field_errors() const;
   /// "drill", "sink" or "wire" (PLANT-MODEL.md §6.5); nullopt for another name.
   static std::optional<SimParams> preset(std::string_view name);
+
+ private:
+  // The parts of visit(), one for each section above, called in declaration order (defined in
+  // params_schema.cpp). `v` marks every field it is given load time only; `writable` is visit()'s
+  // own visitor, for the fields the driver applies at run time (the electrode's length, the hole).
+
+  // The generator (§1): voltages, current, pulse times.
+  void visit_generator(edm::rt::ParamVisitor& v);
+  // The ignition delay (§1, §6.2 step 4).
+  void visit_ignition(edm::rt::ParamVisitor& v);
+  // Shorts (§6.2 steps 1-2), short events at the gap (§4a), the injected contact.
+  void visit_shorts(edm::rt::ParamVisitor& v);
+  // Arcs (§6.2 step 3).
+  void visit_arcs(edm::rt::ParamVisitor& v);
+  // Removal and wear (§2, §6.2 step 6).
+  void visit_removal(edm::rt::ParamVisitor& v);
+  // The tool and the work's thickness, where the tip starts.
+  void visit_electrode(edm::rt::ParamVisitor& v, edm::rt::ParamVisitor& writable);
+  // The work on the machine, the reference switches, encoders, touch mode, the hole (§3a).
+  void visit_work(edm::rt::ParamVisitor& v, edm::rt::ParamVisitor& writable);
+  // Debris and flushing (§6.2 step 7).
+  void visit_flushing(edm::rt::ParamVisitor& v);
+  // The axes (§3, §6.3).
+  void visit_axes(edm::rt::ParamVisitor& v);
+  // WEDM (§6.4).
+  void visit_wire(edm::rt::ParamVisitor& v);
+  // The sensors (§6.2 step 8) and the cost bound.
+  void visit_sensors(edm::rt::ParamVisitor& v);
 };
 
 /// The names preset() knows, in a fixed order.

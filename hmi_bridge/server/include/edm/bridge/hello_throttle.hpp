@@ -3,8 +3,8 @@
 //  - per key: the transport address, or (transport address, hello's "peer") when a relaying HMI
 //    (edmhmi serve) names the end client. After n failures of a key within kForgetAfter of each
 //    other, no further hello of that key is *evaluated* before kBaseDelay·2^(n−1) (at most
-//    kMaxDelay) has passed since its last failure. So one browser's failures behind edmhmi do
-//    not delay another browser's log-in.
+//    kMaxDelay) has passed since its last failure (FailureBackoff, edmhmi's schedule too). So one
+//    browser's failures behind edmhmi do not delay another browser's log-in.
 //  - per transport address (aggregate, whatever the peer): at most kAggregateFailures failures
 //    in any kForgetAfter window; a hello that would exceed it waits until the oldest of them has
 //    left the window. A client that names a new peer in every hello still guesses at most
@@ -25,14 +25,16 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "edm/bridge/failure_backoff.hpp"
+
 namespace edm::bridge {
 
 class HelloThrottle {
  public:
   using Clock = std::chrono::steady_clock;
-  static constexpr std::chrono::milliseconds kBaseDelay{250};
-  static constexpr std::chrono::milliseconds kMaxDelay{10'000};
-  static constexpr std::chrono::seconds kForgetAfter{60};
+  static constexpr auto kBaseDelay = FailureBackoff::kBaseDelay;
+  static constexpr auto kMaxDelay = FailureBackoff::kMaxDelay;
+  static constexpr auto kForgetAfter = FailureBackoff::kForgetAfter;
   static constexpr std::size_t kAggregateFailures = 64;
 
   /// At most `max_keys` keys and as many addresses are remembered (the stalest go first).
@@ -51,11 +53,7 @@ class HelloThrottle {
   [[nodiscard]] std::size_t addresses() const noexcept { return addresses_.size(); }
 
  private:
-  struct Key {
-    std::uint32_t failures{0};
-    Clock::time_point last_failure{};
-    Clock::time_point admit_at{};
-  };
+  using Key = FailureBackoff;  // one key's schedule
   // The last kAggregateFailures failure times of one address, a ring (oldest at `next` when full).
   struct Address {
     std::array<Clock::time_point, kAggregateFailures> times{};
