@@ -16,6 +16,11 @@ namespace {
 constexpr auto kProgressPeriod = std::chrono::milliseconds(100);
 constexpr auto kTracePeriod = std::chrono::milliseconds(20);
 constexpr std::size_t kTraceSamplesPerEvent = 512;
+// At most this many trace events per tap per tick (4 × 512 samples / 20 ms: 100 kHz, ten times
+// the fastest task). Unbounded, a producer faster than the io thread could serialise (a slow or
+// overloaded host) kept trace_tick() from returning: no close, hello or reply ran any more. Past
+// the bound the tap's ring overflows and counts it (tap_dropped), as it does for any slow reader.
+constexpr int kTraceEventsPerTick = 4;
 
 Json progress_json(const rt::JobProgress& p) {
   return {{"outcome", std::string(rt::outcome_name(p.outcome))},
@@ -412,7 +417,9 @@ void Server::Impl::retrace() {
 void Server::Impl::trace_tick() {
   for (std::size_t i = 0; i < taps.size(); ++i) {
     trace_scratch.clear();
-    while (taps[i]->drain(trace_scratch, kTraceSamplesPerEvent) > 0) {
+    for (int batch = 0;
+         batch < kTraceEventsPerTick && taps[i]->drain(trace_scratch, kTraceSamplesPerEvent) > 0;
+         ++batch) {
       const auto& names = tap_names[i];
       for (const auto& s : live_sessions()) {
         if (s->trace_vars().empty()) {

@@ -246,6 +246,7 @@ class Session : public std::enable_shared_from_this<Session> {
   bool writing_{false};
   bool close_after_flush_{false};
   bool lingering_{false};
+  bool close_posted_{false};  // a stalled session's close is posted (send_event)
   bool closed_{false};
   std::uint64_t seq_{0};
   std::uint64_t dropped_{0};

@@ -320,7 +320,7 @@ bool Session::queue_full() const {
 }
 
 void Session::send_event(std::string_view name, Json body) {
-  if (closed_ || close_after_flush_ || lingering_) {
+  if (closed_ || close_after_flush_ || lingering_ || close_posted_) {
     return;
   }
   if (queue_full()) {
@@ -334,7 +334,8 @@ void Session::send_event(std::string_view name, Json body) {
       log(spdlog::level::warn, "not reading for {} ms ({} events dropped); disconnecting",
           server_.opt.stall_timeout.count(), dropped_);
       // Posted: the caller is a broadcast loop, and closing takes the session out of the
-      // server's registry.
+      // server's registry. Once: the events until it runs are not this session's any more.
+      close_posted_ = true;
       async_close();
     }
     return;
