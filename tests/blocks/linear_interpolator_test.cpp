@@ -19,8 +19,8 @@ namespace {
 using Vec3 = std::array<double, 3>;
 
 // The block with every input wired to a test-owned output.
-struct Rig : InterpolatorRig<LinearInterpolator> {
-  explicit Rig(rt::Duration period = 1ms, LinearInterpolatorParams p = {})
+struct LinearRig : InterpolatorRig<LinearInterpolator> {
+  explicit LinearRig(rt::Duration period = 1ms, LinearInterpolatorParams p = {})
       : InterpolatorRig(period) {
     h.start_ok(p);
     ov.set(1.0);
@@ -48,7 +48,7 @@ double dist(const Vec3& a, const Vec3& b) {
 }
 
 TEST(LinearInterpolatorTest, starts_at_the_parameter_position_idle) {
-  Rig r(1ms, {.x0_mm = 1.5, .y0_mm = -2.0, .z0_mm = 10.0});
+  LinearRig r(1ms, {.x0_mm = 1.5, .y0_mm = -2.0, .z0_mm = 10.0});
   EXPECT_EQ(r.h.step(), BlockStatus::kOk);
   EXPECT_EQ(r.pos(), (Vec3{1.5, -2.0, 10.0}));
   EXPECT_EQ(r.vel(), (Vec3{0.0, 0.0, 0.0}));
@@ -58,7 +58,7 @@ TEST(LinearInterpolatorTest, starts_at_the_parameter_position_idle) {
 
 TEST(LinearInterpolatorTest, follows_eq_12_13_and_ends_exactly) {
   // 3-4-0 triangle: l = 5 mm; feed 600 mm/min at 1 ms → fr = 0.01 mm per sample, 500 samples.
-  Rig r;
+  LinearRig r;
   ASSERT_EQ(r.move({3.0, 4.0, 0.0}, 600.0), BlockStatus::kOk);
   EXPECT_TRUE(r.busy());
   EXPECT_NEAR(r.pos()[0], 0.01 * 3.0 / 5.0, 1e-15);
@@ -93,7 +93,7 @@ TEST(LinearInterpolatorTest, random_moves_end_exactly_and_step_fr_every_sample_b
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   std::uniform_real_distribution<double> feed_dist(5.0, 6000.0);
   std::uniform_real_distribution<double> ov_dist(0.1, 2.0);
-  Rig r(250us);
+  LinearRig r(250us);
   const double dt = r.h.dt_s();
   double worst_rel = 0.0;
   for (int m = 0; m < 300; ++m) {
@@ -149,7 +149,7 @@ TEST(LinearInterpolatorTest, random_moves_end_exactly_and_step_fr_every_sample_b
 TEST(LinearInterpolatorTest, hold_keeps_the_position_and_resumes_without_loss) {
   // Reference run without hold, then the same move with a hold of 137 samples in the middle:
   // the sequence of positions is the same, only delayed.
-  Rig ref;
+  LinearRig ref;
   ASSERT_EQ(ref.move({-7.25, 2.5, 1.0}, 1234.5), BlockStatus::kOk);
   std::vector<Vec3> path{ref.pos()};
   while (ref.busy()) {
@@ -158,7 +158,7 @@ TEST(LinearInterpolatorTest, hold_keeps_the_position_and_resumes_without_loss) {
   }
   ASSERT_GT(path.size(), 300u);
 
-  Rig r;
+  LinearRig r;
   ASSERT_EQ(r.move({-7.25, 2.5, 1.0}, 1234.5), BlockStatus::kOk);
   std::size_t k = 0;
   EXPECT_EQ(r.pos(), path[k]);
@@ -187,7 +187,7 @@ TEST(LinearInterpolatorTest, hold_keeps_the_position_and_resumes_without_loss) {
 
 TEST(LinearInterpolatorTest, override_scales_the_feed_live_and_is_clamped) {
   // 10 mm at 600 mm/min, 1 ms: fr = 0.01 mm at 100 %.
-  Rig r;
+  LinearRig r;
   r.ov.set(2.0);
   ASSERT_EQ(r.move({10.0, 0.0, 0.0}, 600.0), BlockStatus::kOk);
   EXPECT_NEAR(r.pos()[0], 0.02, 1e-15);
@@ -213,7 +213,7 @@ TEST(LinearInterpolatorTest, override_scales_the_feed_live_and_is_clamped) {
 }
 
 TEST(LinearInterpolatorTest, zero_length_move_is_done_at_once) {
-  Rig r(1ms, {.x0_mm = 1.0, .y0_mm = 2.0, .z0_mm = 3.0});
+  LinearRig r(1ms, {.x0_mm = 1.0, .y0_mm = 2.0, .z0_mm = 3.0});
   EXPECT_EQ(r.move({0.0, 0.0, 0.0}, 0.0), BlockStatus::kOk) << "feed not needed";
   EXPECT_FALSE(r.busy());
   EXPECT_TRUE(r.done());
@@ -222,7 +222,7 @@ TEST(LinearInterpolatorTest, zero_length_move_is_done_at_once) {
 }
 
 TEST(LinearInterpolatorTest, consecutive_moves_chain_from_the_end_point) {
-  Rig r;
+  LinearRig r;
   const Vec3 a{1.0, 0.1, -0.3};
   const Vec3 b{-0.7, 2.0, 0.05};
   r.move(a, 900.0);
@@ -235,7 +235,7 @@ TEST(LinearInterpolatorTest, consecutive_moves_chain_from_the_end_point) {
 }
 
 TEST(LinearInterpolatorTest, start_edge_while_busy_is_ignored_and_level_does_not_restart) {
-  Rig r;
+  LinearRig r;
   r.move({1.0, 0.0, 0.0}, 600.0);  // 100 samples
   for (int n = 0; n < 10; ++n) {
     r.h.step();
@@ -254,7 +254,7 @@ TEST(LinearInterpolatorTest, start_edge_while_busy_is_ignored_and_level_does_not
 }
 
 TEST(LinearInterpolatorTest, load_sets_the_position_and_cancels_a_move) {
-  Rig r;
+  LinearRig r;
   r.move({5.0, 5.0, 5.0}, 600.0);
   r.h.step();
   r.load_x.set(-1.0);
@@ -276,7 +276,7 @@ TEST(LinearInterpolatorTest, load_sets_the_position_and_cancels_a_move) {
 }
 
 TEST(LinearInterpolatorTest, non_finite_inputs_fault_without_moving) {
-  Rig r;
+  LinearRig r;
   EXPECT_EQ(r.move({kNaN, 1.0, 0.0}, 600.0), BlockStatus::kFault);
   EXPECT_FALSE(r.busy());
   EXPECT_EQ(r.pos(), (Vec3{0.0, 0.0, 0.0}));
@@ -304,7 +304,7 @@ TEST(LinearInterpolatorTest, non_finite_inputs_fault_without_moving) {
 }
 
 TEST(LinearInterpolatorTest, safe_state_cancels_the_move) {
-  Rig r;
+  LinearRig r;
   r.move({1.0, 0.0, 0.0}, 600.0);
   r.h.step();
   const Vec3 p = r.pos();

@@ -28,8 +28,8 @@ ShortRetractParams test_params() {
           .progress_mm = 0.05};
 }
 
-struct Rig {
-  explicit Rig(const ShortRetractParams& p) { EXPECT_TRUE(h.start(p).empty()); }
+struct RetractRig {
+  explicit RetractRig(const ShortRetractParams& p) { EXPECT_TRUE(h.start(p).empty()); }
   BlockStatus step(double x, double y, double z, bool short_now = false) {
     xs.set(x);
     ys.set(y);
@@ -58,7 +58,7 @@ std::array<double, 3> l_path(double s) {
                   : std::array<double, 3>{0.3, 0.0, -(s - 0.3)};
 }
 
-void drive_l_path(Rig& r) {
+void drive_l_path(RetractRig& r) {
   for (int k = 0; k <= 70; ++k) {
     ASSERT_EQ(r.step(l_path(0.01 * k)), BlockStatus::kOk);
     ASSERT_FALSE(r.active());
@@ -77,7 +77,7 @@ TEST(ShortRetractTest, retract_walks_back_along_the_path_and_resumes_to_the_star
   auto p = test_params();
   p.retract_distance_mm = 0.495;  // not a whole number of steps: the last one is cut
   p.resume_speed_mm_s = 4.0;      // 0.004 mm per cycle, 123.75 steps
-  Rig r(p);
+  RetractRig r(p);
   drive_l_path(r);
   const auto head = l_path(0.7);
   EXPECT_EQ(r.step(head, true), BlockStatus::kOk);
@@ -114,7 +114,7 @@ TEST(ShortRetractTest, reacceleration_reaches_full_feed_within_resume_ramp) {
     auto p = test_params();
     p.resume_ramp_ms = ramp_ms;
     p.retract_distance_mm = 0.05;
-    Rig r(p);
+    RetractRig r(p);
     drive_l_path(r);
     for (int k = 0; k < 3; ++k) {
       r.step(l_path(0.7), true);
@@ -144,7 +144,7 @@ TEST(ShortRetractTest, reacceleration_reaches_full_feed_within_resume_ramp) {
 TEST(ShortRetractTest, max_tries_without_progress_raise_alarm_and_hold) {
   auto p = test_params();
   p.retract_distance_mm = 0.05;
-  Rig r(p);
+  RetractRig r(p);
   drive_l_path(r);
   const auto head = l_path(0.7);
   // The short never clears: retract, and a sustained short while walking forward retracts again.
@@ -190,7 +190,7 @@ TEST(ShortRetractTest, progress_along_the_path_resets_tries) {
   auto p = test_params();
   p.retract_distance_mm = 0.02;
   p.resume_ramp_ms = 0.0;
-  Rig r(p);
+  RetractRig r(p);
   drive_l_path(r);
   auto short_and_recover = [&](double s) {
     for (int k = 0; k < 3; ++k) {
@@ -215,7 +215,7 @@ TEST(ShortRetractTest, progress_along_the_path_resets_tries) {
 TEST(ShortRetractTest, history_is_bounded_and_the_retract_stops_at_its_oldest_point) {
   auto p = test_params();
   p.history_capacity = 8;
-  Rig r(p);
+  RetractRig r(p);
   for (int k = 0; k < 20; ++k) {
     r.step(0.01 * k, 0.0, 0.0);
     ASSERT_LE(r.h.block().history_size(), 8u);
@@ -236,7 +236,7 @@ TEST(ShortRetractTest, history_is_bounded_and_the_retract_stops_at_its_oldest_po
 }
 
 TEST(ShortRetractTest, a_servo_back_off_unwinds_the_recorded_path) {
-  Rig r(test_params());
+  RetractRig r(test_params());
   auto z_at = [&](int k) { r.step(0.0, 0.0, -0.01 * k); };
   for (int k = 0; k <= 20; ++k) {
     z_at(k);  // down to −0.20
@@ -260,7 +260,7 @@ TEST(ShortRetractTest, a_servo_back_off_unwinds_the_recorded_path) {
 TEST(ShortRetractTest, retract_distance_after_a_back_off_is_net_path_length) {
   auto p = test_params();
   p.retract_distance_mm = 0.1;
-  Rig r(p);
+  RetractRig r(p);
   for (int k = 0; k <= 20; ++k) {
     r.step(0.0, 0.0, -0.01 * k);
   }
@@ -282,7 +282,7 @@ TEST(ShortRetractTest, retract_distance_after_a_back_off_is_net_path_length) {
 TEST(ShortRetractTest, min_spacing_thins_the_history) {
   auto p = test_params();
   p.min_spacing_mm = 0.0495;
-  Rig r(p);
+  RetractRig r(p);
   for (int k = 0; k <= 100; ++k) {
     r.step(0.001 * k, 0.0, 0.0);  // 0.1 mm in 1 µm steps
   }
@@ -290,7 +290,7 @@ TEST(ShortRetractTest, min_spacing_thins_the_history) {
 }
 
 TEST(ShortRetractTest, disable_clears_the_history_and_passes_through) {
-  Rig r(test_params());
+  RetractRig r(test_params());
   auto& enable = r.h.source<bool>("enable");
   enable.set(true);
   drive_l_path(r);
@@ -305,7 +305,7 @@ TEST(ShortRetractTest, disable_clears_the_history_and_passes_through) {
 }
 
 TEST(ShortRetractTest, non_finite_position_is_a_fault_and_not_recorded) {
-  Rig r(test_params());
+  RetractRig r(test_params());
   r.step(0.0, 0.0, 0.0);
   r.step(0.01, 0.0, 0.0);
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -324,7 +324,7 @@ TEST(ShortRetractTest, validate_and_load_time_only_capacity) {
   EXPECT_FALSE(rt::validate_params(
                    ShortRetractParams{.resume_ramp_ms = std::numeric_limits<double>::quiet_NaN()})
                    .empty());
-  Rig r(test_params());
+  RetractRig r(test_params());
   EXPECT_FALSE(r.h.write_param("history_capacity", rt::ParamValue::of_int(16)).empty());
   EXPECT_TRUE(r.h.write_param("max_tries", rt::ParamValue::of_int(5)).empty());
   BlockHarness<ShortRetract> no_task(rt::Duration{0});

@@ -16,7 +16,7 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = HelloThrottle::Clock;
 
-Json parse(const std::string& line) { return Json::parse(line, nullptr, false); }
+Json parse_reply(const std::string& line) { return Json::parse(line, nullptr, false); }
 
 std::string hello_line(const std::string& token, const Json& peer) {
   Json h = {{"id", 1}, {"op", "hello"}, {"protocol", 1}, {"token", token}};
@@ -135,7 +135,7 @@ TEST_F(HelloPeer, a_client_rotating_peer_is_held_to_the_aggregate) {
   for (int i = 0; i < n; ++i) {
     RawSocket s(server_->port());
     s.send(hello_line("guess-" + std::to_string(i) + "-xxxxxxxxxxxx", "rot-" + std::to_string(i)));
-    const Json r = parse(s.read_line(5s));
+    const Json r = parse_reply(s.read_line(5s));
     ASSERT_EQ(r["error"]["code"], "unauthorized") << i << ": each new peer is evaluated at once";
   }
   EXPECT_EQ(server_->stats().hello_failures, static_cast<std::uint64_t>(n));
@@ -160,7 +160,7 @@ TEST_F(HelloPeer, a_bad_peer_is_bad_request_and_guesses_nothing) {
     RawSocket s(server_->port());
     Json h = {{"id", 1}, {"op", "hello"}, {"protocol", 1}, {"token", kOp}, {"peer", p}};
     s.send(h.dump() + "\n");
-    const Json r = parse(s.read_line());
+    const Json r = parse_reply(s.read_line());
     EXPECT_EQ(r["error"]["code"], "bad_request") << p.dump() << " → " << r;
     EXPECT_TRUE(s.closed_within(3s)) << p.dump();
   }

@@ -20,7 +20,7 @@ const std::string kHead = "version: 1\nmachine: {name: m}\n";
 const std::string kTasks = "tasks:\n  - {name: fast, interval: 1ms, programs: [p]}\n";
 
 // Parses text expected to be invalid; returns its diagnostics (fails the test if it parsed).
-std::vector<Diagnostic> errors_of(const std::string& text) {
+std::vector<Diagnostic> details_errors_of(const std::string& text) {
   try {
     parse_config_text(text, "t.yaml");
   } catch (const ConfigError& e) {
@@ -31,7 +31,7 @@ std::vector<Diagnostic> errors_of(const std::string& text) {
 }
 
 std::string first_error(const std::string& text) {
-  const auto d = errors_of(text);
+  const auto d = details_errors_of(text);
   return d.empty() ? std::string() : d.front().str();
 }
 
@@ -113,7 +113,7 @@ TEST(ParseFile, fifo_device_and_huge_files_are_refused_at_1_1) {
 }
 
 TEST(Collect, several_errors_reported_in_file_order) {
-  const auto d = errors_of(
+  const auto d = details_errors_of(
       "version: 1\n"
       "machine: {name: m, colour: red}\n"  // 2: unknown key
       "tasks:\n"
@@ -135,8 +135,8 @@ TEST(Collect, several_errors_reported_in_file_order) {
 }
 
 TEST(Collect, misspelt_required_key_is_one_error_not_two) {
-  const auto d = errors_of(kHead + "tasks:\n  - {name: f, intervall: 1ms, programs: [p]}\n" +
-                           "programs: [{name: p}]\n");
+  const auto d = details_errors_of(
+      kHead + "tasks:\n  - {name: f, intervall: 1ms, programs: [p]}\n" + "programs: [{name: p}]\n");
   ASSERT_EQ(d.size(), 1u) << d[1].str();
   EXPECT_NE(d[0].message.find("did you mean 'interval'"), std::string::npos);
 }
@@ -152,7 +152,7 @@ TEST(Collect, error_flood_is_capped) {
   for (int i = 0; i < 300; ++i) {
     text += "  k" + std::to_string(i) + ": 1\n";
   }
-  const auto d = errors_of(text);
+  const auto d = details_errors_of(text);
   ASSERT_EQ(d.size(), 101u);
   EXPECT_NE(d.back().message.find("200 more errors"), std::string::npos) << d.back().str();
   EXPECT_GE(d.back().loc.line, 1);
@@ -240,7 +240,7 @@ TEST(Hostile, alias_bomb_is_not_expanded) {
             ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + ", " + p + "]\n";
   }
   const auto start = std::chrono::steady_clock::now();
-  const auto d = errors_of(text);
+  const auto d = details_errors_of(text);
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
   ASSERT_FALSE(d.empty());
 }
@@ -249,13 +249,13 @@ TEST(Hostile, self_referencing_alias_in_every_section) {
   for (const char* section : {"machine", "conditions", "tasks", "programs", "trace", "bridge"}) {
     const std::string text = kHead + kTasks + "programs: [{name: p}]\n" + "x: &r {" + section +
                              ": *r}\n" + std::string(section) + ": &s [*s, {a: *s}]\n";
-    const auto d = errors_of(text);
+    const auto d = details_errors_of(text);
     EXPECT_FALSE(d.empty()) << section;
   }
   const std::string params = kHead + kTasks +
                              "programs: [{name: p, blocks: [{name: b, type: T, params: &m "
                              "{k: *m}}], wires: &w {b.x: *w}}]\n";
-  EXPECT_EQ(errors_of(params).size(), 2u);
+  EXPECT_EQ(details_errors_of(params).size(), 2u);
 }
 
 TEST(Hostile, deep_nesting_is_an_error_not_a_stack_overflow) {
@@ -263,7 +263,7 @@ TEST(Hostile, deep_nesting_is_an_error_not_a_stack_overflow) {
   for (int i = 0; i < 5000; ++i) {
     block += std::string(static_cast<std::size_t>(i % 200 + 1), ' ') + "- \n";
   }
-  EXPECT_FALSE(errors_of(block).empty());
+  EXPECT_FALSE(details_errors_of(block).empty());
   EXPECT_NE(first_error(kHead + "tasks: " + std::string(100000, '[')).find("t.yaml:"),
             std::string::npos);
   EXPECT_NE(first_error(kHead + "tasks: " + std::string(100000, '{')).find("t.yaml:"),
@@ -285,10 +285,11 @@ TEST(Hostile, encodings_and_line_endings) {
           "version: 1\nmachine: {name: \"m\xff\"}\n" + kTasks + "programs: [{name: p}]\n", "t")
           .machine.name,
       "m\xff");
-  EXPECT_FALSE(errors_of(kHead + "tasks: [{name: \"f\xc3\", interval: 1ms, programs: [p]}]\n" +
-                         "programs: [{name: p}]\n")
+  EXPECT_FALSE(details_errors_of(kHead +
+                                 "tasks: [{name: \"f\xc3\", interval: 1ms, programs: [p]}]\n" +
+                                 "programs: [{name: p}]\n")
                    .empty());
-  EXPECT_FALSE(errors_of(std::string("version: 1\0machine: x\n", 22)).empty());
+  EXPECT_FALSE(details_errors_of(std::string("version: 1\0machine: x\n", 22)).empty());
 }
 
 TEST(Hostile, null_sections_say_how_to_write_empty) {

@@ -28,7 +28,7 @@ std::unique_ptr<rt::Runtime> build(const std::string& yaml) {
 
 // A seed-003/000 program on a loopback machine whose FuzzyServoLUT has these `rules` (YAML text).
 std::string config(const std::string& rules) {
-  return test::test_data("controllers/fuzzy_program.yaml", {{"rules", rules}});
+  return edm::test::test_data("controllers/fuzzy_program.yaml", {{"rules", rules}});
 }
 
 TEST(ControllersConfig, a_full_seed_003_and_000_program_loads_from_yaml) {

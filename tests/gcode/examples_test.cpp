@@ -17,11 +17,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kParts = fs::path(EDM_SOURCE_DIR) / "examples" / "parts";
+const fs::path kExampleParts = fs::path(EDM_SOURCE_DIR) / "examples" / "parts";
 
 GcodeResult interpret_part(const std::string& name,
                            const machining::MachineTables& tables = test_tables()) {
-  std::ifstream in(kParts / name, std::ios::binary);
+  std::ifstream in(kExampleParts / name, std::ios::binary);
   EXPECT_TRUE(in.good()) << name;
   std::ostringstream ss;
   ss << in.rdbuf();
@@ -39,7 +39,7 @@ TEST(GcodeExamples, EveryExampleInterpretsCleanly) {
   const machining::MachineTables drill_sim = machining::read_machine_tables(
       std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
   int count = 0;
-  for (const auto& e : fs::directory_iterator(kParts)) {
+  for (const auto& e : fs::directory_iterator(kExampleParts)) {
     if (e.path().extension() != ".nc") continue;
     ++count;
     const std::string name = e.path().filename().string();

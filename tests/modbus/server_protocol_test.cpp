@@ -17,7 +17,7 @@ using namespace std::chrono_literals;
 using Bytes = std::vector<std::uint8_t>;
 
 // The exception code of a reply to function fc, or -1 when it is not an exception reply to fc.
-int exception_of(const Bytes& r, std::uint8_t fc) {
+int exception_code_of(const Bytes& r, std::uint8_t fc) {
   if (r.size() != 9 || r[7] != (fc | 0x80U)) {
     return -1;
   }
@@ -74,7 +74,7 @@ TEST(ModbusServerProtocol, EveryFunctionCodeIsServedOrExceptionOneWithItsFunctio
     if (served.contains(code)) {
       EXPECT_EQ(r[7], fc) << "fc " << code << " not served normally";
     } else {
-      EXPECT_EQ(exception_of(r, fc), 1) << "fc " << code << ": function byte " << int{r[7]};
+      EXPECT_EQ(exception_code_of(r, fc), 1) << "fc " << code << ": function byte " << int{r[7]};
     }
   }
   // A PDU of the function code alone: too short for a served function (03), still 01 for
@@ -84,7 +84,7 @@ TEST(ModbusServerProtocol, EveryFunctionCodeIsServedOrExceptionOneWithItsFunctio
     ASSERT_TRUE(c.send(mb_frame({fc}, 7)));
     const Bytes r = c.reply();
     ASSERT_FALSE(r.empty()) << "fc " << code;
-    EXPECT_EQ(exception_of(r, fc), served.contains(code) ? 3 : 1) << "fc " << code;
+    EXPECT_EQ(exception_code_of(r, fc), served.contains(code) ? 3 : 1) << "fc " << code;
   }
   const auto k = s.counters();
   EXPECT_EQ(k.requests, 512U);
@@ -120,7 +120,7 @@ TEST(ModbusServerProtocol, HeadersThatLieCloseTheConnection) {
   f[5] = 8;  // 7 PDU bytes announced, 5 sent
   ASSERT_TRUE(c.send(f));
   ASSERT_TRUE(c.send({0, 0}));
-  EXPECT_EQ(exception_of(c.reply(), 3), 3);
+  EXPECT_EQ(exception_code_of(c.reply(), 3), 3);
 }
 
 TEST(ModbusServerProtocol, RequestsAtTheProtocolsLimitsGetTheirException) {
@@ -129,7 +129,7 @@ TEST(ModbusServerProtocol, RequestsAtTheProtocolsLimitsGetTheirException) {
   ASSERT_TRUE(c.connected());
   const auto ex = [&](const Bytes& pdu) {
     EXPECT_TRUE(c.send(mb_frame(pdu)));
-    return exception_of(c.reply(), pdu[0]);
+    return exception_code_of(c.reply(), pdu[0]);
   };
   // Quantity 0 and one over the limit of each function: 03.
   EXPECT_EQ(ex({1, 0, 0, 0, 0}), 3);

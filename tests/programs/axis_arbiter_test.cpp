@@ -12,11 +12,11 @@ namespace {
 
 using programs::AxisArbiter;
 
-struct Rig {
+struct ArbiterRig {
   AxisArbiter a;
   rt::Output<bool> manual;
   rt::Output<double> man_v{-1.0}, loop_v{-2.0};
-  Rig() {
+  ArbiterRig() {
     a.manual.connect(manual);
     for (rt::Input<double>* in : {&a.manual_vx_mm_s, &a.manual_vy_mm_s, &a.manual_vz_mm_s}) {
       in->connect(man_v);
@@ -37,7 +37,7 @@ TEST(AxisArbiter, EachAxisFollowsTheSafeStateThenManualThenItsCycleThenItsLoop) 
        {rt::MachineState::kReady, rt::MachineState::kRunning, rt::MachineState::kHold,
         rt::MachineState::kFault, rt::MachineState::kEstop}) {
     for (int mask = 0; mask < 16; ++mask) {  // bit 0: manual, bits 1-3: cycle claims x, y, z
-      Rig r;
+      ArbiterRig r;
       const bool manual = (mask & 1) != 0;
       const bool claims[3] = {(mask & 2) != 0, (mask & 4) != 0, (mask & 8) != 0};
       r.manual.set(manual);
@@ -74,7 +74,7 @@ TEST(AxisArbiter, EachAxisFollowsTheSafeStateThenManualThenItsCycleThenItsLoop) 
 }
 
 TEST(AxisArbiter, TheSafeStateStopsEveryAxisAtOnce) {
-  Rig r;
+  ArbiterRig r;
   rt::CycleContext ctx;
   ctx.state = rt::MachineState::kRunning;
   r.a.update(ctx);

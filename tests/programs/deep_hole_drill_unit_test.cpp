@@ -18,7 +18,7 @@ namespace {
 using namespace std::chrono_literals;
 using programs::DeepHoleDrill;
 
-programs::DeepHoleDrillParams params() {
+programs::DeepHoleDrillParams unit_params() {
   programs::DeepHoleDrillParams p;
   p.depth_default_mm = 2.0;
   p.touch_cycles = 3;
@@ -29,7 +29,7 @@ programs::DeepHoleDrillParams params() {
 TEST(DeepHoleDrill, RegisteredAsAProgramType) { EXPECT_TRUE(is_builtin_program("DeepHoleDrill")); }
 
 TEST(DeepHoleDrill, IdleUntilARisingStartThenApproachesWithTheGeneratorOn) {
-  Rig r(params());
+  Rig r(unit_params());
   r.step();
   EXPECT_EQ(r.state(), 0);
   EXPECT_FALSE(r.gen());
@@ -44,7 +44,7 @@ TEST(DeepHoleDrill, IdleUntilARisingStartThenApproachesWithTheGeneratorOn) {
 // The operator's feed override (EdmJob wires it): it scales the approach and caps the downward
 // feed of DRILL at override·v_feed_max; backing off is never scaled; not finite: no feed.
 TEST(DeepHoleDrill, FeedOverrideScalesTheApproachAndTheDownwardCapNeverTheBackOff) {
-  Rig r(params());
+  Rig r(unit_params());
   rt::Output<double> ov;
   ov.set(0.5);
   r.in<double>("feed_override").connect(ov);
@@ -71,7 +71,7 @@ TEST(DeepHoleDrill, FeedOverrideScalesTheApproachAndTheDownwardCapNeverTheBackOf
 }
 
 TEST(DeepHoleDrill, TouchNeedsTouchCyclesConsecutiveCyclesWithSparks) {
-  Rig r(params());
+  Rig r(unit_params());
   r.start.set(true);
   r.z_mm.set(0.1);
   r.step();  // APPROACH
@@ -93,7 +93,7 @@ TEST(DeepHoleDrill, TouchNeedsTouchCyclesConsecutiveCyclesWithSparks) {
 }
 
 TEST(DeepHoleDrill, DrillsOnTdThenRetractsAtDepthAndEndsDone) {
-  auto p = params();
+  auto p = unit_params();
   Rig r(p);
   r.comp.set(false);  // depth = touch_z − z exactly
   r.start.set(true);
@@ -130,7 +130,7 @@ TEST(DeepHoleDrill, DrillsOnTdThenRetractsAtDepthAndEndsDone) {
 }
 
 TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
-  Rig r(params());
+  Rig r(unit_params());
   r.start_sparking(20, 12.0, 20);
   ASSERT_EQ(r.state(), 2);
   const double vz_in = -0.05 * 4.0;
@@ -146,7 +146,7 @@ TEST(DeepHoleDrill, WearCompensationFeedsFasterAndIsSubtractedFromTheDepth) {
 // A wired vz_servo_mm_s replaces the P law in DRILL (clamped to the gap child's −1 … +5 mm/s),
 // passes through the same wear compensation, and a broken (non-finite) value stops the feed.
 TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
-  Rig r(params());
+  Rig r(unit_params());
   rt::Output<double> servo;
   r.wire_servo(servo);
   r.comp.set(false);
@@ -174,7 +174,7 @@ TEST(DeepHoleDrill, AWiredExternalServoReplacesThePLawInDrill) {
 }
 
 TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
-  Rig r(params());
+  Rig r(unit_params());
   rt::Output<double> servo;
   r.wire_servo(servo);
   servo.set(-0.25);
@@ -185,7 +185,7 @@ TEST(DeepHoleDrill, WearCompensationActsOnTheExternalServosCommand) {
 }
 
 TEST(DeepHoleDrill, SafeStateTurnsTheGeneratorOffAndBacksZOffWithoutFinishing) {
-  Rig r(params());
+  Rig r(unit_params());
   r.start_sparking(20, 12.0, 10);
   ASSERT_EQ(r.state(), 2);
   r.z_mm.set(-0.5);
@@ -217,7 +217,7 @@ TEST(DeepHoleDrill, SafeStateTurnsTheGeneratorOffAndBacksZOffWithoutFinishing) {
 }
 
 TEST(DeepHoleDrill, SafeStateDuringApproachBacksOffByTheClearance) {
-  Rig r(params());
+  Rig r(unit_params());
   r.start.set(true);
   r.z_mm.set(0.2);
   r.step();
@@ -232,7 +232,7 @@ TEST(DeepHoleDrill, SafeStateDuringApproachBacksOffByTheClearance) {
 }
 
 TEST(DeepHoleDrill, BadParametersAreRefused) {
-  auto p = params();
+  auto p = unit_params();
   p.depth_default_mm = 0.0;
   p.touch_cycles = 0;
   p.approach_speed_mm_s = 2.0;

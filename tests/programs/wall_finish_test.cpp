@@ -23,11 +23,11 @@ namespace {
 using namespace std::chrono_literals;
 using programs::WallFinish;
 
-struct Rig : CompositeRig<WallFinish> {
+struct FinishRig : CompositeRig<WallFinish> {
   WallFinish& wf{block};
   rt::Output<double> x_mm, y_mm, start_offset, final_offset;
 
-  explicit Rig(const programs::WallFinishParams& p) : CompositeRig(p) {
+  explicit FinishRig(const programs::WallFinishParams& p) : CompositeRig(p) {
     // orbit.kr keeps WallFinish's default 1e-4 mm/µs: Td = 10 µs → Δr = 1 µm per revolution.
     EXPECT_TRUE(write_param(wf, "orbit.dr_max_mm", rt::ParamValue::of_real(0.005)).empty());
     configure("cycle.finish");
@@ -80,7 +80,7 @@ TEST(WallFinish, RejectsBadParameters) {
 }
 
 TEST(WallFinish, FullCyclePolarityThenGrowingOrbitThenBackToCentre) {
-  Rig rig(params());
+  FinishRig rig(params());
   rig.final_offset.set(0.0105);  // not a multiple of Δr: the last step is cut to land on it
   for (int k = 0; k < 50; ++k) rig.step();
   EXPECT_EQ(rig.state(), 0);
@@ -151,7 +151,7 @@ TEST(WallFinish, FullCyclePolarityThenGrowingOrbitThenBackToCentre) {
 // circle, and the feed_mm_min input (G160's F through EdmJob) replaces the parameter.
 TEST(WallFinish, OrbitReferenceRunsAtTheFeedOnTheFinalRadius) {
   for (const double feed_in : {0.0, 45.0}) {
-    Rig rig(params());  // feed_default_mm_min 20
+    FinishRig rig(params());  // feed_default_mm_min 20
     rt::Output<double> feed;
     feed.set(feed_in);
     rig.in<double>("feed_mm_min").connect(feed);
@@ -184,7 +184,7 @@ TEST(WallFinish, OrbitReferenceRunsAtTheFeedOnTheFinalRadius) {
 }
 
 TEST(WallFinish, GrowthPerRevolutionIsClampedToDrMax) {
-  Rig rig(params());
+  FinishRig rig(params());
   rig.final_offset.set(0.012);
   rig.start.set(true);
   std::vector<double> offsets;
@@ -205,7 +205,7 @@ TEST(WallFinish, GrowthPerRevolutionIsClampedToDrMax) {
 }
 
 TEST(WallFinish, StartOffsetIsTheFirstOrbitRadius) {
-  Rig rig(params());
+  FinishRig rig(params());
   rig.start_offset.set(0.02);
   rig.final_offset.set(0.022);
   rig.start.set(true);
@@ -220,7 +220,7 @@ TEST(WallFinish, StartOffsetIsTheFirstOrbitRadius) {
 }
 
 TEST(WallFinish, SafeStateStopsAtOnceAndIgnoresStart) {
-  Rig rig(params());
+  FinishRig rig(params());
   rig.final_offset.set(0.05);
   rig.start.set(true);
   for (int k = 0; k < 1000; ++k) rig.step();

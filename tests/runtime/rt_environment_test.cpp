@@ -35,7 +35,7 @@ class FifoReader {
  public:
   explicit FifoReader(const std::string& path) {
     if (mkfifo(path.c_str(), 0600) == 0) {
-      fd_ = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+      fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     }
   }
   ~FifoReader() {

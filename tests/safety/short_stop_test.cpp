@@ -148,7 +148,8 @@ TEST_F(ShortStopUnit, ABrokenCounterReadsShortAndAForceIsCutToo) {
 
 // --- Config ------------------------------------------------------------------------------------
 
-std::string first_error(const std::string& short_stop, const std::string& retract = "positive") {
+std::string stop_first_error(const std::string& short_stop,
+                             const std::string& retract = "positive") {
   const std::string yaml = safety_machine(2) +
                            R"(    axes: [{name: Z, velocity: io.ao0, position: io.ai0, retract: )" +
                            retract + R"(}]
@@ -157,19 +158,19 @@ std::string first_error(const std::string& short_stop, const std::string& retrac
 }
 
 TEST(ShortStopConfig, TheCountersMustBeLintOutputsOfTheDriver) {
-  EXPECT_EQ(first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1]}"),
+  EXPECT_EQ(stop_first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1]}"),
             "m.yaml:9:26: machine.safety: 'io.ai1' (short_stop.shorts) must be a LINT output (a "
             "reading from the machine) of the I/O driver; it is a LREAL output");
 }
 
 TEST(ShortStopConfig, TheLimitIsAFractionAndAnAxisMustHaveARetractDirection) {
-  EXPECT_EQ(first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1], limit: 1.5}"),
+  EXPECT_EQ(stop_first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1], limit: 1.5}"),
             "m.yaml:9:59: machine.safety.short_stop.limit: must be in (0, 1], the fraction of a "
             "cycle's pulses that are shorts (got 1.5)");
-  EXPECT_EQ(first_error("    short_stop: {shorts: io.ai1, pulses: []}"),
+  EXPECT_EQ(stop_first_error("    short_stop: {shorts: io.ai1, pulses: []}"),
             "m.yaml:9:42: machine.safety.short_stop.pulses: needs at least one pin: the pulse "
             "counters that add up to all pulses of a cycle");
-  EXPECT_EQ(first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1]}", "none"),
+  EXPECT_EQ(stop_first_error("    short_stop: {shorts: io.ai1, pulses: [io.ai1]}", "none"),
             "m.yaml:9:17: machine.safety.short_stop: no supervised axis has a retract direction "
             "(axes[].retract): the short stop cuts the motion against it, toward the work");
 }

@@ -14,7 +14,7 @@
 namespace edm::sim {
 namespace {
 
-constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kPlantMs = 1'000'000;
 
 PlantCommands generator_on() {
   PlantCommands c;
@@ -137,7 +137,7 @@ TEST(SimPlant, sensors_account_for_all_time_and_quantise_td) {
     const auto s = p.take_sensors();
     std::int64_t t = 0;
     for (auto x : s.time_ns) t += x;
-    ASSERT_EQ(t, kMs);
+    ASSERT_EQ(t, kPlantMs);
     ASSERT_EQ(s.td_sum_ns % 10, 0);
     ASSERT_GT(s.td_count, 5);
   }
