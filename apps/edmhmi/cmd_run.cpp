@@ -205,8 +205,7 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
       }
       break;
     case RunOutcome::kFinished:
-    case RunOutcome::kAborted:
-      break;
+    case RunOutcome::kAborted: break;
   }
   std::fputs(edm::hmi::format_report(r.report).c_str(), stdout);
   std::fflush(stdout);

@@ -135,10 +135,8 @@ double ise_integral(std::span<const double> b_in, std::span<const double> a_in) 
   for (std::size_t i = 0; i < b_in.size(); ++i) b[i] = b_in[i] / a_in[n];
 
   switch (n) {
-    case 1:
-      return b[0] * b[0] / (2.0 * a[0] * a[1]);
-    case 2:
-      return (b[1] * b[1] * a[0] + b[0] * b[0] * a[2]) / (2.0 * a[0] * a[1] * a[2]);
+    case 1: return b[0] * b[0] / (2.0 * a[0] * a[1]);
+    case 2: return (b[1] * b[1] * a[0] + b[0] * b[0] * a[2]) / (2.0 * a[0] * a[1] * a[2]);
     case 3: {
       const double num = b[2] * b[2] * a[0] * a[1] +
                          (b[1] * b[1] - 2.0 * b[0] * b[2]) * a[0] * a[3] +

@@ -69,16 +69,12 @@ std::string default_text(const rt::ParamRef& ref) {
   }
   const rt::ParamValue v = rt::read_param(ref);
   switch (v.type) {
-    case ParamType::kBool:
-      return v.b ? "true" : "false";
-    case ParamType::kInt:
-      return std::to_string(v.i);
-    case ParamType::kReal:
-      return real_text(v.r);
+    case ParamType::kBool: return v.b ? "true" : "false";
+    case ParamType::kInt: return std::to_string(v.i);
+    case ParamType::kReal: return real_text(v.r);
     case ParamType::kDuration:
       return v.i == 0 ? "0s" : rt::format_duration(rt::Duration{v.i});  // not "0ns"
-    case ParamType::kString:
-      break;
+    case ParamType::kString: break;
   }
   return {};
 }

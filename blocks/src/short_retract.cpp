@@ -180,8 +180,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
     }
 
     switch (state_) {
-      case State::kIdle:
-        break;
+      case State::kIdle: break;
       case State::kRetract: {
         pos_s_ = std::max(pos_s_ - p.retract_speed_mm_s * dt_s_, target_s_);
         while (seg_ > 0 && at(seg_).s > pos_s_) {
@@ -222,9 +221,7 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
           v_scale_now = static_cast<double>(ramp_k_) / static_cast<double>(ramp_cycles_);
         }
         break;
-      case State::kHold:
-        v_scale_now = 0.0;
-        break;
+      case State::kHold: v_scale_now = 0.0; break;
     }
   }
   const bool active_now =

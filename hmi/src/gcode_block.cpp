@@ -111,9 +111,7 @@ class Sorter {
           }
           break;
         case 'G':
-        case 'M':
-          ok = sort_code(b, w) && ok;
-          break;
+        case 'M': ok = sort_code(b, w) && ok; break;
         case 'X':
         case 'Y':
         case 'Z':

@@ -46,14 +46,10 @@ namespace {
 
 Motion motion_of(const Word& g) noexcept {
   switch (code10(g)) {
-    case 0:
-      return Motion::kRapid;
-    case 10:
-      return Motion::kLinear;
-    case 20:
-      return Motion::kArcCw;
-    default:
-      return Motion::kArcCcw;
+    case 0: return Motion::kRapid;
+    case 10: return Motion::kLinear;
+    case 20: return Motion::kArcCw;
+    default: return Motion::kArcCcw;
   }
 }
 

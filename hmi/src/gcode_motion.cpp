@@ -88,15 +88,10 @@ void Interpreter::do_motion(const Block& b) {
       push(make(MotionKind::kRapid, b, at));
       break;
     }
-    case Motion::kLinear:
-      do_linear(b, at, start, target);
-      break;
+    case Motion::kLinear: do_linear(b, at, start, target); break;
     case Motion::kArcCw:
-    case Motion::kArcCcw:
-      do_arc(b, at, start, target);
-      break;
-    case Motion::kNone:
-      break;  // refused in phase 1
+    case Motion::kArcCcw: do_arc(b, at, start, target); break;
+    case Motion::kNone: break;  // refused in phase 1
   }
 }
 

@@ -127,14 +127,11 @@ std::optional<Json> offset_set_for_touch(std::string_view frame, TouchTarget t,
     return true;
   };
   switch (t) {
-    case TouchTarget::kZ:
-      return put("z", r.z_mm) ? std::optional<Json>(p) : std::nullopt;
+    case TouchTarget::kZ: return put("z", r.z_mm) ? std::optional<Json>(p) : std::nullopt;
     case TouchTarget::kXPlus:
-    case TouchTarget::kXMinus:
-      return put("x", r.x_mm) ? std::optional<Json>(p) : std::nullopt;
+    case TouchTarget::kXMinus: return put("x", r.x_mm) ? std::optional<Json>(p) : std::nullopt;
     case TouchTarget::kYPlus:
-    case TouchTarget::kYMinus:
-      return put("y", r.y_mm) ? std::optional<Json>(p) : std::nullopt;
+    case TouchTarget::kYMinus: return put("y", r.y_mm) ? std::optional<Json>(p) : std::nullopt;
     case TouchTarget::kCenter:
       return put("x", r.x_mm) && put("y", r.y_mm) ? std::optional<Json>(p) : std::nullopt;
   }

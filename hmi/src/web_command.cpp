@@ -15,40 +15,24 @@ Json bad_request(const std::string& message) {
 /// The blocking part of a command: the reply body.
 Json run(PageBackend& b, const PageCommand& c, std::uint64_t owner) {
   switch (c.op) {
-    case PageOp::kCheck:
-      return b.check(c.text, c.name);
-    case PageOp::kUpload:
-      return b.upload(c.text, c.name);
-    case PageOp::kStart:
-      return b.start_job(c.dry_run);
-    case PageOp::kStartFrom:
-      return b.start_from(c.from_line, c.depth_done_mm, c.dry_run);
-    case PageOp::kMdi:
-      return b.mdi(c.mdi_line);
-    case PageOp::kJogHold:
-      return b.jog_hold(owner, c.axis, c.velocity_mm_s);
-    case PageOp::kJogRelease:
-      b.jog_release(owner);
-      return {{"ok", true}};
-    case PageOp::kJogStop:
-      b.jog_stop_hold();
-      return b.relay("jog.stop", c.params);
-    case PageOp::kTouch:
-      return b.touch(c.target, c.set_frame);
-    case PageOp::kOffsetSet:
-      return b.offset_set(c.params);
-    case PageOp::kAck:
-      b.acknowledge(c.seq);
-      return {{"ok", true}};
+    case PageOp::kCheck: return b.check(c.text, c.name);
+    case PageOp::kUpload: return b.upload(c.text, c.name);
+    case PageOp::kStart: return b.start_job(c.dry_run);
+    case PageOp::kStartFrom: return b.start_from(c.from_line, c.depth_done_mm, c.dry_run);
+    case PageOp::kMdi: return b.mdi(c.mdi_line);
+    case PageOp::kJogHold: return b.jog_hold(owner, c.axis, c.velocity_mm_s);
+    case PageOp::kJogRelease: b.jog_release(owner); return {{"ok", true}};
+    case PageOp::kJogStop: b.jog_stop_hold(); return b.relay("jog.stop", c.params);
+    case PageOp::kTouch: return b.touch(c.target, c.set_frame);
+    case PageOp::kOffsetSet: return b.offset_set(c.params);
+    case PageOp::kAck: b.acknowledge(c.seq); return {{"ok", true}};
     case PageOp::kManualStatus:
     case PageOp::kOffsetGet: {
       const Json body = c.op == PageOp::kManualStatus ? b.manual_status() : b.offsets();
       return {{"ok", !body.is_null()}, {"body", body}};
     }
-    case PageOp::kJob:
-      return {{"ok", true}, {"body", b.job_snapshot()}};
-    case PageOp::kStats:
-      return b.stats();
+    case PageOp::kJob: return {{"ok", true}, {"body", b.job_snapshot()}};
+    case PageOp::kStats: return b.stats();
     case PageOp::kCycleHold:
     case PageOp::kCycleResume:
     case PageOp::kCycleStop:
@@ -61,8 +45,7 @@ Json run(PageBackend& b, const PageCommand& c, std::uint64_t owner) {
     case PageOp::kVarRead:
     case PageOp::kVarWrite:
     case PageOp::kVarForce:
-    case PageOp::kVarUnforce:
-      return b.relay(page_op_info(c.op).name, c.params);
+    case PageOp::kVarUnforce: return b.relay(page_op_info(c.op).name, c.params);
   }
   return bad_request("unknown command");
 }

@@ -123,8 +123,7 @@ Json toolpath_points(const std::vector<machining::MotionBlock>& blocks, const Ve
         pts.push_back(point(at));
         break;
       }
-      default:
-        break;
+      default: break;
     }
   }
   if (pts.size() <= max_points || max_points < 2) return pts;

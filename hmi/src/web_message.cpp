@@ -124,17 +124,13 @@ bool short_string(const Json& v, std::size_t max) {
 
 bool fits(const Json& v, const Field& f) {
   switch (f.kind) {
-    case Kind::kString:
-      return short_string(v, f.max_bytes);
+    case Kind::kString: return short_string(v, f.max_bytes);
     case Kind::kLine:
       return short_string(v, f.max_bytes) &&
              v.get_ref<const std::string&>().find_first_of("\r\n") == std::string::npos;
-    case Kind::kBool:
-      return v.is_boolean();
-    case Kind::kNumber:
-      return finite(v);
-    case Kind::kNumberOrNull:
-      return v.is_null() || finite(v);
+    case Kind::kBool: return v.is_boolean();
+    case Kind::kNumber: return finite(v);
+    case Kind::kNumberOrNull: return v.is_null() || finite(v);
     case Kind::kInt32:
       if (v.is_number_unsigned()) {
         return v.get<std::uint64_t>() <=
@@ -151,8 +147,7 @@ bool fits(const Json& v, const Field& f) {
         if (!short_string(e, f.max_bytes)) return false;
       }
       return true;
-    case Kind::kScalar:
-      return finite(v) || v.is_boolean() || short_string(v, f.max_bytes);
+    case Kind::kScalar: return finite(v) || v.is_boolean() || short_string(v, f.max_bytes);
   }
   return false;
 }
@@ -160,25 +155,17 @@ bool fits(const Json& v, const Field& f) {
 std::string expected(const Field& f) {
   const std::string bytes = std::to_string(f.max_bytes);
   switch (f.kind) {
-    case Kind::kString:
-      return "a string of at most " + bytes + " bytes";
-    case Kind::kLine:
-      return "one line of at most " + bytes + " bytes";
-    case Kind::kBool:
-      return "true or false";
-    case Kind::kNumber:
-      return "a finite number";
-    case Kind::kNumberOrNull:
-      return "a finite number or null";
-    case Kind::kInt32:
-      return "a 32-bit integer";
-    case Kind::kUint:
-      return "a non-negative integer";
+    case Kind::kString: return "a string of at most " + bytes + " bytes";
+    case Kind::kLine: return "one line of at most " + bytes + " bytes";
+    case Kind::kBool: return "true or false";
+    case Kind::kNumber: return "a finite number";
+    case Kind::kNumberOrNull: return "a finite number or null";
+    case Kind::kInt32: return "a 32-bit integer";
+    case Kind::kUint: return "a non-negative integer";
     case Kind::kStringArray:
       return "an array of 1 to " + std::to_string(kMaxPageVarNames) + " strings of at most " +
              bytes + " bytes";
-    case Kind::kScalar:
-      return "a number, true/false or a string of at most " + bytes + " bytes";
+    case Kind::kScalar: return "a number, true/false or a string of at most " + bytes + " bytes";
   }
   return "?";
 }
@@ -206,9 +193,7 @@ void fill(PageCommand& c, const Json& m) {
       str("text", c.text);
       str("name", c.name);
       break;
-    case PageOp::kStart:
-      c.dry_run = flag("dry_run");
-      break;
+    case PageOp::kStart: c.dry_run = flag("dry_run"); break;
     case PageOp::kStartFrom:
       c.from_line = m.at("line").get<std::int32_t>();
       if (const auto it = m.find("depth_done"); it != m.end() && !it->is_null()) {
@@ -216,9 +201,7 @@ void fill(PageCommand& c, const Json& m) {
       }
       c.dry_run = flag("dry_run");
       break;
-    case PageOp::kMdi:
-      str("line", c.mdi_line);
-      break;
+    case PageOp::kMdi: str("line", c.mdi_line); break;
     case PageOp::kJogHold:
       str("axis", c.axis);
       c.velocity_mm_s = m.at("velocity").get<double>();
@@ -227,11 +210,8 @@ void fill(PageCommand& c, const Json& m) {
       str("target", c.target);
       str("set", c.set_frame);
       break;
-    case PageOp::kAck:
-      c.seq = m.at("seq").get<std::uint64_t>();
-      break;
-    default:
-      break;
+    case PageOp::kAck: c.seq = m.at("seq").get<std::uint64_t>(); break;
+    default: break;
   }
 }
 

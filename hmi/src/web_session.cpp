@@ -109,12 +109,8 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
   void push(std::shared_ptr<const std::string> message, WebOutbox::Kind kind) {
     if (closing_ || close_reason_) return;
     switch (outbox_.push(std::move(message), kind)) {
-      case WebOutbox::Push::kStartWrite:
-        stall_since_.reset();
-        return do_write();
-      case WebOutbox::Push::kQueued:
-        stall_since_.reset();
-        return;
+      case WebOutbox::Push::kStartWrite: stall_since_.reset(); return do_write();
+      case WebOutbox::Push::kQueued: stall_since_.reset(); return;
       case WebOutbox::Push::kDropped:
         hub_.count_drop();
         if (!stall_since_) stall_since_ = Clock::now();
@@ -162,9 +158,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
     if (buffer_.capacity() > 64 * 1024) buffer_.shrink_to_fit();  // a 2 MiB upload is not kept
     PageAction a = page_action(text, role_);
     switch (a.kind) {
-      case PageAction::Kind::kReply:
-        send_json(a.reply);
-        break;
+      case PageAction::Kind::kReply: send_json(a.reply); break;
       case PageAction::Kind::kClose:
         send_json(a.reply);
         return close(websocket::close_code::policy_error, "log in first");
@@ -174,9 +168,7 @@ class WsSession : public WebSink, public std::enable_shared_from_this<WsSession<
       case PageAction::Kind::kHeld:
         if (*role_ == bridge::Role::kOperator) hub_.manual().held(id_);
         break;
-      case PageAction::Kind::kRun:
-        run_command(std::move(a.command));
-        break;
+      case PageAction::Kind::kRun: run_command(std::move(a.command)); break;
     }
     do_read();
   }

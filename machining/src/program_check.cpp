@@ -55,18 +55,10 @@ ArcBox arc_bounding_box(double sx, double sy, double ex, double ey, bool clockwi
     // An axis direction a lies on the arc when it is reached from `from` within the sweep.
     if (full || ccw_sweep(from, a) <= sweep) {
       switch (k) {
-        case 0:
-          box.max_x = std::max(box.max_x, r);
-          break;
-        case 1:
-          box.max_y = std::max(box.max_y, r);
-          break;
-        case 2:
-          box.min_x = std::min(box.min_x, -r);
-          break;
-        default:
-          box.min_y = std::min(box.min_y, -r);
-          break;
+        case 0: box.max_x = std::max(box.max_x, r); break;
+        case 1: box.max_y = std::max(box.max_y, r); break;
+        case 2: box.min_x = std::min(box.min_x, -r); break;
+        default: box.min_y = std::min(box.min_y, -r); break;
       }
     }
   }
@@ -239,11 +231,8 @@ std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
         }
         break;
       case MotionKind::kRotation:
-      case MotionKind::kFlushing:
-        break;
-      case MotionKind::kEnd:
-        ended = true;
-        break;
+      case MotionKind::kFlushing: break;
+      case MotionKind::kEnd: ended = true; break;
     }
     if (b.kind != MotionKind::kCondition && b.condition > 0 &&
         tables.condition(b.condition) == nullptr) {

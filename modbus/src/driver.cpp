@@ -422,9 +422,7 @@ bool ModbusDriver::exchange_once(Link& link) noexcept {
   for (const Span& s : reads_) {
     int rc = 0;
     switch (s.table) {
-      case Table::kCoil:
-        rc = modbus_read_bits(link.ctx, s.start, s.count, link.bits.data());
-        break;
+      case Table::kCoil: rc = modbus_read_bits(link.ctx, s.start, s.count, link.bits.data()); break;
       case Table::kDiscreteInput:
         rc = modbus_read_input_bits(link.ctx, s.start, s.count, link.bits.data());
         break;

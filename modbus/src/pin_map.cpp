@@ -43,16 +43,11 @@ struct RawRange {
 
 RawRange range_of(ValueType t) noexcept {
   switch (t) {
-    case ValueType::kBool:
-      return {0, 1};
-    case ValueType::kInt16:
-      return {-32768.0, 32767.0};
-    case ValueType::kUint16:
-      return {0.0, 65535.0};
-    case ValueType::kInt32:
-      return {-2147483648.0, 2147483647.0};
-    case ValueType::kUint32:
-      return {0.0, 4294967295.0};
+    case ValueType::kBool: return {0, 1};
+    case ValueType::kInt16: return {-32768.0, 32767.0};
+    case ValueType::kUint16: return {0.0, 65535.0};
+    case ValueType::kInt32: return {-2147483648.0, 2147483647.0};
+    case ValueType::kUint32: return {0.0, 4294967295.0};
     case ValueType::kFloat32:
       return {-static_cast<double>(std::numeric_limits<float>::max()),
               static_cast<double>(std::numeric_limits<float>::max())};
@@ -64,32 +59,22 @@ RawRange range_of(ValueType t) noexcept {
 
 std::string_view to_string(Table t) noexcept {
   switch (t) {
-    case Table::kCoil:
-      return "coil";
-    case Table::kDiscreteInput:
-      return "discrete_input";
-    case Table::kInputRegister:
-      return "input_register";
-    case Table::kHoldingRegister:
-      return "holding_register";
+    case Table::kCoil: return "coil";
+    case Table::kDiscreteInput: return "discrete_input";
+    case Table::kInputRegister: return "input_register";
+    case Table::kHoldingRegister: return "holding_register";
   }
   return "?";
 }
 
 std::string_view to_string(ValueType t) noexcept {
   switch (t) {
-    case ValueType::kBool:
-      return "bool";
-    case ValueType::kInt16:
-      return "int16";
-    case ValueType::kUint16:
-      return "uint16";
-    case ValueType::kInt32:
-      return "int32";
-    case ValueType::kUint32:
-      return "uint32";
-    case ValueType::kFloat32:
-      return "float32";
+    case ValueType::kBool: return "bool";
+    case ValueType::kInt16: return "int16";
+    case ValueType::kUint16: return "uint16";
+    case ValueType::kInt32: return "int32";
+    case ValueType::kUint32: return "uint32";
+    case ValueType::kFloat32: return "float32";
   }
   return "?";
 }
@@ -271,15 +256,9 @@ double decode(const std::uint16_t* words, const Encoding& enc) noexcept {
     const std::uint16_t lo = enc.order == WordOrder::kBig ? words[1] : w0;
     const std::uint32_t u = (static_cast<std::uint32_t>(hi) << 16U) | lo;
     switch (enc.type) {
-      case ValueType::kInt32:
-        raw = static_cast<double>(static_cast<std::int32_t>(u));
-        break;
-      case ValueType::kFloat32:
-        raw = static_cast<double>(std::bit_cast<float>(u));
-        break;
-      default:
-        raw = static_cast<double>(u);
-        break;
+      case ValueType::kInt32: raw = static_cast<double>(static_cast<std::int32_t>(u)); break;
+      case ValueType::kFloat32: raw = static_cast<double>(std::bit_cast<float>(u)); break;
+      default: raw = static_cast<double>(u); break;
     }
   }
   return raw * enc.scale + enc.offset;
@@ -304,18 +283,10 @@ bool encode(double value, const Encoding& enc, std::uint16_t* words) noexcept {
   switch (enc.type) {
     case ValueType::kBool:
     case ValueType::kUint16:
-    case ValueType::kUint32:
-      u = static_cast<std::uint32_t>(raw);
-      break;
-    case ValueType::kInt16:
-      u = static_cast<std::uint16_t>(static_cast<std::int16_t>(raw));
-      break;
-    case ValueType::kInt32:
-      u = static_cast<std::uint32_t>(static_cast<std::int32_t>(raw));
-      break;
-    case ValueType::kFloat32:
-      u = std::bit_cast<std::uint32_t>(static_cast<float>(raw));
-      break;
+    case ValueType::kUint32: u = static_cast<std::uint32_t>(raw); break;
+    case ValueType::kInt16: u = static_cast<std::uint16_t>(static_cast<std::int16_t>(raw)); break;
+    case ValueType::kInt32: u = static_cast<std::uint32_t>(static_cast<std::int32_t>(raw)); break;
+    case ValueType::kFloat32: u = std::bit_cast<std::uint32_t>(static_cast<float>(raw)); break;
   }
   if (words_of(enc.type) == 1) {
     words[0] = static_cast<std::uint16_t>(u);

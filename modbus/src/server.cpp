@@ -416,11 +416,8 @@ void Server::close_client(std::vector<std::unique_ptr<Client>>& clients, std::si
       log_about(spdlog::level::info, c.address,
                 fmt::format("{}: no request for {} ms: closed", c.name, ms(config_.idle_timeout)));
       break;
-    case Close::kEvicted:
-      evicted_.fetch_add(1, std::memory_order_relaxed);
-      break;
-    default:
-      break;
+    case Close::kEvicted: evicted_.fetch_add(1, std::memory_order_relaxed); break;
+    default: break;
   }
   clients.erase(clients.begin() + static_cast<std::ptrdiff_t>(i));
   open_.store(clients.size(), std::memory_order_relaxed);

@@ -143,10 +143,8 @@ bool is_served_function(std::uint8_t fc) noexcept {
     case kWriteSingleCoil:
     case kWriteSingleRegister:
     case kWriteMultipleCoils:
-    case kWriteMultipleRegisters:
-      return true;
-    default:
-      return false;
+    case kWriteMultipleRegisters: return true;
+    default: return false;
   }
 }
 
@@ -157,16 +155,12 @@ std::size_t serve_pdu(const std::uint8_t* req, std::size_t n, std::uint8_t* rsp,
     case kReadCoils:
     case kReadDiscreteInputs:
     case kReadHoldingRegisters:
-    case kReadInputRegisters:
-      return serve_read(fc, req, n, rsp, regs);
+    case kReadInputRegisters: return serve_read(fc, req, n, rsp, regs);
     case kWriteSingleCoil:
-    case kWriteSingleRegister:
-      return serve_write_single(fc, req, n, rsp, regs);
+    case kWriteSingleRegister: return serve_write_single(fc, req, n, rsp, regs);
     case kWriteMultipleCoils:
-    case kWriteMultipleRegisters:
-      return serve_write_multiple(fc, req, n, rsp, regs);
-    default:
-      return exception(fc, Exception::kIllegalFunction, rsp);
+    case kWriteMultipleRegisters: return serve_write_multiple(fc, req, n, rsp, regs);
+    default: return exception(fc, Exception::kIllegalFunction, rsp);
   }
 }
 

@@ -98,13 +98,10 @@ Exception MapRegisters::write_checked(Table t, std::uint16_t addr, std::uint16_t
                                 e->var, v, rt::log_quoted(s.message, kNoteMessageBytes));
       note_.refused = true;
       switch (s.result) {
-        case rt::VarResult::kBusy:
-          return Exception::kBusy;
+        case rt::VarResult::kBusy: return Exception::kBusy;
         case rt::VarResult::kInvalid:
-        case rt::VarResult::kTypeMismatch:
-          return Exception::kIllegalDataValue;
-        default:
-          return Exception::kDeviceFailure;
+        case rt::VarResult::kTypeMismatch: return Exception::kIllegalDataValue;
+        default: return Exception::kDeviceFailure;
       }
     }
     ++writes_;

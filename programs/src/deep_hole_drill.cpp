@@ -21,50 +21,36 @@ constexpr double kMaxApproachSpeed = blocks::GapControllerPParams{}.v_feed_max_m
 void DeepHoleDrillParams::visit(rt::ParamVisitor& v) {
   namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
   v.param("depth_default_mm", depth_default_mm,
-          {.unit = "mm",
-           .description = "target hole depth while the depth_mm input is 0",
-           .range = r::kPositiveLengthMm});
+          {"mm", "target hole depth while the depth_mm input is 0", r::kPositiveLengthMm});
   v.param("approach_speed_mm_s", approach_speed_mm_s,
-          {.unit = "mm/s",
-           .description = "feed down until the first sparks (at most the gap feed limit)",
-           .range = rt::open_closed(0.0, kMaxApproachSpeed)});
+          {"mm/s", "feed down until the first sparks (at most the gap feed limit)",
+           rt::open_closed(0.0, kMaxApproachSpeed)});
   v.param("spark_gap_offset_um", spark_gap_offset_um,
-          {.unit = "um",
-           .description = "frontal gap at the first sparks less the working gap: the hole is "
-                          "this much shallower than the front's travel from the touch",
-           .range = rt::closed(-1000.0, 1000.0)});
+          {"um",
+           "frontal gap at the first sparks less the working gap: the hole is this much shallower "
+           "than the front's travel from the touch",
+           rt::closed(-1000.0, 1000.0)});
   v.param("contact_offset_um", contact_offset_um,
-          {.unit = "um",
-           .description = "working gap less the touch-sensing distance: a hole measured by touch "
-                          "(contact_depth_mm) is this much deeper than the front's travel from "
-                          "the contact",
-           .range = rt::closed(-1000.0, 1000.0)});
+          {"um",
+           "working gap less the touch-sensing distance: a hole measured by touch "
+           "(contact_depth_mm) is this much deeper than the front's travel from the contact",
+           rt::closed(-1000.0, 1000.0)});
   v.param("touch_cycles", touch_cycles,
-          {.unit = "cycles",
-           .description = "consecutive cycles with sparks that count as touching the work",
-           .range = r::kCycles});
+          {"cycles", "consecutive cycles with sparks that count as touching the work", r::kCycles});
   v.param("retract_speed_mm_s", retract_speed_mm_s,
-          {.unit = "mm/s", .description = "upward speed of the retract", .range = r::kSpeedMmS});
+          {"mm/s", "upward speed of the retract", r::kSpeedMmS});
   v.param("clearance_mm", clearance_mm,
-          {.unit = "mm",
-           .description = "retract to the touch height plus this",
-           .range = r::kLengthMm});
+          {"mm", "retract to the touch height plus this", r::kLengthMm});
   // Up to 1e7 cycles: 1000 s at the 10 kHz task, 10^4 s at 1 kHz.
   v.param("breakthrough_cycles", breakthrough_cycles,
-          {.unit = "cycles",
-           .description = "cycles without ignition that mean breakthrough of a through hole",
-           .range = rt::closed(1.0, 1.0e7)});
+          {"cycles", "cycles without ignition that mean breakthrough of a through hole",
+           rt::closed(1.0, 1.0e7)});
   v.param("breakthrough_min_mm", breakthrough_min_mm,
-          {.unit = "mm",
-           .description = "no breakthrough is detected above this depth",
-           .range = r::kLengthMm});
-  v.param("overtravel_mm", overtravel_mm,
-          {.unit = "mm", .description = "feed on after breakthrough", .range = r::kLengthMm});
+          {"mm", "no breakthrough is detected above this depth", r::kLengthMm});
+  v.param("overtravel_mm", overtravel_mm, {"mm", "feed on after breakthrough", r::kLengthMm});
   shorts.visit(v);
   v.param("short_backoff_mm", short_backoff_mm,
-          {.unit = "mm",
-           .description = "Z backs off this far on alarm 150, generator off, then holds",
-           .range = r::kLengthMm});
+          {"mm", "Z backs off this far on alarm 150, generator off, then holds", r::kLengthMm});
 }
 
 DeepHoleDrill::DeepHoleDrill()

@@ -6,25 +6,23 @@ namespace edm::programs {
 
 void DepthProbeParams::visit(rt::ParamVisitor& v) {
   v.param("enable", enable,
-          {.description = "measure a blind hole's depth by touch (bottom and surface) and drill "
-                          "the rest from the measurement"});
+          {"",
+           "measure a blind hole's depth by touch (bottom and surface) and drill the rest from the "
+           "measurement"});
   v.param("margin_mm", margin_mm,
-          {.unit = "mm",
-           .description = "the first drilling stops this much short of the depth (more than "
-                          "the wear estimate's error)",
-           .range = rt::open_closed(0.0, 5.0)});
+          {"mm",
+           "the first drilling stops this much short of the depth (more than the wear estimate's "
+           "error)",
+           rt::open_closed(0.0, 5.0)});
   v.param("dx_mm", dx_mm,
-          {.unit = "mm",
-           .description = "X of the surface touch relative to the hole (on the work)",
-           .range = rt::closed(-100.0, 100.0)});
+          {"mm", "X of the surface touch relative to the hole (on the work)",
+           rt::closed(-100.0, 100.0)});
   v.param("dy_mm", dy_mm,
-          {.unit = "mm",
-           .description = "Y of the surface touch relative to the hole (on the work)",
-           .range = rt::closed(-100.0, 100.0)});
+          {"mm", "Y of the surface touch relative to the hole (on the work)",
+           rt::closed(-100.0, 100.0)});
   v.param("clear_mm", clear_mm,
-          {.unit = "mm",
-           .description = "a probe touch starts this far above the expected contact",
-           .range = rt::open_closed(0.0, 5.0)});
+          {"mm", "a probe touch starts this far above the expected contact",
+           rt::open_closed(0.0, 5.0)});
 }
 
 void DepthProbe::activate() noexcept {
@@ -181,8 +179,7 @@ DepthProbe::End DepthProbe::run(ProbeMoves& moves, double hold_x, double hold_y,
       set_step(kOff);
       end.over = true;
       break;
-    default:
-      break;
+    default: break;
   }
   return end;
 }

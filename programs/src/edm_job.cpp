@@ -23,22 +23,15 @@ constexpr std::int64_t kStillCycles = 5;
 
 void EdmJobParams::visit(rt::ParamVisitor& v) {
   namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
-  v.param("rapid_speed_mm_s", rapid_speed_mm_s,
-          {.unit = "mm/s", .description = "speed of rapids", .range = r::kSpeedMmS});
+  v.param("rapid_speed_mm_s", rapid_speed_mm_s, {"mm/s", "speed of rapids", r::kSpeedMmS});
   v.param("feed_default_mm_s", feed_default_mm_s,
-          {.unit = "mm/s",
-           .description = "feed of linear moves and arcs whose block has none",
-           .range = r::kSpeedMmS});
+          {"mm/s", "feed of linear moves and arcs whose block has none", r::kSpeedMmS});
   // An electrode radius plus a side gap: up to 1 m (a die-sinking electrode of 2 m).
   v.param("orbit_radius_offset_mm", orbit_radius_offset_mm,
-          {.unit = "mm",
-           .description = "orbit offset = final radius - this (electrode radius + finishing side "
-                          "gap)",
-           .range = rt::open_closed(0.0, 1000.0)});
+          {"mm", "orbit offset = final radius - this (electrode radius + finishing side gap)",
+           rt::open_closed(0.0, 1000.0)});
   v.param("polarity_settle", polarity_settle,
-          {.unit = "s",
-           .description = "generator-off wait when a condition changes the polarity",
-           .range = r::kSettleS});
+          {"s", "generator-off wait when a condition changes the polarity", r::kSettleS});
 }
 
 EdmJob::EdmJob()
@@ -381,12 +374,8 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
       select_condition(b.condition);
       return true;
     }
-    case MotionKind::kRotation:
-      rotation_on.set(b.on);
-      return true;
-    case MotionKind::kFlushing:
-      flushing_on.set(b.on);
-      return true;
+    case MotionKind::kRotation: rotation_on.set(b.on); return true;
+    case MotionKind::kFlushing: flushing_on.set(b.on); return true;
     case MotionKind::kDwell:
       if (step_ == Step::kEnter) {
         wait_until_ = ctx.release + rt::Duration(static_cast<std::int64_t>(b.dwell_s * 1e9));
@@ -394,17 +383,13 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
       }
       return !hold && ctx.release >= wait_until_;
     case MotionKind::kRapid:
-    case MotionKind::kLinear:
-      return run_linear(b, ctx, hold, status);
+    case MotionKind::kLinear: return run_linear(b, ctx, hold, status);
     case MotionKind::kArcCw:
-    case MotionKind::kArcCcw:
-      return run_arc(b, ctx, hold, status);
+    case MotionKind::kArcCcw: return run_arc(b, ctx, hold, status);
     case MotionKind::kDrill:
       return dry_run.get() || run_drill(b, ctx, hold, status);  // a dry run skips it
-    case MotionKind::kOrbitFinish:
-      return dry_run.get() || run_finish(b, hold);
-    case MotionKind::kEnd:
-      return true;
+    case MotionKind::kOrbitFinish: return dry_run.get() || run_finish(b, hold);
+    case MotionKind::kEnd: return true;
   }
   return true;
 }

@@ -27,69 +27,40 @@ int axis_of(char c) noexcept { return c == 'X' ? 0 : c == 'Y' ? 1 : c == 'Z' ? 2
 
 void ManualMotionParams::visit(rt::ParamVisitor& v) {
   namespace r = blocks::ranges;  // the shared physical ranges (param_ranges.hpp)
-  v.param("jog_v_max_mm_s", jog_v_max_mm_s,
-          {.unit = "mm/s", .description = "fastest continuous jog", .range = r::kSpeedMmS});
-  v.param("accel_mm_s2", accel_mm_s2,
-          {.unit = "mm/s2", .description = "acceleration of manual moves", .range = r::kAccelMmS2});
+  v.param("jog_v_max_mm_s", jog_v_max_mm_s, {"mm/s", "fastest continuous jog", r::kSpeedMmS});
+  v.param("accel_mm_s2", accel_mm_s2, {"mm/s2", "acceleration of manual moves", r::kAccelMmS2});
   v.param("kp_per_s", kp_per_s,
-          {.unit = "1/s",
-           .description = "position gain that keeps the axis on its manual reference",
-           .range = r::kLoopGainPerS});
+          {"1/s", "position gain that keeps the axis on its manual reference", r::kLoopGainPerS});
   // A dead-man time up to 1 min: longer is no dead-man.
   v.param("deadman", deadman,
-          {.unit = "s",
-           .description = "a continuous jog not refreshed for this long stops (dead-man)",
-           .range = rt::open_closed(0.0, 60.0)});
+          {"s", "a continuous jog not refreshed for this long stops (dead-man)",
+           rt::open_closed(0.0, 60.0)});
   v.param("home_order", home_order,
           {.description = "the order in which the axes are referenced (X, Y, Z each at most once)",
            .load_time_only = true});
-  v.param(
-      "home_search_mm_s", home_search_mm_s,
-      {.unit = "mm/s", .description = "speed toward the reference switch", .range = r::kSpeedMmS});
+  v.param("home_search_mm_s", home_search_mm_s,
+          {"mm/s", "speed toward the reference switch", r::kSpeedMmS});
   v.param("home_latch_mm_s", home_latch_mm_s,
-          {.unit = "mm/s",
-           .description = "slow speed onto the switch where the position is set",
-           .range = r::kSpeedMmS});
+          {"mm/s", "slow speed onto the switch where the position is set", r::kSpeedMmS});
   v.param("home_back_off_mm", home_back_off_mm,
-          {.unit = "mm",
-           .description = "back-off from the switch before the slow latch",
-           .range = r::kPositiveLengthMm});
+          {"mm", "back-off from the switch before the slow latch", r::kPositiveLengthMm});
   v.param("home_search_max_mm", home_search_max_mm,
-          {.unit = "mm",
-           .description = "longest search for the switch (else the homing fails)",
-           .range = r::kPositiveLengthMm});
-  v.param("home_x_mm", home_x_mm,
-          {.unit = "mm",
-           .description = "machine X of the X reference switch",
-           .range = r::kPositionMm});
-  v.param("home_y_mm", home_y_mm,
-          {.unit = "mm",
-           .description = "machine Y of the Y reference switch",
-           .range = r::kPositionMm});
-  v.param("home_z_mm", home_z_mm,
-          {.unit = "mm",
-           .description = "machine Z of the Z reference switch",
-           .range = r::kPositionMm});
+          {"mm", "longest search for the switch (else the homing fails)", r::kPositiveLengthMm});
+  v.param("home_x_mm", home_x_mm, {"mm", "machine X of the X reference switch", r::kPositionMm});
+  v.param("home_y_mm", home_y_mm, {"mm", "machine Y of the Y reference switch", r::kPositionMm});
+  v.param("home_z_mm", home_z_mm, {"mm", "machine Z of the Z reference switch", r::kPositionMm});
   v.param("touch_fast_mm_s", touch_fast_mm_s,
-          {.unit = "mm/s",
-           .description = "first approach toward the work in touch mode",
-           .range = r::kSpeedMmS});
+          {"mm/s", "first approach toward the work in touch mode", r::kSpeedMmS});
   v.param("touch_slow_mm_s", touch_slow_mm_s,
-          {.unit = "mm/s",
-           .description = "second approach: the touch is where it makes contact",
-           .range = r::kSpeedMmS});
+          {"mm/s", "second approach: the touch is where it makes contact", r::kSpeedMmS});
   v.param("touch_max_mm", touch_max_mm,
-          {.unit = "mm",
-           .description = "longest approach without contact (else no contact)",
-           .range = r::kPositiveLengthMm});
-  v.param(
-      "touch_back_off_mm", touch_back_off_mm,
-      {.unit = "mm", .description = "back-off after each contact", .range = r::kPositiveLengthMm});
+          {"mm", "longest approach without contact (else no contact)", r::kPositiveLengthMm});
+  v.param("touch_back_off_mm", touch_back_off_mm,
+          {"mm", "back-off after each contact", r::kPositiveLengthMm});
   // An electrode diameter up to 1 m.
   v.param("electrode_d_mm", electrode_d_mm,
-          {.unit = "mm",
-           .description = "electrode diameter: an edge lies one radius beyond the axis at contact",
-           .range = rt::closed(0.0, 1000.0)});
+          {"mm", "electrode diameter: an edge lies one radius beyond the axis at contact",
+           rt::closed(0.0, 1000.0)});
   v.param("reference_required", reference_required,
           {.description = "programs are refused until every axis is referenced",
            .load_time_only = true});
@@ -381,8 +352,7 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
       step_ = Step::kTouchArm;
       break;
     case ManualOp::kNone:
-    case ManualOp::kStop:
-      return;
+    case ManualOp::kStop: return;
   }
   if (step_ != Step::kIdle) {
     status_.busy = true;

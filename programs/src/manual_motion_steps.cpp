@@ -22,8 +22,7 @@ constexpr int kInPositionCycles = 5;
 void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
   const double dt = dt_s_;
   switch (step_) {
-    case Step::kIdle:
-      break;
+    case Step::kIdle: break;
     case Step::kJog:
       step_profile(dt);
       if (req_.op == ManualOp::kJogVelocity && req_.value != 0.0 &&
@@ -234,23 +233,12 @@ void ManualMotion::next_touch(const rt::CycleContext& ctx) noexcept {
     status_.result.y = y_mm.get();
     status_.result.z = z_mm.get();
     switch (req_.target) {
-      case TouchTarget::kZ:
-        status_.result.z = found_;
-        break;
-      case TouchTarget::kXPlus:
-        status_.result.x = found_ + r;
-        break;
-      case TouchTarget::kXMinus:
-        status_.result.x = found_ - r;
-        break;
-      case TouchTarget::kYPlus:
-        status_.result.y = found_ + r;
-        break;
-      case TouchTarget::kYMinus:
-        status_.result.y = found_ - r;
-        break;
-      case TouchTarget::kCenter:
-        break;
+      case TouchTarget::kZ: status_.result.z = found_; break;
+      case TouchTarget::kXPlus: status_.result.x = found_ + r; break;
+      case TouchTarget::kXMinus: status_.result.x = found_ - r; break;
+      case TouchTarget::kYPlus: status_.result.y = found_ + r; break;
+      case TouchTarget::kYMinus: status_.result.y = found_ - r; break;
+      case TouchTarget::kCenter: break;
     }
     return;
   }

@@ -24,27 +24,20 @@ void WallFinishParams::visit(rt::ParamVisitor& v) {
   // Ranges (issue 31): the orbit feed up to 60 m/min (1 m/s, as any axis speed); spark-out up to
   // 1e6 revolutions; the rest in param_ranges.hpp.
   v.param("feed_default_mm_min", feed_default_mm_min,
-          {.unit = "mm/min",
-           .description = "orbit feed fr along the arc's radius (the final offset) while the "
-                          "feed_mm_min input is <= 0",
-           .range = rt::open_closed(0.0, 60000.0)});
+          {"mm/min",
+           "orbit feed fr along the arc's radius (the final offset) while the feed_mm_min input is "
+           "<= 0",
+           rt::open_closed(0.0, 60000.0)});
   v.param("radial_speed_mm_s", radial_speed_mm_s,
-          {.unit = "mm/s",
-           .description = "slew rate of the reference orbit radius",
-           .range = r::kSpeedMmS});
+          {"mm/s", "slew rate of the reference orbit radius", r::kSpeedMmS});
   v.param("spark_out_revs", spark_out_revs,
-          {.unit = "",
-           .description = "revolutions at the final radius before returning to the centre",
-           .range = rt::closed(0.0, 1.0e6)});
+          {"", "revolutions at the final radius before returning to the centre",
+           rt::closed(0.0, 1.0e6)});
   v.param("centre_tol_mm", centre_tol_mm,
-          {.unit = "mm",
-           .description = "BACK ends within this of the centre",
-           .range = r::kPositiveToleranceMm});
-  v.param(
-      "no_spark_timeout", no_spark_timeout,
-      {.unit = "s",
-       .description = "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
-       .range = r::kProcessTimeS});
+          {"mm", "BACK ends within this of the centre", r::kPositiveToleranceMm});
+  v.param("no_spark_timeout", no_spark_timeout,
+          {"s", "ORBIT without a spark this long (outside spark-out) is a fault; 0 s: off",
+           r::kProcessTimeS});
   shorts.visit(v);
 }
 

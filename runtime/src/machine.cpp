@@ -6,82 +6,50 @@ namespace edm::rt {
 
 std::string_view to_string(MachineState s) noexcept {
   switch (s) {
-    case MachineState::kOff:
-      return "OFF";
-    case MachineState::kReady:
-      return "READY";
-    case MachineState::kRunning:
-      return "RUNNING";
-    case MachineState::kHold:
-      return "HOLD";
-    case MachineState::kFault:
-      return "FAULT";
-    case MachineState::kEstop:
-      return "ESTOP";
+    case MachineState::kOff: return "OFF";
+    case MachineState::kReady: return "READY";
+    case MachineState::kRunning: return "RUNNING";
+    case MachineState::kHold: return "HOLD";
+    case MachineState::kFault: return "FAULT";
+    case MachineState::kEstop: return "ESTOP";
   }
   return "?";
 }
 
 std::string_view to_string(MachineCommand c) noexcept {
   switch (c) {
-    case MachineCommand::kPowerOn:
-      return "power_on";
-    case MachineCommand::kStart:
-      return "start";
-    case MachineCommand::kHold:
-      return "hold";
-    case MachineCommand::kResume:
-      return "resume";
-    case MachineCommand::kStop:
-      return "stop";
-    case MachineCommand::kReset:
-      return "reset";
-    case MachineCommand::kEstop:
-      return "estop";
-    case MachineCommand::kPowerOff:
-      return "power_off";
+    case MachineCommand::kPowerOn: return "power_on";
+    case MachineCommand::kStart: return "start";
+    case MachineCommand::kHold: return "hold";
+    case MachineCommand::kResume: return "resume";
+    case MachineCommand::kStop: return "stop";
+    case MachineCommand::kReset: return "reset";
+    case MachineCommand::kEstop: return "estop";
+    case MachineCommand::kPowerOff: return "power_off";
   }
   return "?";
 }
 
 std::string_view to_string(AlarmCode c) noexcept {
   switch (c) {
-    case AlarmCode::kNone:
-      return "none";
-    case AlarmCode::kWatchdog:
-      return "watchdog";
-    case AlarmCode::kWatchdogWarning:
-      return "watchdog_warning";
-    case AlarmCode::kHostStall:
-      return "host_stall";
-    case AlarmCode::kBlockFault:
-      return "block_fault";
-    case AlarmCode::kIoFault:
-      return "io_fault";
-    case AlarmCode::kIoStale:
-      return "io_stale";
-    case AlarmCode::kEstop:
-      return "estop";
-    case AlarmCode::kInterlockOpen:
-      return "interlock_open";
-    case AlarmCode::kFollowingError:
-      return "following_error";
-    case AlarmCode::kSoftLimit:
-      return "soft_limit";
-    case AlarmCode::kShortCircuit:
-      return "short_circuit";
-    case AlarmCode::kElectrodeUsedUp:
-      return "electrode_used_up";
-    case AlarmCode::kWireBreak:
-      return "wire_break";
-    case AlarmCode::kRetainCorrupt:
-      return "retain_corrupt";
-    case AlarmCode::kForcesReleased:
-      return "forces_released";
-    case AlarmCode::kJobInterrupted:
-      return "job_interrupted";
-    case AlarmCode::kRetainWriteFailed:
-      return "retain_write_failed";
+    case AlarmCode::kNone: return "none";
+    case AlarmCode::kWatchdog: return "watchdog";
+    case AlarmCode::kWatchdogWarning: return "watchdog_warning";
+    case AlarmCode::kHostStall: return "host_stall";
+    case AlarmCode::kBlockFault: return "block_fault";
+    case AlarmCode::kIoFault: return "io_fault";
+    case AlarmCode::kIoStale: return "io_stale";
+    case AlarmCode::kEstop: return "estop";
+    case AlarmCode::kInterlockOpen: return "interlock_open";
+    case AlarmCode::kFollowingError: return "following_error";
+    case AlarmCode::kSoftLimit: return "soft_limit";
+    case AlarmCode::kShortCircuit: return "short_circuit";
+    case AlarmCode::kElectrodeUsedUp: return "electrode_used_up";
+    case AlarmCode::kWireBreak: return "wire_break";
+    case AlarmCode::kRetainCorrupt: return "retain_corrupt";
+    case AlarmCode::kForcesReleased: return "forces_released";
+    case AlarmCode::kJobInterrupted: return "job_interrupted";
+    case AlarmCode::kRetainWriteFailed: return "retain_write_failed";
   }
   return "?";
 }

@@ -4,35 +4,24 @@ namespace edm::rt {
 
 std::string_view to_string(ManualOp op) noexcept {
   switch (op) {
-    case ManualOp::kNone:
-      return "none";
-    case ManualOp::kHome:
-      return "home";
+    case ManualOp::kNone: return "none";
+    case ManualOp::kHome: return "home";
     case ManualOp::kJogDistance:
-    case ManualOp::kJogVelocity:
-      return "jog";
-    case ManualOp::kTouch:
-      return "touch";
-    case ManualOp::kStop:
-      return "stop";
+    case ManualOp::kJogVelocity: return "jog";
+    case ManualOp::kTouch: return "touch";
+    case ManualOp::kStop: return "stop";
   }
   return "none";
 }
 
 std::string_view to_string(TouchTarget t) noexcept {
   switch (t) {
-    case TouchTarget::kZ:
-      return "z";
-    case TouchTarget::kXPlus:
-      return "x+";
-    case TouchTarget::kXMinus:
-      return "x-";
-    case TouchTarget::kYPlus:
-      return "y+";
-    case TouchTarget::kYMinus:
-      return "y-";
-    case TouchTarget::kCenter:
-      return "center";
+    case TouchTarget::kZ: return "z";
+    case TouchTarget::kXPlus: return "x+";
+    case TouchTarget::kXMinus: return "x-";
+    case TouchTarget::kYPlus: return "y+";
+    case TouchTarget::kYMinus: return "y-";
+    case TouchTarget::kCenter: return "center";
   }
   return "z";
 }
@@ -50,66 +39,43 @@ bool touch_target_from_string(std::string_view s, TouchTarget& out) noexcept {
 
 std::string_view to_string(ManualMode m) noexcept {
   switch (m) {
-    case ManualMode::kIdle:
-      return "idle";
-    case ManualMode::kHome:
-      return "home";
-    case ManualMode::kJog:
-      return "jog";
-    case ManualMode::kTouch:
-      return "touch";
+    case ManualMode::kIdle: return "idle";
+    case ManualMode::kHome: return "home";
+    case ManualMode::kJog: return "jog";
+    case ManualMode::kTouch: return "touch";
   }
   return "idle";
 }
 
 std::string_view to_string(ManualError e) noexcept {
   switch (e) {
-    case ManualError::kNone:
-      return "";
-    case ManualError::kStopped:
-      return "stopped by the operator";
-    case ManualError::kDeadman:
-      return "dead-man: the jog was not refreshed in time";
-    case ManualError::kNoContact:
-      return "no contact within the search distance";
-    case ManualError::kAlreadyInContact:
-      return "the electrode already touches the work";
-    case ManualError::kSoftLimit:
-      return "the move would leave the soft limits";
+    case ManualError::kNone: return "";
+    case ManualError::kStopped: return "stopped by the operator";
+    case ManualError::kDeadman: return "dead-man: the jog was not refreshed in time";
+    case ManualError::kNoContact: return "no contact within the search distance";
+    case ManualError::kAlreadyInContact: return "the electrode already touches the work";
+    case ManualError::kSoftLimit: return "the move would leave the soft limits";
     case ManualError::kNoSwitch:
       return "the reference switch did not trip within the search distance";
-    case ManualError::kInterrupted:
-      return "interrupted: the machine left READY";
-    case ManualError::kNotAvailable:
-      return "not available on this machine";
-    case ManualError::kBadRequest:
-      return "out of range";
+    case ManualError::kInterrupted: return "interrupted: the machine left READY";
+    case ManualError::kNotAvailable: return "not available on this machine";
+    case ManualError::kBadRequest: return "out of range";
   }
   return "";
 }
 
 std::string_view error_code(ManualError e) noexcept {
   switch (e) {
-    case ManualError::kNone:
-      return "";
-    case ManualError::kStopped:
-      return "stopped";
-    case ManualError::kDeadman:
-      return "deadman";
-    case ManualError::kNoContact:
-      return "no_contact";
-    case ManualError::kAlreadyInContact:
-      return "in_contact";
-    case ManualError::kSoftLimit:
-      return "soft_limit";
-    case ManualError::kNoSwitch:
-      return "no_switch";
-    case ManualError::kInterrupted:
-      return "interrupted";
-    case ManualError::kNotAvailable:
-      return "not_available";
-    case ManualError::kBadRequest:
-      return "bad_request";
+    case ManualError::kNone: return "";
+    case ManualError::kStopped: return "stopped";
+    case ManualError::kDeadman: return "deadman";
+    case ManualError::kNoContact: return "no_contact";
+    case ManualError::kAlreadyInContact: return "in_contact";
+    case ManualError::kSoftLimit: return "soft_limit";
+    case ManualError::kNoSwitch: return "no_switch";
+    case ManualError::kInterrupted: return "interrupted";
+    case ManualError::kNotAvailable: return "not_available";
+    case ManualError::kBadRequest: return "bad_request";
   }
   return "";
 }

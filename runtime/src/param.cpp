@@ -8,48 +8,34 @@ namespace edm::rt {
 
 std::string_view to_string(ParamType t) noexcept {
   switch (t) {
-    case ParamType::kBool:
-      return "BOOL";
-    case ParamType::kInt:
-      return "LINT";
-    case ParamType::kReal:
-      return "LREAL";
-    case ParamType::kDuration:
-      return "TIME";
-    case ParamType::kString:
-      return "STRING";
+    case ParamType::kBool: return "BOOL";
+    case ParamType::kInt: return "LINT";
+    case ParamType::kReal: return "LREAL";
+    case ParamType::kDuration: return "TIME";
+    case ParamType::kString: return "STRING";
   }
   return "?";
 }
 
 double ParamValue::as_double() const noexcept {
   switch (type) {
-    case ParamType::kBool:
-      return b ? 1.0 : 0.0;
-    case ParamType::kInt:
-      return static_cast<double>(i);
-    case ParamType::kReal:
-      return r;
+    case ParamType::kBool: return b ? 1.0 : 0.0;
+    case ParamType::kInt: return static_cast<double>(i);
+    case ParamType::kReal: return r;
     case ParamType::kDuration:
       return static_cast<double>(i) / 1e9;  // exact for whole seconds: 60 s is 60, not 60.00…01
-    case ParamType::kString:
-      return 0.0;
+    case ParamType::kString: return 0.0;
   }
   return 0.0;
 }
 
 ParamValue read_param(const ParamRef& ref) noexcept {
   switch (ref.type) {
-    case ParamType::kBool:
-      return ParamValue::of_bool(*static_cast<bool*>(ref.field));
-    case ParamType::kInt:
-      return ParamValue::of_int(*static_cast<std::int64_t*>(ref.field));
-    case ParamType::kReal:
-      return ParamValue::of_real(*static_cast<double*>(ref.field));
-    case ParamType::kDuration:
-      return ParamValue::of_duration(*static_cast<Duration*>(ref.field));
-    case ParamType::kString:
-      break;
+    case ParamType::kBool: return ParamValue::of_bool(*static_cast<bool*>(ref.field));
+    case ParamType::kInt: return ParamValue::of_int(*static_cast<std::int64_t*>(ref.field));
+    case ParamType::kReal: return ParamValue::of_real(*static_cast<double*>(ref.field));
+    case ParamType::kDuration: return ParamValue::of_duration(*static_cast<Duration*>(ref.field));
+    case ParamType::kString: break;
   }
   return ParamValue{ParamType::kString, false, 0, 0.0};
 }
@@ -59,20 +45,11 @@ bool write_param(const ParamRef& ref, const ParamValue& v) noexcept {
     return false;
   }
   switch (ref.type) {
-    case ParamType::kBool:
-      *static_cast<bool*>(ref.field) = v.b;
-      return true;
-    case ParamType::kInt:
-      *static_cast<std::int64_t*>(ref.field) = v.i;
-      return true;
-    case ParamType::kReal:
-      *static_cast<double*>(ref.field) = v.r;
-      return true;
-    case ParamType::kDuration:
-      *static_cast<Duration*>(ref.field) = Duration{v.i};
-      return true;
-    case ParamType::kString:
-      return false;
+    case ParamType::kBool: *static_cast<bool*>(ref.field) = v.b; return true;
+    case ParamType::kInt: *static_cast<std::int64_t*>(ref.field) = v.i; return true;
+    case ParamType::kReal: *static_cast<double*>(ref.field) = v.r; return true;
+    case ParamType::kDuration: *static_cast<Duration*>(ref.field) = Duration{v.i}; return true;
+    case ParamType::kString: return false;
   }
   return false;
 }
@@ -136,8 +113,7 @@ void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef 
   double v = 0.0;
   switch (ref.type) {
     case ParamType::kBool:
-    case ParamType::kString:
-      return;
+    case ParamType::kString: return;
     case ParamType::kInt:
       v = static_cast<double>(*static_cast<const std::int64_t*>(ref.field));
       break;
@@ -148,9 +124,7 @@ void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef 
         return;
       }
       break;
-    case ParamType::kDuration:
-      v = read_param(ref).as_double();
-      break;
+    case ParamType::kDuration: v = read_param(ref).as_double(); break;
   }
   if (!spec.range.contains(v)) {
     errs.push_back({std::string(name), outside(spec.range, v)});
@@ -160,16 +134,14 @@ void check_field(std::vector<ParamError>& errs, std::string_view name, ParamRef 
 std::string range_violation(const ParamSpec& spec, const ParamValue& v, bool with_unit) {
   switch (v.type) {
     case ParamType::kBool:
-    case ParamType::kString:
-      return {};
+    case ParamType::kString: return {};
     case ParamType::kReal:
       if (spec.finite && !std::isfinite(v.r)) {
         return "must be a finite number (got " + num(v.r) + ")";
       }
       break;
     case ParamType::kInt:
-    case ParamType::kDuration:
-      break;
+    case ParamType::kDuration: break;
   }
   const double x = v.as_double();
   return spec.range.contains(x)

@@ -75,9 +75,7 @@ class SettingsReader final : public ParamVisitor {
         }
         return;
       }
-      case ParamType::kString:
-        *static_cast<std::string*>(ref.field) = t;
-        return;
+      case ParamType::kString: *static_cast<std::string*>(ref.field) = t; return;
     }
   }
 

@@ -4,12 +4,9 @@ namespace edm::rt {
 
 std::string_view to_string(PinType t) noexcept {
   switch (t) {
-    case PinType::kBool:
-      return "BOOL";
-    case PinType::kInt:
-      return "LINT";
-    case PinType::kReal:
-      return "LREAL";
+    case PinType::kBool: return "BOOL";
+    case PinType::kInt: return "LINT";
+    case PinType::kReal: return "LREAL";
   }
   return "?";
 }

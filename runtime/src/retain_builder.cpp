@@ -194,22 +194,16 @@ class RetainBuilder {
                                    RetainType type) {
     if (v.is_pin()) {
       switch (v.pin.type) {
-        case PinType::kBool:
-          return RetainValue::make_bool(v.pin.as_output<bool>()->get());
-        case PinType::kInt:
-          return RetainValue::make_int(v.pin.as_output<std::int64_t>()->get());
-        case PinType::kReal:
-          return RetainValue::make_real(v.pin.as_output<double>()->get());
+        case PinType::kBool: return RetainValue::make_bool(v.pin.as_output<bool>()->get());
+        case PinType::kInt: return RetainValue::make_int(v.pin.as_output<std::int64_t>()->get());
+        case PinType::kReal: return RetainValue::make_real(v.pin.as_output<double>()->get());
       }
     }
     const ParamValue p = reg.read_param(v.name).value_or(ParamValue{});
     switch (type) {
-      case RetainType::kBool:
-        return RetainValue::make_bool(p.b);
-      case RetainType::kInt:
-        return RetainValue::make_int(p.i);
-      case RetainType::kReal:
-        return RetainValue::make_real(p.r);
+      case RetainType::kBool: return RetainValue::make_bool(p.b);
+      case RetainType::kInt: return RetainValue::make_int(p.i);
+      case RetainType::kReal: return RetainValue::make_real(p.r);
     }
     return {};
   }
@@ -247,15 +241,9 @@ class RetainBuilder {
       return;
     }
     switch (v->pin.type) {
-      case PinType::kBool:
-        v->pin.as_output<bool>()->set(value.b);
-        break;
-      case PinType::kInt:
-        v->pin.as_output<std::int64_t>()->set(value.i);
-        break;
-      case PinType::kReal:
-        v->pin.as_output<double>()->set(value.r);
-        break;
+      case PinType::kBool: v->pin.as_output<bool>()->set(value.b); break;
+      case PinType::kInt: v->pin.as_output<std::int64_t>()->set(value.i); break;
+      case PinType::kReal: v->pin.as_output<double>()->set(value.r); break;
     }
   }
 

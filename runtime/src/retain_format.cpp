@@ -40,12 +40,8 @@ void append_value(std::string& out, const RetainValue& v) {
   std::array<char, 64> buf{};
   std::to_chars_result res{};
   switch (v.type) {
-    case RetainType::kBool:
-      out += v.b ? '1' : '0';
-      return;
-    case RetainType::kInt:
-      res = std::to_chars(buf.data(), buf.data() + buf.size(), v.i);
-      break;
+    case RetainType::kBool: out += v.b ? '1' : '0'; return;
+    case RetainType::kInt: res = std::to_chars(buf.data(), buf.data() + buf.size(), v.i); break;
     case RetainType::kReal:
       // Shortest representation that parses back to the same bits (C++17 to_chars guarantee).
       res = std::to_chars(buf.data(), buf.data() + buf.size(), v.r);
@@ -101,12 +97,9 @@ std::string printable(std::string_view s) {
 
 std::string_view to_string(RetainType t) noexcept {
   switch (t) {
-    case RetainType::kBool:
-      return "BOOL";
-    case RetainType::kInt:
-      return "LINT";
-    case RetainType::kReal:
-      return "LREAL";
+    case RetainType::kBool: return "BOOL";
+    case RetainType::kInt: return "LINT";
+    case RetainType::kReal: return "LREAL";
   }
   return "?";
 }
@@ -116,10 +109,8 @@ bool operator==(const RetainValue& a, const RetainValue& b) noexcept {
     return false;
   }
   switch (a.type) {
-    case RetainType::kBool:
-      return a.b == b.b;
-    case RetainType::kInt:
-      return a.i == b.i;
+    case RetainType::kBool: return a.b == b.b;
+    case RetainType::kInt: return a.i == b.i;
     case RetainType::kReal:
       return std::bit_cast<std::uint64_t>(a.r) == std::bit_cast<std::uint64_t>(b.r);
   }

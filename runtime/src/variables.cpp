@@ -8,12 +8,9 @@ namespace edm::rt {
 
 std::string_view to_string(VarKind k) noexcept {
   switch (k) {
-    case VarKind::kInput:
-      return "input";
-    case VarKind::kOutput:
-      return "output";
-    case VarKind::kParam:
-      return "param";
+    case VarKind::kInput: return "input";
+    case VarKind::kOutput: return "output";
+    case VarKind::kParam: return "param";
   }
   return "?";
 }
@@ -93,8 +90,7 @@ std::optional<ParamValue> to_param_value(ParamType t, double x, std::string& why
         return std::nullopt;
       }
       return ParamValue::of_int(static_cast<std::int64_t>(x));
-    case ParamType::kReal:
-      return ParamValue::of_real(x);
+    case ParamType::kReal: return ParamValue::of_real(x);
     case ParamType::kDuration:
       if (x < 0.0 || x > 9.0e9) {
         why = "TIME takes seconds in [0, 9e9]";
@@ -195,12 +191,9 @@ template <class F>
 auto with_value_type(PinType t, F&& f) {
   using R = decltype(f.template operator()<double>());
   switch (t) {
-    case PinType::kBool:
-      return f.template operator()<bool>();
-    case PinType::kInt:
-      return f.template operator()<std::int64_t>();
-    case PinType::kReal:
-      return f.template operator()<double>();
+    case PinType::kBool: return f.template operator()<bool>();
+    case PinType::kInt: return f.template operator()<std::int64_t>();
+    case PinType::kReal: return f.template operator()<double>();
   }
   return R();
 }
@@ -259,9 +252,7 @@ VarStatus VariableRegistry::force(std::string_view name, double value) {
       }
       force_pin<std::int64_t>(v->pin, static_cast<std::int64_t>(value));
       break;
-    case PinType::kReal:
-      force_pin<double>(v->pin, value);
-      break;
+    case PinType::kReal: force_pin<double>(v->pin, value); break;
   }
   // After the pin: a sweep that misses this force sees the flag and sweeps again next cycle.
   maybe_forced_.store(true, std::memory_order_release);

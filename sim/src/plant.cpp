@@ -179,17 +179,10 @@ void Plant::enter_phase(Phase ph, std::int64_t t_ns, std::int64_t dur_ns) noexce
 
 void Plant::on_phase_end(std::int64_t t_ns) noexcept {
   switch (phase_) {
-    case Phase::kWait:
-      enter_phase(Phase::kOn, t_ns, on_ns_);
-      break;
-    case Phase::kOn:
-      enter_phase(Phase::kOff, t_ns, off_ns_);
-      break;
-    case Phase::kOff:
-      start_pulse(t_ns);
-      break;
-    case Phase::kIdle:
-      break;
+    case Phase::kWait: enter_phase(Phase::kOn, t_ns, on_ns_); break;
+    case Phase::kOn: enter_phase(Phase::kOff, t_ns, off_ns_); break;
+    case Phase::kOff: start_pulse(t_ns); break;
+    case Phase::kIdle: break;
   }
 }
 
@@ -292,9 +285,7 @@ void Plant::start_pulse(std::int64_t t_ns) noexcept {
       on_voltage_v_ = p.discharge_voltage_v;
       break;
     case PulseClass::kTransientArc:
-    case PulseClass::kStableArc:
-      on_voltage_v_ = p.arc_voltage_v;
-      break;
+    case PulseClass::kStableArc: on_voltage_v_ = p.arc_voltage_v; break;
     case PulseClass::kShort:
       if (out.debris_short) on_ns_ = to_ns(p.debris_short_us);
       on_voltage_v_ = p.short_voltage_v;

@@ -47,8 +47,7 @@ double Plant::gap_volume_mm3(double gap_um) const noexcept {
   switch (tool_) {
     case Tool::kTube:
       return area_front_mm2_ * g + side_area_mm2_ * (state_.wall_radius_mm - p.tool_od_mm / 2.0);
-    case Tool::kBlock:
-      return area_front_mm2_ * g + side_area_mm2_ * p.side_gap_mm;
+    case Tool::kBlock: return area_front_mm2_ * g + side_area_mm2_ * p.side_gap_mm;
     case Tool::kWire: {
       const double h = cut_thickness_mm();
       return (p.wire_d_mm + 2.0 * g) * h * g + 2.0 * h * p.near_tip_zone_mm * g;

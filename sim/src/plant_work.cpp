@@ -30,9 +30,7 @@ void Plant::init_work() noexcept {
     case Tool::kBlock:
       tool_section_ = {0.0, 0.0, p.tool_width_mm / 2.0, p.tool_length_mm / 2.0, false};
       break;
-    case Tool::kWire:
-      tool_section_ = {0.0, 0.0, p.wire_d_mm / 2.0, p.wire_d_mm / 2.0, true};
-      break;
+    case Tool::kWire: tool_section_ = {0.0, 0.0, p.wire_d_mm / 2.0, p.wire_d_mm / 2.0, true}; break;
   }
   work_.block = {p.work_origin_x_mm + (p.work_x_min_mm + p.work_x_max_mm) / 2.0,
                  p.work_origin_y_mm + (p.work_y_min_mm + p.work_y_max_mm) / 2.0,

@@ -73,20 +73,15 @@ class OpStates : public ::testing::Test {
     m.command(rt::MachineCommand::kReset);
     int queued = 0;
     switch (s) {
-      case OpState::kOff:
-        m.command(rt::MachineCommand::kPowerOff);
-        break;
-      case OpState::kIdle:
-        break;
+      case OpState::kOff: m.command(rt::MachineCommand::kPowerOff); break;
+      case OpState::kIdle: break;
       case OpState::kJogging:
         queued = rt_->manual().request(manual(rt::ManualOp::kJogVelocity)) != 0 ? 1 : 0;
         break;
       case OpState::kManual:
         queued = rt_->manual().request(manual(rt::ManualOp::kJogDistance)) != 0 ? 1 : 0;
         break;
-      case OpState::kRunning:
-        m.command(rt::MachineCommand::kStart);
-        break;
+      case OpState::kRunning: m.command(rt::MachineCommand::kStart); break;
       case OpState::kHold:
         m.command(rt::MachineCommand::kStart);
         m.command(rt::MachineCommand::kHold);
@@ -100,9 +95,7 @@ class OpStates : public ::testing::Test {
         m.raise(a);
         break;
       }
-      case OpState::kEstop:
-        m.command(rt::MachineCommand::kEstop);
-        break;
+      case OpState::kEstop: m.command(rt::MachineCommand::kEstop); break;
     }
     EXPECT_EQ(current_op_state(*rt_), s) << to_string(s);
     return queued;

@@ -45,9 +45,7 @@ void one_message(std::string_view text, std::optional<bridge::Role>& role,
       EDM_FUZZ_CHECK(a.token.size() <= hmi::kMaxPageTokenBytes);
       role = a.token == "viewer" ? bridge::Role::kViewer : bridge::Role::kOperator;
       return;
-    case PageAction::Kind::kHeld:
-      EDM_FUZZ_CHECK(role.has_value());
-      return;
+    case PageAction::Kind::kHeld: EDM_FUZZ_CHECK(role.has_value()); return;
     case PageAction::Kind::kReply: {
       EDM_FUZZ_CHECK(role.has_value());
       const Json back = check_text(a.reply);
@@ -57,8 +55,7 @@ void one_message(std::string_view text, std::optional<bridge::Role>& role,
       }
       return;
     }
-    case PageAction::Kind::kRun:
-      break;
+    case PageAction::Kind::kRun: break;
   }
   EDM_FUZZ_CHECK(role.has_value());
   const hmi::PageCommand& c = a.command;

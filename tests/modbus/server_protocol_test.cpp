@@ -27,24 +27,15 @@ int exception_code_of(const Bytes& r, std::uint8_t fc) {
 // A valid request of each served function against the fixture's map.
 Bytes valid_request(std::uint8_t fc) {
   switch (fc) {
-    case 1:
-      return {1, 0, 0, 0, 2};  // coils 0-1
-    case 2:
-      return {2, 0, 0, 0, 1};
-    case 3:
-      return {3, 0, 2, 0, 1};
-    case 4:
-      return {4, 0, 0, 0, 2};
-    case 5:
-      return {5, 0, 1, 0xFF, 0};  // p.dsc.arcs_as_short = true
-    case 6:
-      return {6, 0, 3, 0, 20};  // p.lp.tau = 20 ms
-    case 15:
-      return {15, 0, 1, 0, 1, 1, 0};
-    case 16:
-      return {16, 0, 0, 0, 2, 4, 0x40, 0, 0, 0};  // p.g.k = 2.0f
-    default:
-      return {fc, 0, 0, 0, 1};
+    case 1: return {1, 0, 0, 0, 2};  // coils 0-1
+    case 2: return {2, 0, 0, 0, 1};
+    case 3: return {3, 0, 2, 0, 1};
+    case 4: return {4, 0, 0, 0, 2};
+    case 5: return {5, 0, 1, 0xFF, 0};  // p.dsc.arcs_as_short = true
+    case 6: return {6, 0, 3, 0, 20};    // p.lp.tau = 20 ms
+    case 15: return {15, 0, 1, 0, 1, 1, 0};
+    case 16: return {16, 0, 0, 0, 2, 4, 0x40, 0, 0, 0};  // p.g.k = 2.0f
+    default: return {fc, 0, 0, 0, 1};
   }
 }
 

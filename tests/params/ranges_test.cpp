@@ -117,8 +117,7 @@ rt::ParamValue outside_low(const rt::Variable& v) {
       const auto ns = static_cast<std::int64_t>(std::ceil(r.lo * 1e9));
       return rt::ParamValue::of_duration(rt::Duration{ns - (r.lo_open ? 0 : 1)});
     }
-    default:
-      return rt::ParamValue::of_real(r.lo_open ? r.lo : std::nextafter(r.lo, -kInf));
+    default: return rt::ParamValue::of_real(r.lo_open ? r.lo : std::nextafter(r.lo, -kInf));
   }
 }
 rt::ParamValue outside_high(const rt::Variable& v) {
@@ -131,31 +130,24 @@ rt::ParamValue outside_high(const rt::Variable& v) {
       const auto ns = static_cast<std::int64_t>(std::floor(r.hi * 1e9));
       return rt::ParamValue::of_duration(rt::Duration{ns + (r.hi_open ? 0 : 1)});
     }
-    default:
-      return rt::ParamValue::of_real(r.hi_open ? r.hi : std::nextafter(r.hi, kInf));
+    default: return rt::ParamValue::of_real(r.hi_open ? r.hi : std::nextafter(r.hi, kInf));
   }
 }
 // The bound itself when it is closed, else the nearest value inside.
 rt::ParamValue at_low(const rt::Variable& v) {
   const rt::ParamValue o = outside_low(v);
   switch (v.param_type) {
-    case rt::ParamType::kInt:
-      return rt::ParamValue::of_int(o.i + 1);
-    case rt::ParamType::kDuration:
-      return rt::ParamValue::of_duration(rt::Duration{o.i + 1});
-    default:
-      return rt::ParamValue::of_real(std::nextafter(o.r, kInf));
+    case rt::ParamType::kInt: return rt::ParamValue::of_int(o.i + 1);
+    case rt::ParamType::kDuration: return rt::ParamValue::of_duration(rt::Duration{o.i + 1});
+    default: return rt::ParamValue::of_real(std::nextafter(o.r, kInf));
   }
 }
 rt::ParamValue at_high(const rt::Variable& v) {
   const rt::ParamValue o = outside_high(v);
   switch (v.param_type) {
-    case rt::ParamType::kInt:
-      return rt::ParamValue::of_int(o.i - 1);
-    case rt::ParamType::kDuration:
-      return rt::ParamValue::of_duration(rt::Duration{o.i - 1});
-    default:
-      return rt::ParamValue::of_real(std::nextafter(o.r, -kInf));
+    case rt::ParamType::kInt: return rt::ParamValue::of_int(o.i - 1);
+    case rt::ParamType::kDuration: return rt::ParamValue::of_duration(rt::Duration{o.i - 1});
+    default: return rt::ParamValue::of_real(std::nextafter(o.r, -kInf));
   }
 }
 

@@ -175,12 +175,8 @@ TEST(RetainHostile, parser_survives_random_bytes) {
           case 0:
             if (at < text.size()) text[at] = static_cast<char>(byte(rng));
             break;
-          case 1:
-            text.insert(at, 1, static_cast<char>(byte(rng)));
-            break;
-          default:
-            text.erase(at, rng() % 8);
-            break;
+          case 1: text.insert(at, 1, static_cast<char>(byte(rng))); break;
+          default: text.erase(at, rng() % 8); break;
         }
       }
     } else {

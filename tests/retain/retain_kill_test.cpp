@@ -37,15 +37,9 @@ RetainMap iteration_map(std::int64_t it) {
     char name[48];
     std::snprintf(name, sizeof name, "prog.block%03d.pin", k);
     switch (k % 3) {
-      case 0:
-        m.emplace(name, RetainValue::make_int(it * 1000 + k));
-        break;
-      case 1:
-        m.emplace(name, RetainValue::make_real(static_cast<double>(it) * 0.1 + k));
-        break;
-      default:
-        m.emplace(name, RetainValue::make_bool(((it + k) & 1) != 0));
-        break;
+      case 0: m.emplace(name, RetainValue::make_int(it * 1000 + k)); break;
+      case 1: m.emplace(name, RetainValue::make_real(static_cast<double>(it) * 0.1 + k)); break;
+      default: m.emplace(name, RetainValue::make_bool(((it + k) & 1) != 0)); break;
     }
   }
   return m;

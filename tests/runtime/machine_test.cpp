@@ -19,13 +19,9 @@ using rt::MachineState;
 void drive_to(rt::Machine& m, MachineState s) {
   auto cmd = [&](MachineCommand c) { ASSERT_EQ(m.command(c), rt::CommandResult::kOk); };
   switch (s) {
-    case MachineState::kOff:
-      return;
-    case MachineState::kReady:
-      return cmd(MachineCommand::kPowerOn);
-    case MachineState::kRunning:
-      cmd(MachineCommand::kPowerOn);
-      return cmd(MachineCommand::kStart);
+    case MachineState::kOff: return;
+    case MachineState::kReady: return cmd(MachineCommand::kPowerOn);
+    case MachineState::kRunning: cmd(MachineCommand::kPowerOn); return cmd(MachineCommand::kStart);
     case MachineState::kHold:
       cmd(MachineCommand::kPowerOn);
       cmd(MachineCommand::kStart);
@@ -37,9 +33,7 @@ void drive_to(rt::Machine& m, MachineState s) {
       m.raise(a);
       return;
     }
-    case MachineState::kEstop:
-      cmd(MachineCommand::kPowerOn);
-      return cmd(MachineCommand::kEstop);
+    case MachineState::kEstop: cmd(MachineCommand::kPowerOn); return cmd(MachineCommand::kEstop);
   }
 }
 

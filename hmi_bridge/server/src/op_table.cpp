@@ -128,22 +128,14 @@ std::optional<ops::Body> refuse_in_state(Session& s, const OpSpec& op, const Par
 
 std::string_view to_string(OpState s) noexcept {
   switch (s) {
-    case S::kOff:
-      return "OFF";
-    case S::kIdle:
-      return "READY";
-    case S::kJogging:
-      return "READY with a continuous jog running";
-    case S::kManual:
-      return "READY with a manual operation running";
-    case S::kRunning:
-      return "RUNNING";
-    case S::kHold:
-      return "HOLD";
-    case S::kFault:
-      return "FAULT";
-    case S::kEstop:
-      return "ESTOP";
+    case S::kOff: return "OFF";
+    case S::kIdle: return "READY";
+    case S::kJogging: return "READY with a continuous jog running";
+    case S::kManual: return "READY with a manual operation running";
+    case S::kRunning: return "RUNNING";
+    case S::kHold: return "HOLD";
+    case S::kFault: return "FAULT";
+    case S::kEstop: return "ESTOP";
   }
   return "?";
 }
@@ -166,30 +158,21 @@ const OpKind& op_kind(const OpSpec& op, const Json& msg) noexcept {
 
 OpState current_op_state(rt::Runtime& rt) noexcept {
   switch (rt.machine().state()) {
-    case rt::MachineState::kOff:
-      return S::kOff;
-    case rt::MachineState::kRunning:
-      return S::kRunning;
-    case rt::MachineState::kHold:
-      return S::kHold;
-    case rt::MachineState::kFault:
-      return S::kFault;
-    case rt::MachineState::kEstop:
-      return S::kEstop;
-    case rt::MachineState::kReady:
-      break;
+    case rt::MachineState::kOff: return S::kOff;
+    case rt::MachineState::kRunning: return S::kRunning;
+    case rt::MachineState::kHold: return S::kHold;
+    case rt::MachineState::kFault: return S::kFault;
+    case rt::MachineState::kEstop: return S::kEstop;
+    case rt::MachineState::kReady: break;
   }
   if (rt.job().active()) return S::kRunning;
   switch (rt.manual().activity()) {
     case rt::ManualOp::kNone:
-    case rt::ManualOp::kStop:
-      return S::kIdle;
-    case rt::ManualOp::kJogVelocity:
-      return S::kJogging;
+    case rt::ManualOp::kStop: return S::kIdle;
+    case rt::ManualOp::kJogVelocity: return S::kJogging;
     case rt::ManualOp::kHome:
     case rt::ManualOp::kJogDistance:
-    case rt::ManualOp::kTouch:
-      break;
+    case rt::ManualOp::kTouch: break;
   }
   return S::kManual;
 }

@@ -16,14 +16,11 @@ constexpr std::size_t kMaxDurationChars = 64;
 
 ErrorCode var_error(rt::VarResult r) {
   switch (r) {
-    case rt::VarResult::kNotFound:
-      return ErrorCode::kNotFound;
-    case rt::VarResult::kBusy:
-      return ErrorCode::kBusy;
+    case rt::VarResult::kNotFound: return ErrorCode::kNotFound;
+    case rt::VarResult::kBusy: return ErrorCode::kBusy;
     case rt::VarResult::kInvalidState:
       return ErrorCode::kInvalidState;  // e.g. a force refused in FAULT or ESTOP
-    default:
-      return ErrorCode::kBadRequest;
+    default: return ErrorCode::kBadRequest;
   }
 }
 

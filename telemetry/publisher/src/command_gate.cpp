@@ -71,8 +71,7 @@ std::optional<rt::ParamValue> from_integer(Int i, const sp::Metric& m, rt::Param
         return rt::ParamValue::of_real(static_cast<double>(i));
       }
       return from_seconds(static_cast<double>(i), m, why);
-    case rt::ParamType::kString:
-      break;
+    case rt::ParamType::kString: break;
   }
   return refuse(why, "STRING parameters are set in the config only");
 }
@@ -102,19 +101,15 @@ std::optional<rt::ParamValue> command_value(const sp::Metric& m, rt::ParamType t
     const double x = *d;
     if (!std::isfinite(x)) return refuse(why, sent(m) + ": the value must be finite");
     switch (type) {
-      case rt::ParamType::kBool:
-        return refuse(why, sent(m) + " does not fit BOOL: send a Boolean");
+      case rt::ParamType::kBool: return refuse(why, sent(m) + " does not fit BOOL: send a Boolean");
       case rt::ParamType::kInt:
         if (x != std::trunc(x) || std::fabs(x) > static_cast<double>(kExact)) {
           return refuse(why, sent(m) + " does not fit LINT (whole numbers within +-2^53)");
         }
         return rt::ParamValue::of_int(static_cast<std::int64_t>(x));
-      case rt::ParamType::kReal:
-        return rt::ParamValue::of_real(x);
-      case rt::ParamType::kDuration:
-        return from_seconds(x, m, why);
-      case rt::ParamType::kString:
-        break;
+      case rt::ParamType::kReal: return rt::ParamValue::of_real(x);
+      case rt::ParamType::kDuration: return from_seconds(x, m, why);
+      case rt::ParamType::kString: break;
     }
   }
   return refuse(why, sent(m) + " does not fit " + target);

@@ -74,33 +74,24 @@ enum Fixed : std::size_t {
 sp::DataType metric_type(const rt::Variable& v) {
   if (v.is_pin()) {
     switch (v.pin.type) {
-      case rt::PinType::kBool:
-        return sp::DataType::kBoolean;
-      case rt::PinType::kInt:
-        return sp::DataType::kInt64;
-      case rt::PinType::kReal:
-        return sp::DataType::kDouble;
+      case rt::PinType::kBool: return sp::DataType::kBoolean;
+      case rt::PinType::kInt: return sp::DataType::kInt64;
+      case rt::PinType::kReal: return sp::DataType::kDouble;
     }
   }
   switch (v.param_type) {
-    case rt::ParamType::kBool:
-      return sp::DataType::kBoolean;
-    case rt::ParamType::kInt:
-      return sp::DataType::kInt64;
-    default:
-      return sp::DataType::kDouble;  // REAL, TIME in seconds
+    case rt::ParamType::kBool: return sp::DataType::kBoolean;
+    case rt::ParamType::kInt: return sp::DataType::kInt64;
+    default: return sp::DataType::kDouble;  // REAL, TIME in seconds
   }
 }
 
 sp::Value typed(sp::DataType t, double x) {
   if (!std::isfinite(x)) return t == sp::DataType::kDouble ? sp::Value{x} : sp::Value{};
   switch (t) {
-    case sp::DataType::kBoolean:
-      return x != 0.0;
-    case sp::DataType::kInt64:
-      return static_cast<std::int64_t>(std::llround(x));
-    default:
-      return x;
+    case sp::DataType::kBoolean: return x != 0.0;
+    case sp::DataType::kInt64: return static_cast<std::int64_t>(std::llround(x));
+    default: return x;
   }
 }
 

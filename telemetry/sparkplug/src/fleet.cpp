@@ -158,11 +158,8 @@ void FleetTable::on_message(std::string_view topic, std::string_view payload,
       if (!d.born && asked_.count(key) == 0) rebirth_.insert(key);
       break;
     }
-    case MessageType::kDDeath:
-      n.devices[t->device].online = false;
-      break;
-    default:
-      break;
+    case MessageType::kDDeath: n.devices[t->device].online = false; break;
+    default: break;
   }
 }
 

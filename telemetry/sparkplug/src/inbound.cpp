@@ -53,15 +53,9 @@ ScreenResult screen_payload(std::string_view bytes, const InboundLimits& limits)
     const std::uint64_t field = tag >> 3;
     bool ok = false;
     switch (tag & 7u) {
-      case kVarint:
-        ok = field != kMetricsField && w.varint(v);
-        break;
-      case kFixed64:
-        ok = field != kMetricsField && w.skip(8);
-        break;
-      case kFixed32:
-        ok = field != kMetricsField && w.skip(4);
-        break;
+      case kVarint: ok = field != kMetricsField && w.varint(v); break;
+      case kFixed64: ok = field != kMetricsField && w.skip(8); break;
+      case kFixed32: ok = field != kMetricsField && w.skip(4); break;
       case kLen:
         ok = w.varint(v) && w.skip(v);
         if (field == kMetricsField) ++r.metrics;

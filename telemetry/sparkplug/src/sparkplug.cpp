@@ -46,23 +46,13 @@ void put_value(pb::Payload::Metric& m, DataType type, const Value& v) {
     case DataType::kInt32:
     case DataType::kUInt8:
     case DataType::kUInt16:
-    case DataType::kUInt32:
-      m.set_int_value(static_cast<std::uint32_t>(as_i64()));
-      break;
+    case DataType::kUInt32: m.set_int_value(static_cast<std::uint32_t>(as_i64())); break;
     case DataType::kInt64:
     case DataType::kUInt64:
-    case DataType::kDateTime:
-      m.set_long_value(static_cast<std::uint64_t>(as_i64()));
-      break;
-    case DataType::kFloat:
-      m.set_float_value(static_cast<float>(as_double(v).value_or(0.0)));
-      break;
-    case DataType::kDouble:
-      m.set_double_value(as_double(v).value_or(0.0));
-      break;
-    case DataType::kBoolean:
-      m.set_boolean_value(as_double(v).value_or(0.0) != 0.0);
-      break;
+    case DataType::kDateTime: m.set_long_value(static_cast<std::uint64_t>(as_i64())); break;
+    case DataType::kFloat: m.set_float_value(static_cast<float>(as_double(v).value_or(0.0))); break;
+    case DataType::kDouble: m.set_double_value(as_double(v).value_or(0.0)); break;
+    case DataType::kBoolean: m.set_boolean_value(as_double(v).value_or(0.0) != 0.0); break;
     case DataType::kString:
     case DataType::kText:
     case DataType::kUnknown:
@@ -87,24 +77,17 @@ Value get_value(const pb::Payload::Metric& m) {
           return static_cast<std::int64_t>(static_cast<std::int16_t>(m.int_value()));
         case DataType::kInt32:
           return static_cast<std::int64_t>(static_cast<std::int32_t>(m.int_value()));
-        default:
-          return static_cast<std::uint64_t>(m.int_value());
+        default: return static_cast<std::uint64_t>(m.int_value());
       }
     case pb::Payload::Metric::kLongValue:
       if (type == DataType::kInt64) return static_cast<std::int64_t>(m.long_value());
       return m.long_value();
-    case pb::Payload::Metric::kFloatValue:
-      return static_cast<double>(m.float_value());
-    case pb::Payload::Metric::kDoubleValue:
-      return m.double_value();
-    case pb::Payload::Metric::kBooleanValue:
-      return m.boolean_value();
-    case pb::Payload::Metric::kStringValue:
-      return m.string_value();
-    case pb::Payload::Metric::kBytesValue:
-      return m.bytes_value();
-    case pb::Payload::Metric::VALUE_NOT_SET:
-      break;
+    case pb::Payload::Metric::kFloatValue: return static_cast<double>(m.float_value());
+    case pb::Payload::Metric::kDoubleValue: return m.double_value();
+    case pb::Payload::Metric::kBooleanValue: return m.boolean_value();
+    case pb::Payload::Metric::kStringValue: return m.string_value();
+    case pb::Payload::Metric::kBytesValue: return m.bytes_value();
+    case pb::Payload::Metric::VALUE_NOT_SET: break;
   }
   return std::monostate{};
 }
@@ -115,34 +98,24 @@ bool value_fits(const pb::Payload::Metric& m) {
   using M = pb::Payload::Metric;
   const auto as_i32 = [&] { return static_cast<std::int32_t>(m.int_value()); };
   switch (m.datatype()) {
-    case pb::Int8:
-      return m.value_case() == M::kIntValue && as_i32() >= -128 && as_i32() <= 127;
+    case pb::Int8: return m.value_case() == M::kIntValue && as_i32() >= -128 && as_i32() <= 127;
     case pb::Int16:
       return m.value_case() == M::kIntValue && as_i32() >= -32768 && as_i32() <= 32767;
     case pb::Int32:
-    case pb::UInt32:
-      return m.value_case() == M::kIntValue;
-    case pb::UInt8:
-      return m.value_case() == M::kIntValue && m.int_value() <= 0xFFu;
-    case pb::UInt16:
-      return m.value_case() == M::kIntValue && m.int_value() <= 0xFFFFu;
+    case pb::UInt32: return m.value_case() == M::kIntValue;
+    case pb::UInt8: return m.value_case() == M::kIntValue && m.int_value() <= 0xFFu;
+    case pb::UInt16: return m.value_case() == M::kIntValue && m.int_value() <= 0xFFFFu;
     case pb::Int64:
     case pb::UInt64:
-    case pb::DateTime:
-      return m.value_case() == M::kLongValue;
-    case pb::Float:
-      return m.value_case() == M::kFloatValue;
-    case pb::Double:
-      return m.value_case() == M::kDoubleValue;
-    case pb::Boolean:
-      return m.value_case() == M::kBooleanValue;
+    case pb::DateTime: return m.value_case() == M::kLongValue;
+    case pb::Float: return m.value_case() == M::kFloatValue;
+    case pb::Double: return m.value_case() == M::kDoubleValue;
+    case pb::Boolean: return m.value_case() == M::kBooleanValue;
     case pb::String:
     case pb::Text:
-    case pb::UUID:
-      return m.value_case() == M::kStringValue;
+    case pb::UUID: return m.value_case() == M::kStringValue;
     case pb::Bytes:
-    case pb::File:
-      return m.value_case() == M::kBytesValue;
+    case pb::File: return m.value_case() == M::kBytesValue;
     default:  // Unknown, DataSet, Template, PropertySet…: no scalar value here
       return false;
   }
@@ -159,36 +132,21 @@ std::string_view to_string(MessageType t) noexcept {
 
 std::string_view to_string(DataType t) noexcept {
   switch (t) {
-    case DataType::kInt8:
-      return "Int8";
-    case DataType::kInt16:
-      return "Int16";
-    case DataType::kInt32:
-      return "Int32";
-    case DataType::kInt64:
-      return "Int64";
-    case DataType::kUInt8:
-      return "UInt8";
-    case DataType::kUInt16:
-      return "UInt16";
-    case DataType::kUInt32:
-      return "UInt32";
-    case DataType::kUInt64:
-      return "UInt64";
-    case DataType::kFloat:
-      return "Float";
-    case DataType::kDouble:
-      return "Double";
-    case DataType::kBoolean:
-      return "Boolean";
-    case DataType::kString:
-      return "String";
-    case DataType::kDateTime:
-      return "DateTime";
-    case DataType::kText:
-      return "Text";
-    case DataType::kUnknown:
-      break;
+    case DataType::kInt8: return "Int8";
+    case DataType::kInt16: return "Int16";
+    case DataType::kInt32: return "Int32";
+    case DataType::kInt64: return "Int64";
+    case DataType::kUInt8: return "UInt8";
+    case DataType::kUInt16: return "UInt16";
+    case DataType::kUInt32: return "UInt32";
+    case DataType::kUInt64: return "UInt64";
+    case DataType::kFloat: return "Float";
+    case DataType::kDouble: return "Double";
+    case DataType::kBoolean: return "Boolean";
+    case DataType::kString: return "String";
+    case DataType::kDateTime: return "DateTime";
+    case DataType::kText: return "Text";
+    case DataType::kUnknown: break;
   }
   return "Unknown";
 }

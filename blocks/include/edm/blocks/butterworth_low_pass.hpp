@@ -36,15 +36,10 @@ struct ButterworthLowPassParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("cutoff", cutoff,
-            {.unit = "1",
-             .description = "cut-off Wn as a fraction of the Nyquist frequency",
-             .range = rt::open(0.0, 1.0)});
+            {"1", "cut-off Wn as a fraction of the Nyquist frequency", rt::open(0.0, 1.0)});
     v.param("initial", initial,
-            {.unit = "",
-             .description = "steady-state value after activation, signal unit",
-             .range = ranges::kSignal});
-    v.param("prime", prime,
-            {.unit = "", .description = "the first sample after activation sets the steady state"});
+            {"", "steady-state value after activation, signal unit", ranges::kSignal});
+    v.param("prime", prime, {"", "the first sample after activation sets the steady state"});
   }
 };
 

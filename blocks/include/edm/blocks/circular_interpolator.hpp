@@ -43,17 +43,12 @@ struct CircularInterpolatorParams {
   double end_tol_mm{1e-3};  // [mm] allowed | |end − C| − R |, ≥ 0
 
   void visit(rt::ParamVisitor& v) {
+    v.param("x0_mm", x0_mm, {"mm", "X position at activation", ranges::kPositionMm});
+    v.param("y0_mm", y0_mm, {"mm", "Y position at activation", ranges::kPositionMm});
     v.param(
-        "x0_mm", x0_mm,
-        {.unit = "mm", .description = "X position at activation", .range = ranges::kPositionMm});
-    v.param(
-        "y0_mm", y0_mm,
-        {.unit = "mm", .description = "Y position at activation", .range = ranges::kPositionMm});
-    v.param("end_tol_mm", end_tol_mm,
-            {.unit = "mm",
-             .description =
-                 "largest accepted difference between the end point's radius and the start radius",
-             .range = ranges::kToleranceMm});
+        "end_tol_mm", end_tol_mm,
+        {"mm", "largest accepted difference between the end point's radius and the start radius",
+         ranges::kToleranceMm});
   }
 };
 

@@ -53,13 +53,12 @@ struct DischargeStateCounterParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("interval", interval,
-            {.unit = "pulses",
-             .description = "analysis interval m: latch the counts once m pulses arrived since "
-                            "the last latch (>= 32: all-new pulses)",
-             .range = rt::closed(1.0, static_cast<double>(kMaxInterval))});
+            {"pulses",
+             "analysis interval m: latch the counts once m pulses arrived since the last latch (>= "
+             "32: all-new pulses)",
+             rt::closed(1.0, static_cast<double>(kMaxInterval))});
     v.param("arcs_as_short", arcs_as_short,
-            {.unit = "",
-             .description = "count transient and stable arcs as short pulses (false: as normal)"});
+            {"", "count transient and stable arcs as short pulses (false: as normal)"});
   }
 };
 

@@ -88,18 +88,13 @@ struct FuzzyServoLUTParams {
   double v_max_mm_s{5.0};    // [mm/s] > 0: |v| at a normalised output of 1
 
   void visit(rt::ParamVisitor& v) {
-    v.param(
-        "open_terms", open_terms,
-        {.unit = "pulses", .description = "terms of the open count, e.g. 'Z=tri(-14,0,14) ...'"});
-    v.param("short_terms", short_terms,
-            {.unit = "pulses", .description = "terms of the short count"});
+    v.param("open_terms", open_terms,
+            {"pulses", "terms of the open count, e.g. 'Z=tri(-14,0,14) ...'"});
+    v.param("short_terms", short_terms, {"pulses", "terms of the short count"});
     v.param("normal_terms", normal_terms,
-            {.unit = "pulses",
-             .description = "terms of the normal count 32 - open - short (optional)"});
-    v.param("velocity_terms", velocity_terms,
-            {.unit = "1", .description = "output terms in units of v_max_mm_s"});
-    v.param("rules", rules,
-            {.unit = "", .description = "'if open is L and short is Z then v is PB; ...'"});
+            {"pulses", "terms of the normal count 32 - open - short (optional)"});
+    v.param("velocity_terms", velocity_terms, {"1", "output terms in units of v_max_mm_s"});
+    v.param("rules", rules, {"", "'if open is L and short is Z then v is PB; ...'"});
     v.param("samples", samples,
             {.unit = "",
              .description = "points of the sampled output universe",
@@ -121,9 +116,7 @@ struct FuzzyServoLUTParams {
              .range = rt::kPositive,
              .load_time_only = true});
     v.param("v_max_mm_s", v_max_mm_s,
-            {.unit = "mm/s",
-             .description = "speed at a normalised output of +-1",
-             .range = ranges::kSpeedMmS});
+            {"mm/s", "speed at a normalised output of +-1", ranges::kSpeedMmS});
   }
 };
 

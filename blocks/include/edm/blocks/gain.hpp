@@ -21,11 +21,8 @@ struct GainParams {
 
   void visit(rt::ParamVisitor& v) {
     // Ranges (issue 31): a gain within ±1e6, an offset within ±1e12 (param_ranges.hpp).
-    v.param("k", k, {.unit = "", .description = "gain", .range = ranges::kGain});
-    v.param("offset", offset,
-            {.unit = "",
-             .description = "added after the gain, in the output's unit",
-             .range = ranges::kSignal});
+    v.param("k", k, {"", "gain", ranges::kGain});
+    v.param("offset", offset, {"", "added after the gain, in the output's unit", ranges::kSignal});
   }
 };
 

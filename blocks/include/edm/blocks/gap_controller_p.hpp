@@ -53,30 +53,23 @@ struct GapControllerPParams {
     // 1 µs error already saturates any speed limit); Tdr and Td within 10 ms (param_ranges.hpp);
     // ki up to 1e4 (ki/kg = 1/Ti: Ti = 1 ms even at the largest kg, 5 µs at the default one).
     v.param("kg", kg,
-            {.unit = "mm/s/us",
-             .description = "gain: Vz per microsecond of Td error",
-             .range = rt::open_closed(0.0, 10.0)});
+            {"mm/s/us", "gain: Vz per microsecond of Td error", rt::open_closed(0.0, 10.0)});
     v.param("tdr_default_us", tdr_default_us,
-            {.unit = "us",
-             .description = "reference ignition delay while the tdr_us input is 0",
-             .range = rt::open_closed(0.0, 10000.0)});
+            {"us", "reference ignition delay while the tdr_us input is 0",
+             rt::open_closed(0.0, 10000.0)});
     v.param("v_feed_max_mm_s", v_feed_max_mm_s,
-            {.unit = "mm/s", .description = "largest downward speed", .range = ranges::kSpeedMmS});
+            {"mm/s", "largest downward speed", ranges::kSpeedMmS});
     v.param("v_retract_max_mm_s", v_retract_max_mm_s,
-            {.unit = "mm/s", .description = "largest upward speed", .range = ranges::kSpeedMmS});
+            {"mm/s", "largest upward speed", ranges::kSpeedMmS});
     v.param("retract_speed_mm_s", retract_speed_mm_s,
-            {.unit = "mm/s",
-             .description = "upward speed while retract, <= v_retract_max_mm_s",
-             .range = ranges::kSpeedMmS});
+            {"mm/s", "upward speed while retract, <= v_retract_max_mm_s", ranges::kSpeedMmS});
     v.param("idle_feed_mm_s", idle_feed_mm_s,
-            {.unit = "mm/s",
-             .description = "speed while no valid Td, >= -v_feed_max_mm_s",
-             .range = rt::closed(-1000.0, 0.0)});
+            {"mm/s", "speed while no valid Td, >= -v_feed_max_mm_s", rt::closed(-1000.0, 0.0)});
     v.param("ki", ki,
-            {.unit = "mm/s/(us*s)",
-             .description = "integral gain on the Td error; 0 = seed 004's P law (steady Td "
-                            "offset v_b/Kg while drilling)",
-             .range = rt::closed(0.0, 1.0e4)});
+            {"mm/s/(us*s)",
+             "integral gain on the Td error; 0 = seed 004's P law (steady Td offset v_b/Kg while "
+             "drilling)",
+             rt::closed(0.0, 1.0e4)});
   }
   /// Cross-field rules: retract_speed <= v_retract_max, idle_feed >= -v_feed_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -61,18 +61,11 @@ struct GreyPredictorGM11Params {
              .range = rt::closed(4.0, static_cast<double>(kMaxWindow)),
              .load_time_only = true});
     v.param("horizon", horizon,
-            {.unit = "samples",
-             .description = "prediction horizon p",
-             .range = rt::closed(0.0, static_cast<double>(kMaxHorizon))});
+            {"samples", "prediction horizon p", rt::closed(0.0, static_cast<double>(kMaxHorizon))});
     v.param("paper_exp", paper_exp,
-            {.unit = "",
-             .description = "true: exp(-c) of the paper's eq. 1; false: the exact discrete rho"});
-    v.param("out_min", out_min,
-            {.unit = "", .description = "lower clamp of out (Rab: 0)", .range = ranges::kSignal});
-    v.param("out_max", out_max,
-            {.unit = "",
-             .description = "upper clamp of out (Rab: 1), >= out_min",
-             .range = ranges::kSignal});
+            {"", "true: exp(-c) of the paper's eq. 1; false: the exact discrete rho"});
+    v.param("out_min", out_min, {"", "lower clamp of out (Rab: 0)", ranges::kSignal});
+    v.param("out_max", out_max, {"", "upper clamp of out (Rab: 1), >= out_min", ranges::kSignal});
   }
   /// Cross-field rule: out_min <= out_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

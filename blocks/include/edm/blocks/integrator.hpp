@@ -31,18 +31,11 @@ struct IntegratorParams {
 
   void visit(rt::ParamVisitor& v) {
     // Ranges (issue 31): a gain within ±1e6, signals within ±1e12 (param_ranges.hpp).
-    v.param("k", k,
-            {.unit = "1/s",
-             .description = "integration gain: out changes by k·in per second",
-             .range = ranges::kGain});
-    v.param("min", min,
-            {.unit = "", .description = "lower limit of out", .range = ranges::kSignal});
-    v.param("max", max,
-            {.unit = "", .description = "upper limit of out, >= min", .range = ranges::kSignal});
+    v.param("k", k, {"1/s", "integration gain: out changes by k·in per second", ranges::kGain});
+    v.param("min", min, {"", "lower limit of out", ranges::kSignal});
+    v.param("max", max, {"", "upper limit of out, >= min", ranges::kSignal});
     v.param("initial", initial,
-            {.unit = "",
-             .description = "out at configure and while reset is true (clamped)",
-             .range = ranges::kSignal});
+            {"", "out at configure and while reset is true (clamped)", ranges::kSignal});
   }
   /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -74,39 +74,19 @@ struct IterativeLearningControlParams {
     // Ranges (issue 31): model coefficients within ±1e6 (the sinking config: p0 0.005, k_delta
     // 1290), u and the error clamp in the position signal's unit, within ±1e12 (param_ranges.hpp).
     v.param("p0", p0,
-            {.unit = "1",
-             .description = "first impulse-response sample of the axis loop, != 0",
-             .range = ranges::kCoefficient});
+            {"1", "first impulse-response sample of the axis loop, != 0", ranges::kCoefficient});
     v.param("k_delta", k_delta,
-            {.unit = "",
-             .description = "output per unit of gap, y = k_delta*gap + b, != 0",
-             .range = ranges::kCoefficient});
+            {"", "output per unit of gap, y = k_delta*gap + b, != 0", ranges::kCoefficient});
     v.param("q_pole", q_pole,
-            {.unit = "1",
-             .description = "pole a of the Q low-pass (0: no filter)",
-             .range = rt::closed(0.0, kMaxPole)});
-    v.param("lambda1", lambda1,
-            {.unit = "1",
-             .description = "forward-motion pole 1",
-             .range = rt::closed(-kMaxPole, kMaxPole)});
-    v.param("lambda2", lambda2,
-            {.unit = "1",
-             .description = "forward-motion pole 2",
-             .range = rt::closed(-kMaxPole, kMaxPole)});
-    v.param("lambda3", lambda3,
-            {.unit = "1",
-             .description = "within-cycle pole",
-             .range = rt::closed(-kMaxPole, kMaxPole)});
+            {"1", "pole a of the Q low-pass (0: no filter)", rt::closed(0.0, kMaxPole)});
+    v.param("lambda1", lambda1, {"1", "forward-motion pole 1", rt::closed(-kMaxPole, kMaxPole)});
+    v.param("lambda2", lambda2, {"1", "forward-motion pole 2", rt::closed(-kMaxPole, kMaxPole)});
+    v.param("lambda3", lambda3, {"1", "within-cycle pole", rt::closed(-kMaxPole, kMaxPole)});
     v.param("u_initial", u_initial,
-            {.unit = "",
-             .description = "output before learning, position unit, in [u_min, u_max]",
-             .range = ranges::kSignal});
-    v.param("u_min", u_min,
-            {.unit = "", .description = "lower clamp of u", .range = ranges::kSignal});
-    v.param("u_max", u_max,
-            {.unit = "", .description = "upper clamp of u, >= u_min", .range = ranges::kSignal});
-    v.param("auto_cycle", auto_cycle,
-            {.unit = "", .description = "a cycle ends every n_samples without cycle_start"});
+            {"", "output before learning, position unit, in [u_min, u_max]", ranges::kSignal});
+    v.param("u_min", u_min, {"", "lower clamp of u", ranges::kSignal});
+    v.param("u_max", u_max, {"", "upper clamp of u, >= u_min", ranges::kSignal});
+    v.param("auto_cycle", auto_cycle, {"", "a cycle ends every n_samples without cycle_start"});
     v.param("warm_cycles", warm_cycles,
             {.unit = "cycles",
              .description = "complete cycles recorded from `track` before this block takes over "
@@ -114,11 +94,10 @@ struct IterativeLearningControlParams {
              .range = rt::closed(0.0, 1e6),
              .load_time_only = true});
     v.param("e_max", e_max,
-            {.unit = "",
-             .description =
-                 "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b "
-                 "holds (0: off)",
-             .range = rt::closed(0.0, 1.0e12)});
+            {"",
+             "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b holds "
+             "(0: off)",
+             rt::closed(0.0, 1.0e12)});
   }
   /// Rules a range cannot say: p0 != 0, k_delta != 0, u_min <= u_initial <= u_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -50,25 +50,15 @@ struct JumpCycleParams {
     // Ranges (issue 31): die-sinking jumps every 0.1-10 s (PM §6.5: 1.5 s), so a period up to
     // 10 min and up, down and settle times up to 1 min; speeds as any axis (param_ranges.hpp).
     v.param("period", period,
-            {.unit = "s",
-             .description = "time from one jump's start to the next, > up + down + settle time",
-             .range = rt::open_closed(0.0, 600.0)});
-    v.param("up_time", up_time,
-            {.unit = "s",
-             .description = "time the electrode rises",
-             .range = rt::open_closed(0.0, 60.0)});
-    v.param("down_time", down_time,
-            {.unit = "s",
-             .description = "time it comes back down",
-             .range = rt::open_closed(0.0, 60.0)});
-    v.param("up_speed_mm_s", up_speed_mm_s,
-            {.unit = "mm/s", .description = "rising speed", .range = ranges::kSpeedMmS});
-    v.param("down_speed_mm_s", down_speed_mm_s,
-            {.unit = "mm/s", .description = "lowering speed", .range = ranges::kSpeedMmS});
+            {"s", "time from one jump's start to the next, > up + down + settle time",
+             rt::open_closed(0.0, 600.0)});
+    v.param("up_time", up_time, {"s", "time the electrode rises", rt::open_closed(0.0, 60.0)});
+    v.param("down_time", down_time, {"s", "time it comes back down", rt::open_closed(0.0, 60.0)});
+    v.param("up_speed_mm_s", up_speed_mm_s, {"mm/s", "rising speed", ranges::kSpeedMmS});
+    v.param("down_speed_mm_s", down_speed_mm_s, {"mm/s", "lowering speed", ranges::kSpeedMmS});
     v.param("settle_time", settle_time,
-            {.unit = "s",
-             .description = "`settling` stays true this long after the jump (the approach)",
-             .range = rt::closed(0.0, 60.0)});
+            {"s", "`settling` stays true this long after the jump (the approach)",
+             rt::closed(0.0, 60.0)});
   }
   /// Cross-field rule: period > up_time + down_time + settle_time.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -32,17 +32,11 @@ struct LimiterParams {
   void visit(rt::ParamVisitor& v) {
     // Ranges (issue 31): a signal within ±1e12 (param_ranges.hpp: the ±1e9 defaults are "no
     // limit").
+    v.param("min", min, {"", "lower limit, in the signal's unit", ranges::kSignal});
+    v.param("max", max, {"", "upper limit, >= min, in the signal's unit", ranges::kSignal});
     v.param(
-        "min", min,
-        {.unit = "", .description = "lower limit, in the signal's unit", .range = ranges::kSignal});
-    v.param("max", max,
-            {.unit = "",
-             .description = "upper limit, >= min, in the signal's unit",
-             .range = ranges::kSignal});
-    v.param("rate", rate,
-            {.unit = "1/s",
-             .description = "slew-rate limit in signal units per second (0 = unlimited)",
-             .range = ranges::kSignalRate});
+        "rate", rate,
+        {"1/s", "slew-rate limit in signal units per second (0 = unlimited)", ranges::kSignalRate});
   }
   /// Cross-field rule: min <= max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -37,15 +37,9 @@ struct LinearInterpolatorParams {
   double z0_mm{0.0};  // [mm]
 
   void visit(rt::ParamVisitor& v) {
-    v.param(
-        "x0_mm", x0_mm,
-        {.unit = "mm", .description = "X position at activation", .range = ranges::kPositionMm});
-    v.param(
-        "y0_mm", y0_mm,
-        {.unit = "mm", .description = "Y position at activation", .range = ranges::kPositionMm});
-    v.param(
-        "z0_mm", z0_mm,
-        {.unit = "mm", .description = "Z position at activation", .range = ranges::kPositionMm});
+    v.param("x0_mm", x0_mm, {"mm", "X position at activation", ranges::kPositionMm});
+    v.param("y0_mm", y0_mm, {"mm", "Y position at activation", ranges::kPositionMm});
+    v.param("z0_mm", z0_mm, {"mm", "Z position at activation", ranges::kPositionMm});
   }
 };
 

@@ -25,12 +25,9 @@ struct LowPassParams {
   double initial{0.0};                              // y after activate() [signal unit]
 
   void visit(rt::ParamVisitor& v) {
-    v.param("tau", tau,
-            {.unit = "s", .description = "time constant", .range = ranges::kPositiveProcessTimeS});
+    v.param("tau", tau, {"s", "time constant", ranges::kPositiveProcessTimeS});
     v.param("initial", initial,
-            {.unit = "",
-             .description = "output after activation, in the signal's unit",
-             .range = ranges::kSignal});
+            {"", "output after activation, in the signal's unit", ranges::kSignal});
   }
 };
 

@@ -44,18 +44,13 @@ struct OrbitExpanderParams {
     // past the seed 004 default 1e-4 that "too large a kr shorts the gap"; dr_max, at most 10 mm,
     // clamps the step).
     v.param("kr", kr,
-            {.unit = "mm/us",
-             .description = "radius growth per revolution per us of mean ignition delay",
-             .range = rt::closed(0.0, 1.0)});
+            {"mm/us", "radius growth per revolution per us of mean ignition delay",
+             rt::closed(0.0, 1.0)});
     v.param("dr_max_mm", dr_max_mm,
-            {.unit = "mm",
-             .description = "largest radius growth per revolution",
-             .range = ranges::kToleranceMm});
+            {"mm", "largest radius growth per revolution", ranges::kToleranceMm});
     v.param("samples_per_rev", samples_per_rev,
-            {.unit = "",
-             .description = "samples per revolution (0: a rising edge of rev_pulse ends a "
-                            "revolution)",
-             .range = rt::closed(0.0, static_cast<double>(kMaxSamplesPerRev))});
+            {"", "samples per revolution (0: a rising edge of rev_pulse ends a revolution)",
+             rt::closed(0.0, static_cast<double>(kMaxSamplesPerRev))});
   }
 };
 

@@ -36,12 +36,9 @@ struct PolaritySwitchParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("settle", settle,
-            {.unit = "s",
-             .description = "generator-off time before and after a switch",
-             .range = ranges::kPositiveSettleS});
-    v.param(
-        "initial_positive", initial_positive,
-        {.unit = "", .description = "polarity after activation (false: negative, electrode -)"});
+            {"s", "generator-off time before and after a switch", ranges::kPositiveSettleS});
+    v.param("initial_positive", initial_positive,
+            {"", "polarity after activation (false: negative, electrode -)"});
   }
 };
 

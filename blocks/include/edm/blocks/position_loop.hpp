@@ -39,30 +39,17 @@ struct PositionLoopParams {
     // Ranges (issue 31): kv as any position loop (param_ranges.hpp), ki up to 1e6 1/s² (kv² at
     // kv = 1000), a following-error limit up to 1 m (the sinking ILC bench uses 100 mm).
     v.param("kv", kv,
-            {.unit = "1/s",
-             .description = "position gain: v_cmd per mm of following error",
-             .range = ranges::kLoopGainPerS});
-    v.param("ki", ki,
-            {.unit = "1/s^2",
-             .description = "integral gain (0 = P loop)",
-             .range = rt::closed(0.0, 1.0e6)});
-    v.param(
-        "kff", kff,
-        {.unit = "", .description = "velocity feed-forward weight", .range = rt::closed(0.0, 1.5)});
-    v.param("v_max_mm_s", v_max_mm_s,
-            {.unit = "mm/s", .description = "velocity command limit", .range = ranges::kSpeedMmS});
+            {"1/s", "position gain: v_cmd per mm of following error", ranges::kLoopGainPerS});
+    v.param("ki", ki, {"1/s^2", "integral gain (0 = P loop)", rt::closed(0.0, 1.0e6)});
+    v.param("kff", kff, {"", "velocity feed-forward weight", rt::closed(0.0, 1.5)});
+    v.param("v_max_mm_s", v_max_mm_s, {"mm/s", "velocity command limit", ranges::kSpeedMmS});
     v.param("f_err_max_mm", f_err_max_mm,
-            {.unit = "mm",
-             .description = "following-error limit",
-             .range = rt::open_closed(0.0, 1000.0)});
+            {"mm", "following-error limit", rt::open_closed(0.0, 1000.0)});
     v.param("in_pos_tol_mm", in_pos_tol_mm,
-            {.unit = "mm",
-             .description = "in-position window, |e| <= tol",
-             .range = ranges::kToleranceMm});
+            {"mm", "in-position window, |e| <= tol", ranges::kToleranceMm});
     v.param("in_pos_cycles", in_pos_cycles,
-            {.unit = "cycles",
-             .description = "cycles |e| must stay in the window before in_position",
-             .range = rt::closed(1.0, 1.0e9)});
+            {"cycles", "cycles |e| must stay in the window before in_position",
+             rt::closed(1.0, 1.0e9)});
   }
 };
 

@@ -37,30 +37,16 @@ struct RecursiveLeastSquaresParams {
              .description = "number of regressors phi0.. used (the estimate's dimension)",
              .range = rt::closed(1.0, static_cast<double>(RlsCore::kMaxParams)),
              .load_time_only = true});
-    v.param("lambda", lambda,
-            {.unit = "1", .description = "forgetting factor", .range = rt::closed(1e-3, 1.0)});
+    v.param("lambda", lambda, {"1", "forgetting factor", rt::closed(1e-3, 1.0)});
     // Ranges (issue 31): the covariance start p0 up to 1e9 and its trace bound 1e12 (the defaults
     // 1e3 and 1e4), start values within ±1e6 (param_ranges.hpp).
-    v.param("p0", p0,
-            {.unit = "1",
-             .description = "initial covariance P = p0*I",
-             .range = rt::open_closed(0.0, 1.0e9)});
+    v.param("p0", p0, {"1", "initial covariance P = p0*I", rt::open_closed(0.0, 1.0e9)});
     v.param("trace_max", trace_max,
-            {.unit = "1",
-             .description = "upper bound of trace(P), >= p0",
-             .range = rt::open_closed(0.0, 1.0e12)});
-    v.param(
-        "theta0_init", theta0_init,
-        {.unit = "", .description = "initial estimate of theta0", .range = ranges::kCoefficient});
-    v.param(
-        "theta1_init", theta1_init,
-        {.unit = "", .description = "initial estimate of theta1", .range = ranges::kCoefficient});
-    v.param(
-        "theta2_init", theta2_init,
-        {.unit = "", .description = "initial estimate of theta2", .range = ranges::kCoefficient});
-    v.param(
-        "theta3_init", theta3_init,
-        {.unit = "", .description = "initial estimate of theta3", .range = ranges::kCoefficient});
+            {"1", "upper bound of trace(P), >= p0", rt::open_closed(0.0, 1.0e12)});
+    v.param("theta0_init", theta0_init, {"", "initial estimate of theta0", ranges::kCoefficient});
+    v.param("theta1_init", theta1_init, {"", "initial estimate of theta1", ranges::kCoefficient});
+    v.param("theta2_init", theta2_init, {"", "initial estimate of theta2", ranges::kCoefficient});
+    v.param("theta3_init", theta3_init, {"", "initial estimate of theta3", ranges::kCoefficient});
   }
   /// Cross-field rule: trace_max >= p0.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

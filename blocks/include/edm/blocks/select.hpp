@@ -36,14 +36,11 @@ struct SelectParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("select", select,
-            {.unit = "",
-             .description = "true selects in1 (OR-ed with the input g); writable at run time"});
+            {"", "true selects in1 (OR-ed with the input g); writable at run time"});
     v.param(
         "ramp_time", ramp_time,
-        {.unit = "s",
-         .description =
-             "after a switch, the output's step decays linearly to 0 over this time (0 = at once)",
-         .range = ranges::kProcessTimeS});
+        {"s", "after a switch, the output's step decays linearly to 0 over this time (0 = at once)",
+         ranges::kProcessTimeS});
   }
 };
 

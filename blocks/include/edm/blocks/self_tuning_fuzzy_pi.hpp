@@ -79,72 +79,35 @@ struct SelfTuningFuzzyPIParams {
     // 100), Ku 0.06-0.08 µs and Kv 0.03-0.16 V (up to 1000), the d_pf gain 100 (up to 1e4), the
     // arc-off time 9-50 µs (within 10 ms) and the servo reference 30-70 V (within 400 V); psi_min
     // down to -1e9, the documented "no floor".
-    v.param("ge", ge,
-            {.unit = "1", .description = "error scaling Ge", .range = rt::open_closed(0.0, 1.0e4)});
-    v.param("gce", gce,
-            {.unit = "1",
-             .description = "change-of-error scaling Gce",
-             .range = rt::open_closed(0.0, 1.0e4)});
-    v.param("alpha", alpha,
-            {.unit = "1",
-             .description = "overshoot attenuation alpha",
-             .range = rt::closed(1e-9, 1.0)});
-    v.param("ol", ol,
-            {.unit = "1",
-             .description = "overloading parameter ol",
-             .range = rt::open_closed(0.0, 100.0)});
-    v.param("ku", ku,
-            {.unit = "us",
-             .description = "global gain of the arc-off time",
-             .range = rt::closed(0.0, 1000.0)});
-    v.param("kv", kv,
-            {.unit = "V",
-             .description = "global gain of the servo reference voltage",
-             .range = rt::closed(0.0, 1000.0)});
+    v.param("ge", ge, {"1", "error scaling Ge", rt::open_closed(0.0, 1.0e4)});
+    v.param("gce", gce, {"1", "change-of-error scaling Gce", rt::open_closed(0.0, 1.0e4)});
+    v.param("alpha", alpha, {"1", "overshoot attenuation alpha", rt::closed(1e-9, 1.0)});
+    v.param("ol", ol, {"1", "overloading parameter ol", rt::open_closed(0.0, 100.0)});
+    v.param("ku", ku, {"us", "global gain of the arc-off time", rt::closed(0.0, 1000.0)});
+    v.param("kv", kv, {"V", "global gain of the servo reference voltage", rt::closed(0.0, 1000.0)});
     v.param("rab_ref_default", rab_ref_default,
-            {.unit = "1",
-             .description = "Rab set point while rab_ref is 0",
-             .range = rt::closed(1e-9, 1.0)});
+            {"1", "Rab set point while rab_ref is 0", rt::closed(1e-9, 1.0)});
     v.param("overload_error", overload_error,
-            {.unit = "1",
-             .description = "Psi applies when e is below this (eq. 8: 0.01)",
-             .range = rt::closed(-1.0, 1.0)});
+            {"1", "Psi applies when e is below this (eq. 8: 0.01)", rt::closed(-1.0, 1.0)});
     v.param("dpf_gain", dpf_gain,
-            {.unit = "1",
-             .description = "gain on d_pf = Rab_p - Rab_f in Psi",
-             .range = rt::closed(0.0, 1.0e4)});
-    v.param(
-        "psi_min", psi_min,
-        {.unit = "1",
-         .description = "floor of Psi in overload (0: no reversal; -1e9: none, eq. 8 as printed)",
-         .range = rt::closed(-1.0e9, 100.0)});
-    v.param("u_min_us", u_min_us,
-            {.unit = "us", .description = "shortest arc-off time", .range = ranges::kPulseUs});
-    v.param("u_max_us", u_max_us,
-            {.unit = "us",
-             .description = "longest arc-off time, >= u_min_us",
-             .range = ranges::kPulseUs});
+            {"1", "gain on d_pf = Rab_p - Rab_f in Psi", rt::closed(0.0, 1.0e4)});
+    v.param("psi_min", psi_min,
+            {"1", "floor of Psi in overload (0: no reversal; -1e9: none, eq. 8 as printed)",
+             rt::closed(-1.0e9, 100.0)});
+    v.param("u_min_us", u_min_us, {"us", "shortest arc-off time", ranges::kPulseUs});
+    v.param("u_max_us", u_max_us, {"us", "longest arc-off time, >= u_min_us", ranges::kPulseUs});
     v.param("u_initial_us", u_initial_us,
-            {.unit = "us",
-             .description = "arc-off time after activation, in [u_min_us, u_max_us]",
-             .range = ranges::kPulseUs});
-    v.param(
-        "v_min_v", v_min_v,
-        {.unit = "V", .description = "lowest servo reference voltage", .range = ranges::kVoltageV});
+            {"us", "arc-off time after activation, in [u_min_us, u_max_us]", ranges::kPulseUs});
+    v.param("v_min_v", v_min_v, {"V", "lowest servo reference voltage", ranges::kVoltageV});
     v.param("v_max_v", v_max_v,
-            {.unit = "V",
-             .description = "highest servo reference voltage, >= v_min_v",
-             .range = ranges::kVoltageV});
+            {"V", "highest servo reference voltage, >= v_min_v", ranges::kVoltageV});
     v.param("v_initial_v", v_initial_v,
-            {.unit = "V",
-             .description = "servo reference voltage after activation, in [v_min_v, v_max_v]",
-             .range = ranges::kVoltageV});
-    v.param(
-        "settle_samples", settle_samples,
-        {.unit = "samples",
-         .description =
+            {"V", "servo reference voltage after activation, in [v_min_v, v_max_v]",
+             ranges::kVoltageV});
+    v.param("settle_samples", settle_samples,
+            {"samples",
              "hold u and v this many samples after activation while filter and predictor settle",
-         .range = rt::closed(0.0, 1e9)});
+             rt::closed(0.0, 1e9)});
   }
   /// Cross-field rules: u_min_us <= u_initial_us <= u_max_us, v_min_v <= v_initial_v <= v_max_v.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -95,89 +95,45 @@ struct SelfTuningRegulatorParams {
     // (0-100; the reference voltage itself below 400 V), ti and to up to 10 ms (PM §1: t_on
     // 1-1000 µs), start values within ±1e6, the RLS covariance p0 up to 1e9 and its trace 1e12.
     v.param("beta00", beta00,
-            {.unit = "1",
-             .description = "fixed beta00 of the main model, != 0 (paper -1)",
-             .range = rt::closed(-1000.0, 1000.0)});
+            {"1", "fixed beta00 of the main model, != 0 (paper -1)", rt::closed(-1000.0, 1000.0)});
     v.param("us_per_unit_v", us_per_unit_v,
-            {.unit = "V",
-             .description = "servo reference voltage per unit of u_v",
-             .range = rt::open_closed(0.0, 400.0)});
-    v.param("u_v_min", u_v_min,
-            {.unit = "1", .description = "lowest u_v", .range = rt::closed(0.0, 100.0)});
-    v.param(
-        "u_v_max", u_v_max,
-        {.unit = "1", .description = "highest u_v, >= u_v_min", .range = rt::closed(0.0, 100.0)});
+            {"V", "servo reference voltage per unit of u_v", rt::open_closed(0.0, 400.0)});
+    v.param("u_v_min", u_v_min, {"1", "lowest u_v", rt::closed(0.0, 100.0)});
+    v.param("u_v_max", u_v_max, {"1", "highest u_v, >= u_v_min", rt::closed(0.0, 100.0)});
     v.param("u_v_initial", u_v_initial,
-            {.unit = "1",
-             .description = "u_v after activation, in [u_v_min, u_v_max]",
-             .range = rt::closed(0.0, 100.0)});
+            {"1", "u_v after activation, in [u_v_min, u_v_max]", rt::closed(0.0, 100.0)});
+    v.param("beta01_init", beta01_init, {"1", "initial estimate of beta01", ranges::kCoefficient});
+    v.param("beta0c_init", beta0c_init, {"1", "initial estimate of beta0c", ranges::kCoefficient});
     v.param(
-        "beta01_init", beta01_init,
-        {.unit = "1", .description = "initial estimate of beta01", .range = ranges::kCoefficient});
-    v.param(
-        "beta0c_init", beta0c_init,
-        {.unit = "1", .description = "initial estimate of beta0c", .range = ranges::kCoefficient});
-    v.param("ti_us", ti_us,
-            {.unit = "us",
-             .description = "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti",
-             .range = rt::open_closed(0.0, 10000.0)});
+        "ti_us", ti_us,
+        {"us", "pulse width ti: K1 = ti/(ti+to), beta10 = -1/ti", rt::open_closed(0.0, 10000.0)});
     v.param("to_min_us", to_min_us,
-            {.unit = "us",
-             .description = "shortest pulse-off time",
-             .range = rt::open_closed(0.0, 10000.0)});
+            {"us", "shortest pulse-off time", rt::open_closed(0.0, 10000.0)});
     v.param("to_max_us", to_max_us,
-            {.unit = "us",
-             .description = "longest pulse-off time, >= to_min_us",
-             .range = ranges::kPulseUs});
+            {"us", "longest pulse-off time, >= to_min_us", ranges::kPulseUs});
     v.param("to_initial_us", to_initial_us,
-            {.unit = "us",
-             .description = "pulse-off time after activation, in [to_min_us, to_max_us]",
-             .range = ranges::kPulseUs});
-    v.param(
-        "beta1c_init", beta1c_init,
-        {.unit = "1", .description = "initial estimate of beta1c", .range = ranges::kCoefficient});
-    v.param("lambda", lambda,
-            {.unit = "1", .description = "RLS forgetting factor", .range = rt::closed(0.5, 1.0)});
-    v.param("p0", p0,
-            {.unit = "1",
-             .description = "initial RLS covariance",
-             .range = rt::open_closed(0.0, 1.0e9)});
+            {"us", "pulse-off time after activation, in [to_min_us, to_max_us]", ranges::kPulseUs});
+    v.param("beta1c_init", beta1c_init, {"1", "initial estimate of beta1c", ranges::kCoefficient});
+    v.param("lambda", lambda, {"1", "RLS forgetting factor", rt::closed(0.5, 1.0)});
+    v.param("p0", p0, {"1", "initial RLS covariance", rt::open_closed(0.0, 1.0e9)});
     v.param("trace_max", trace_max,
-            {.unit = "1",
-             .description = "bound of the RLS covariance trace, >= 2*p0",
-             .range = rt::open_closed(0.0, 1.0e12)});
+            {"1", "bound of the RLS covariance trace, >= 2*p0", rt::open_closed(0.0, 1.0e12)});
     v.param("y_rv_good", y_rv_good,
-            {.unit = "1",
-             .description = "y_v reference in a good gap (paper 0.95)",
-             .range = rt::closed(0.0, 2.0)});
+            {"1", "y_v reference in a good gap (paper 0.95)", rt::closed(0.0, 2.0)});
     v.param("y_rt_good", y_rt_good,
-            {.unit = "1",
-             .description = "y_t reference in a good gap (paper 0.9)",
-             .range = rt::closed(0.0, 2.0)});
+            {"1", "y_t reference in a good gap (paper 0.9)", rt::closed(0.0, 2.0)});
     v.param("transient_arc_limit", transient_arc_limit,
-            {.unit = "1",
-             .description = "good gap: transient-arc ratio below",
-             .range = rt::closed(0.0, 1.0)});
+            {"1", "good gap: transient-arc ratio below", rt::closed(0.0, 1.0)});
     v.param("stable_arc_limit", stable_arc_limit,
-            {.unit = "1",
-             .description = "stable arc: stable-arc ratio above this",
-             .range = rt::closed(0.0, 1.0)});
+            {"1", "stable arc: stable-arc ratio above this", rt::closed(0.0, 1.0)});
     v.param("ref_rise", ref_rise,
-            {.unit = "1",
-             .description = "approach to the good references per sample",
-             .range = rt::closed(1e-9, 1.0)});
+            {"1", "approach to the good references per sample", rt::closed(1e-9, 1.0)});
     v.param("ref_step", ref_step,
-            {.unit = "1",
-             .description = "reference decrease per sample during a stable arc",
-             .range = rt::closed(0.0, 1.0)});
+            {"1", "reference decrease per sample during a stable arc", rt::closed(0.0, 1.0)});
     v.param("y_rv_min", y_rv_min,
-            {.unit = "1",
-             .description = "floor of the y_v reference, <= y_rv_good",
-             .range = rt::closed(0.0, 2.0)});
+            {"1", "floor of the y_v reference, <= y_rv_good", rt::closed(0.0, 2.0)});
     v.param("y_rt_min", y_rt_min,
-            {.unit = "1",
-             .description = "floor of the y_t reference, <= y_rt_good",
-             .range = rt::closed(0.0, 2.0)});
+            {"1", "floor of the y_t reference, <= y_rt_good", rt::closed(0.0, 2.0)});
     v.param("k1_on_us", k1_on_us,
             {.unit = "",
              .description = "decoupling gain K1 = ti/(ti+to) on Us (paper: true)",

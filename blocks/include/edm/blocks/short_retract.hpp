@@ -65,37 +65,21 @@ struct ShortRetractParams {
              .range = rt::closed(2.0, static_cast<double>(kMaxHistory)),
              .load_time_only = true});
     v.param("min_spacing_mm", min_spacing_mm,
-            {.unit = "mm",
-             .description = "least distance between recorded points",
-             .range = rt::closed(0.0, 1.0e3)});
+            {"mm", "least distance between recorded points", rt::closed(0.0, 1.0e3)});
     v.param("short_cycles", short_cycles,
-            {.unit = "cycles",
-             .description = "consecutive short cycles that start a retract",
-             .range = rt::closed(1.0, 1.0e9)});
+            {"cycles", "consecutive short cycles that start a retract", rt::closed(1.0, 1.0e9)});
     v.param("retract_distance_mm", retract_distance_mm,
-            {.unit = "mm",
-             .description = "retract length along the path",
-             .range = rt::closed(1.0e-9, 1.0e4)});
+            {"mm", "retract length along the path", rt::closed(1.0e-9, 1.0e4)});
     v.param("retract_speed_mm_s", retract_speed_mm_s,
-            {.unit = "mm/s",
-             .description = "path speed while retracting",
-             .range = rt::closed(1.0e-9, 1.0e4)});
+            {"mm/s", "path speed while retracting", rt::closed(1.0e-9, 1.0e4)});
     v.param("resume_speed_mm_s", resume_speed_mm_s,
-            {.unit = "mm/s",
-             .description = "path speed walking forward again",
-             .range = rt::closed(1.0e-9, 1.0e4)});
+            {"mm/s", "path speed walking forward again", rt::closed(1.0e-9, 1.0e4)});
     v.param("resume_ramp_ms", resume_ramp_ms,
-            {.unit = "ms",
-             .description = "time to ramp v_scale 0 -> 1 after hand-back",
-             .range = rt::closed(0.0, 60000.0)});
+            {"ms", "time to ramp v_scale 0 -> 1 after hand-back", rt::closed(0.0, 60000.0)});
     v.param("max_tries", max_tries,
-            {.unit = "",
-             .description = "retracts without progress before alarm + hold",
-             .range = rt::closed(0.0, 1.0e6)});
+            {"", "retracts without progress before alarm + hold", rt::closed(0.0, 1.0e6)});
     v.param("progress_mm", progress_mm,
-            {.unit = "mm",
-             .description = "path advance past the last short that resets tries",
-             .range = rt::closed(0.0, 1.0e4)});
+            {"mm", "path advance past the last short that resets tries", rt::closed(0.0, 1.0e4)});
   }
 };
 

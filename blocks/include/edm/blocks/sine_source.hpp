@@ -30,19 +30,10 @@ struct SineSourceParams {
   void visit(rt::ParamVisitor& v) {
     // Ranges (issue 31): signals within ±1e12 (param_ranges.hpp); up to 100 kHz, ten times the
     // Nyquist frequency of the fastest (10 kHz) task; a phase within ±1000 rad.
-    v.param("amplitude", amplitude,
-            {.unit = "",
-             .description = "peak amplitude, in the signal's unit",
-             .range = ranges::kSignal});
-    v.param("frequency_hz", frequency_hz,
-            {.unit = "Hz", .description = "frequency", .range = rt::open_closed(0.0, 1.0e5)});
-    v.param(
-        "phase_rad", phase_rad,
-        {.unit = "rad", .description = "phase at cycle 0", .range = rt::closed(-1000.0, 1000.0)});
-    v.param("offset", offset,
-            {.unit = "",
-             .description = "added to the sine, in the signal's unit",
-             .range = ranges::kSignal});
+    v.param("amplitude", amplitude, {"", "peak amplitude, in the signal's unit", ranges::kSignal});
+    v.param("frequency_hz", frequency_hz, {"Hz", "frequency", rt::open_closed(0.0, 1.0e5)});
+    v.param("phase_rad", phase_rad, {"rad", "phase at cycle 0", rt::closed(-1000.0, 1000.0)});
+    v.param("offset", offset, {"", "added to the sine, in the signal's unit", ranges::kSignal});
   }
 };
 

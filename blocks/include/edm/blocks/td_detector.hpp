@@ -57,17 +57,12 @@ struct TdDetectorParams {
              .load_time_only = true});
     v.param(
         "hold_when_empty", hold_when_empty,
-        {.unit = "",
-         .description =
-             "with no ignited pulse in the window keep the last td_us (else output empty_td_us)"});
-    v.param("empty_td_us", empty_td_us,
-            {.unit = "us",
-             .description = "td_us after activation, and with an empty window when not holding",
-             .range = ranges::kTdUs});
+        {"", "with no ignited pulse in the window keep the last td_us (else output empty_td_us)"});
+    v.param(
+        "empty_td_us", empty_td_us,
+        {"us", "td_us after activation, and with an empty window when not holding", ranges::kTdUs});
     v.param("short_td_us", short_td_us,
-            {.unit = "us",
-             .description = "ignition delay a shorted pulse counts with (gap feedback ~ 0)",
-             .range = ranges::kTdUs});
+            {"us", "ignition delay a shorted pulse counts with (gap feedback ~ 0)", ranges::kTdUs});
   }
 };
 

@@ -55,22 +55,15 @@ struct WearCompensatorParams {
     // tube ~0.7 mm²); wear ratios up to 10, the bound of a condition's wear_ratio (machining; PM
     // §2: drills at ~100 V wear >300 %).
     v.param("hole_area_mm2", hole_area_mm2,
-            {.unit = "mm^2",
-             .description = "cross-section of the hole A_hole",
-             .range = rt::open_closed(0.0, 1.0e6)});
+            {"mm^2", "cross-section of the hole A_hole", rt::open_closed(0.0, 1.0e6)});
     v.param("electrode_area_mm2", electrode_area_mm2,
-            {.unit = "mm^2",
-             .description = "cross-section of the electrode material A_e (a tube: pi/4*(D^2-d^2))",
-             .range = rt::open_closed(0.0, 1.0e6)});
+            {"mm^2", "cross-section of the electrode material A_e (a tube: pi/4*(D^2-d^2))",
+             rt::open_closed(0.0, 1.0e6)});
     v.param("wear_ratio_max", wear_ratio_max,
-            {.unit = "",
-             .description = "upper clamp of the wear_ratio input",
-             .range = rt::open_closed(0.0, 10.0)});
+            {"", "upper clamp of the wear_ratio input", rt::open_closed(0.0, 10.0)});
     v.param("wear_ratio_default", wear_ratio_default,
-            {.unit = "",
-             .description = "wear ratio used while the wear_ratio input is <= 0 (unwired), "
-                            "<= wear_ratio_max",
-             .range = rt::closed(0.0, 10.0)});
+            {"", "wear ratio used while the wear_ratio input is <= 0 (unwired), <= wear_ratio_max",
+             rt::closed(0.0, 10.0)});
   }
   /// Cross-field rule: wear_ratio_default <= wear_ratio_max.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -144,8 +144,7 @@ class ShortGuard {
     retract.short_detected.drive(s.short_now);
     s.status = step_child(retract);
     switch (after_retract_step(ctx.release, retract, p)) {
-      case Event::kNone:
-        break;
+      case Event::kNone: break;
       case Event::kRetract:
         s.retract_began = true;
         pins.short_retracts.set(pins.short_retracts.get() + 1);

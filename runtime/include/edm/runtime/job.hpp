@@ -35,14 +35,10 @@ enum class JobOutcome : std::uint8_t {
 /// aborted.
 constexpr std::string_view outcome_name(JobOutcome o) noexcept {
   switch (o) {
-    case JobOutcome::kNone:
-      return "none";
-    case JobOutcome::kRunning:
-      return "running";
-    case JobOutcome::kFinished:
-      return "finished";
-    case JobOutcome::kAborted:
-      return "aborted";
+    case JobOutcome::kNone: return "none";
+    case JobOutcome::kRunning: return "running";
+    case JobOutcome::kFinished: return "finished";
+    case JobOutcome::kAborted: return "aborted";
   }
   return "none";
 }

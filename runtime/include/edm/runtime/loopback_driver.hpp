@@ -20,9 +20,7 @@ struct LoopbackParams {
   std::int64_t channels{4};  // analog and digital channel pairs
 
   void visit(ParamVisitor& v) {
-    v.param(
-        "channels", channels,
-        {.unit = "", .description = "analog and digital channel pairs", .range = closed(1, 64)});
+    v.param("channels", channels, {"", "analog and digital channel pairs", closed(1, 64)});
   }
 };
 
