@@ -48,13 +48,7 @@ struct OperatorRig {
     // Parsed as if beside the shipped machines, so that their fragments are found.
     runtime = build_sim_machine(rt::parse_config_text(text, dir + machine + "-operator.yaml"),
                                 seeded(seed));
-    runtime->machine().command(rt::MachineCommand::kPowerOn);
-    std::vector<rt::Task*> tasks;
-    for (const auto& t : runtime->tasks()) {
-      t->detach_trace();
-      tasks.push_back(t.get());
-    }
-    sched = std::make_unique<rt::VirtualScheduler>(tasks, clock);
+    sched = power_on_virtual(*runtime, clock);
     run_for(std::chrono::milliseconds(5));
   }
 

@@ -43,6 +43,18 @@ inline rt::BuildOptions seeded(int seed) {
   return o;
 }
 
+/// Powers `runtime` on and puts every task on `clock`, traces detached (nothing written).
+inline std::unique_ptr<rt::VirtualScheduler> power_on_virtual(rt::Runtime& runtime,
+                                                              rt::VirtualClock& clock) {
+  runtime.machine().command(rt::MachineCommand::kPowerOn);
+  std::vector<rt::Task*> tasks;
+  for (const auto& t : runtime.tasks()) {
+    t->detach_trace();
+    tasks.push_back(t.get());
+  }
+  return std::make_unique<rt::VirtualScheduler>(tasks, clock);
+}
+
 // A shipped machine (config/machines/<name>.yaml) powered on, every task on one virtual clock
 // (traces detached): `run_until(t)` runs all cycles released before t, `pin(name)` finds a
 // variable's pin (a test failure, and an empty PinRef, if there is none).
@@ -55,13 +67,7 @@ struct VirtualMachine {
       : runtime(build_sim_machine(rt::parse_config_file(std::string(EDM_SOURCE_DIR) +
                                                         "/config/machines/" + name + ".yaml"),
                                   options)) {
-    runtime->machine().command(rt::MachineCommand::kPowerOn);
-    std::vector<rt::Task*> tasks;
-    for (const auto& t : runtime->tasks()) {
-      t->detach_trace();
-      tasks.push_back(t.get());
-    }
-    sched = std::make_unique<rt::VirtualScheduler>(tasks, clock);
+    sched = power_on_virtual(*runtime, clock);
   }
   void run_until(rt::TimePoint t) { sched->run_until(t); }
   rt::VariableRegistry& vars() { return runtime->variables(); }

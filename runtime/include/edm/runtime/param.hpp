@@ -7,9 +7,12 @@
 //   struct LowPassParams {
 //     double tau_s{0.01};
 //     void visit(ParamVisitor& v) {
-//       v.param("tau", tau_s, {.unit = "s", .description = "time constant", .range = kPositive});
+//       v.param("tau", tau_s, {"s", "time constant", kPositive});  // {unit, description, range}
 //     }
 //   };
+//
+// One row a parameter, the ParamSpec positional; the designated form ({.unit = …,
+// .load_time_only = true}) where a spec sets finite or load_time_only.
 //
 // A Params struct may add `std::vector<ParamError> validate() const` for rules that tie fields
 // together (e.g. "max >= min"); it runs only once every field is in its own range.
