@@ -35,6 +35,7 @@
 #include "edm/runtime/config.hpp"
 #include "edm/runtime/io_driver.hpp"
 #include "edm/runtime/runtime.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::bench {
 namespace {
@@ -77,18 +78,18 @@ class BenchGapDriver final : public rt::IoDriver {
     const std::int64_t total = opens + shorts + normal + arcs;
     ratio_short.set(total > 0 ? static_cast<double>(shorts) / static_cast<double>(total) : 0.0);
     gap_voltage_v.set(opens > 0 ? 100.0 : 40.0);
-    x_mm.set(x_);
-    y_mm.set(y_);
-    z_mm.set(z_);
+    pos.x().set(x_);
+    pos.y().set(y_);
+    pos.z().set(z_);
     contact.set(gap_um <= 0.0);
   }
   void write_outputs(const rt::CycleContext& ctx) noexcept override {
     if (rt::is_safe_state(ctx.state)) {
       return;  // axes stopped
     }
-    x_ += vx_cmd.get() * ctx.dt_s;
-    y_ += vy_cmd.get() * ctx.dt_s;
-    z_ += vz_cmd.get() * ctx.dt_s;
+    x_ += v_cmd.x().get() * ctx.dt_s;
+    y_ += v_cmd.y().get() * ctx.dt_s;
+    z_ += v_cmd.z().get() * ctx.dt_s;
     if (sparking_) {
       surface_z_ -= 0.01 * ctx.dt_s;
     }
@@ -104,17 +105,11 @@ class BenchGapDriver final : public rt::IoDriver {
   rt::Output<std::int64_t> n_short{pins_, "n_short"};
   rt::Output<double> ratio_short{pins_, "ratio_short", "1"};
   rt::Output<double> gap_voltage_v{pins_, "gap_voltage_v", "V"};
-  rt::Output<double> x_mm{pins_, "x_mm", "mm"};
-  rt::Output<double> y_mm{pins_, "y_mm", "mm"};
-  rt::Output<double> z_mm{pins_, "z_mm", "mm"};
+  rt::Xyz<rt::Output<double>> pos{pins_, {"x_mm", "y_mm", "z_mm"}, "mm"};
   rt::Output<double> electrode_mm{pins_, "electrode_mm", "mm", 300.0};
-  rt::Output<bool> ref_x{pins_, "ref_x"};
-  rt::Output<bool> ref_y{pins_, "ref_y"};
-  rt::Output<bool> ref_z{pins_, "ref_z"};
+  rt::Xyz<rt::Output<bool>> ref{pins_, {"ref_x", "ref_y", "ref_z"}};
   rt::Output<bool> contact{pins_, "contact"};
-  rt::Input<double> vx_cmd{pins_, "vx_cmd", "mm/s"};
-  rt::Input<double> vy_cmd{pins_, "vy_cmd", "mm/s"};
-  rt::Input<double> vz_cmd{pins_, "vz_cmd", "mm/s"};
+  rt::Xyz<rt::Input<double>> v_cmd{pins_, {"vx_cmd", "vy_cmd", "vz_cmd"}, "mm/s"};
   rt::Input<bool> gen_arm{pins_, "gen_arm"};
   rt::Input<bool> gen_on{pins_, "gen_on"};
   rt::Input<bool> polarity_positive{pins_, "polarity_positive"};
@@ -124,12 +119,9 @@ class BenchGapDriver final : public rt::IoDriver {
   rt::Input<bool> flushing_on{pins_, "flushing_on"};
   rt::Input<bool> rotation_on{pins_, "rotation_on"};
   rt::Input<bool> touch_mode{pins_, "touch_mode"};
-  rt::Input<bool> pos_set_x{pins_, "pos_set_x"};
-  rt::Input<bool> pos_set_y{pins_, "pos_set_y"};
-  rt::Input<bool> pos_set_z{pins_, "pos_set_z"};
-  rt::Input<double> pos_value_x_mm{pins_, "pos_value_x_mm", "mm"};
-  rt::Input<double> pos_value_y_mm{pins_, "pos_value_y_mm", "mm"};
-  rt::Input<double> pos_value_z_mm{pins_, "pos_value_z_mm", "mm"};
+  rt::Xyz<rt::Input<bool>> pos_set{pins_, {"pos_set_x", "pos_set_y", "pos_set_z"}};
+  rt::Xyz<rt::Input<double>> pos_value{
+      pins_, {"pos_value_x_mm", "pos_value_y_mm", "pos_value_z_mm"}, "mm"};
 
  private:
   double x_{0.0}, y_{0.0}, z_{5.0};  // the demo starts clear of the work

@@ -16,7 +16,7 @@ void LinearInterpolator::activate() noexcept {
 }
 
 bool LinearInterpolator::load_position() noexcept {
-  const Vec3 p{load_x_mm.get(), load_y_mm.get(), load_z_mm.get()};
+  const Vec3 p{load_pos.x().get(), load_pos.y().get(), load_pos.z().get()};
   if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
     return false;
   }
@@ -25,7 +25,7 @@ bool LinearInterpolator::load_position() noexcept {
 }
 
 bool LinearInterpolator::latch_move() noexcept {
-  const Vec3 l{lx_mm.get(), ly_mm.get(), lz_mm.get()};
+  const Vec3 l{length.x().get(), length.y().get(), length.z().get()};
   const double feed_mm_min_now = feed_mm_min.get();
   if (!std::isfinite(l[0]) || !std::isfinite(l[1]) || !std::isfinite(l[2]) ||
       !std::isfinite(feed_mm_min_now)) {
@@ -79,12 +79,10 @@ void LinearInterpolator::advance(double ds_mm) noexcept {
 }
 
 void LinearInterpolator::publish(const Vec3& v_mm_s) noexcept {
-  rx_mm.set(pos_[0]);
-  ry_mm.set(pos_[1]);
-  rz_mm.set(pos_[2]);
-  vx_mm_s.set(v_mm_s[0]);
-  vy_mm_s.set(v_mm_s[1]);
-  vz_mm_s.set(v_mm_s[2]);
+  for (std::size_t a = 0; a < rt::kAxes; ++a) {
+    ref_pos[a].set(pos_[a]);
+    vel[a].set(v_mm_s[a]);
+  }
   busy.set(busy_state_);
   done.set(done_state_);
 }

@@ -73,30 +73,32 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
 void EdmJob::bind_self() {
   pulses.feed(drill_.pulses);
   pulses.feed(finish_.pulses);
-  drill_.z_mm.follow(z_mm);
-  manual_.x_mm.follow(x_mm);
-  manual_.y_mm.follow(y_mm);
-  manual_.z_mm.follow(z_mm);
-  finish_.x_mm.follow(x_mm);
-  finish_.y_mm.follow(y_mm);
-  px_.x_mm.follow(x_mm);
-  py_.x_mm.follow(y_mm);
-  pz_.x_mm.follow(z_mm);
+  drill_.z_mm.follow(pos.z());
+  for (std::size_t a = 0; a < rt::kAxes; ++a) manual_.pos[a].follow(pos[a]);
+  finish_.x_mm.follow(pos.x());
+  finish_.y_mm.follow(pos.y());
+  px_.x_mm.follow(pos.x());
+  py_.x_mm.follow(pos.y());
+  pz_.x_mm.follow(pos.z());
   // The axes: manual motion and the loops by wire, the cycles' claims driven (command_axes()).
   axes_.manual.connect(manual_.active);
-  axes_.manual_vx_mm_s.connect(manual_.vx_cmd_mm_s);
-  axes_.manual_vy_mm_s.connect(manual_.vy_cmd_mm_s);
-  axes_.manual_vz_mm_s.connect(manual_.vz_cmd_mm_s);
-  axes_.loop_vx_mm_s.connect(px_.v_cmd_mm_s);
-  axes_.loop_vy_mm_s.connect(py_.v_cmd_mm_s);
-  axes_.loop_vz_mm_s.connect(pz_.v_cmd_mm_s);
+  for (std::size_t a = 0; a < rt::kAxes; ++a) axes_.manual_v[a].connect(manual_.v_cmd[a]);
+  axes_.loop_v.x().connect(px_.v_cmd_mm_s);
+  axes_.loop_v.y().connect(py_.v_cmd_mm_s);
+  axes_.loop_v.z().connect(pz_.v_cmd_mm_s);
   // Everything else a child reads is driven by the sequence (Input::drive), as an IEC 61131-3
   // FB call passes its parameters: no output of this block exists only to feed a child.
   for (rt::Input<bool>* in :
        {&drill_.start, &drill_.hold, &finish_.start, &finish_.hold, &manual_.enable, &lin_.start,
         &lin_.hold, &lin_.load, &arc_.start, &arc_.hold, &arc_.load, &arc_.cw, &arc_.full_circle,
-        &px_.enable, &py_.enable, &pz_.enable, &axes_.cycle_x, &axes_.cycle_y, &axes_.cycle_z}) {
+        &px_.enable, &py_.enable, &pz_.enable}) {
     in->claim();
+  }
+  for (std::size_t a = 0; a < rt::kAxes; ++a) {
+    axes_.cycle[a].claim();
+    axes_.cycle_v[a].claim();
+    lin_.load_pos[a].claim();
+    lin_.length[a].claim();
   }
   for (rt::Input<double>* in : {&drill_.depth_mm,
                                 &drill_.depth_done_mm,
@@ -110,12 +112,6 @@ void EdmJob::bind_self() {
                                 &finish_.final_offset_mm,
                                 &finish_.start_offset_mm,
                                 &finish_.feed_mm_min,
-                                &lin_.load_x_mm,
-                                &lin_.load_y_mm,
-                                &lin_.load_z_mm,
-                                &lin_.lx_mm,
-                                &lin_.ly_mm,
-                                &lin_.lz_mm,
                                 &lin_.feed_mm_min,
                                 &arc_.load_x_mm,
                                 &arc_.load_y_mm,
@@ -129,10 +125,7 @@ void EdmJob::bind_self() {
                                 &pz_.x_ref_mm,
                                 &px_.v_ff_mm_s,
                                 &py_.v_ff_mm_s,
-                                &pz_.v_ff_mm_s,
-                                &axes_.cycle_vx_mm_s,
-                                &axes_.cycle_vy_mm_s,
-                                &axes_.cycle_vz_mm_s}) {
+                                &pz_.v_ff_mm_s}) {
     in->claim();
   }
   for (rt::Input<double>* in :
@@ -145,9 +138,9 @@ void EdmJob::bind_self() {
 void EdmJob::activate_self() noexcept {
   state_value_ = State::kIdle;
   still_cycles_ = 0;
-  last_x_ = x_mm.get();
-  last_y_ = y_mm.get();
-  last_z_ = z_mm.get();
+  last_x_ = pos.x().get();
+  last_y_ = pos.y().get();
+  last_z_ = pos.z().get();
   hold_valid_ = false;
   step_ = Step::kEnter;
   condition_ = nullptr;
@@ -164,17 +157,18 @@ rt::BlockStatus EdmJob::command_axes(const rt::CycleContext& ctx) noexcept {
   AxisClaim claim;
   for (const MachiningCycle* c : cycles_) {
     if (!c->running()) continue;
-    const AxisClaim a = c->axes();
-    if (a.x && !claim.x) claim.x = true, claim.vx_mm_s = a.vx_mm_s;
-    if (a.y && !claim.y) claim.y = true, claim.vy_mm_s = a.vy_mm_s;
-    if (a.z && !claim.z) claim.z = true, claim.vz_mm_s = a.vz_mm_s;
+    const AxisClaim c_axes = c->axes();
+    for (std::size_t a = 0; a < rt::kAxes; ++a) {
+      if (c_axes.claimed[a] && !claim.claimed[a]) {  // the first running cycle's claim wins
+        claim.claimed[a] = true;
+        claim.v_mm_s[a] = c_axes.v_mm_s[a];
+      }
+    }
   }
-  axes_.cycle_x.drive(claim.x);
-  axes_.cycle_y.drive(claim.y);
-  axes_.cycle_z.drive(claim.z);
-  axes_.cycle_vx_mm_s.drive(claim.vx_mm_s);
-  axes_.cycle_vy_mm_s.drive(claim.vy_mm_s);
-  axes_.cycle_vz_mm_s.drive(claim.vz_mm_s);
+  for (std::size_t a = 0; a < rt::kAxes; ++a) {
+    axes_.cycle[a].drive(claim.claimed[a]);
+    axes_.cycle_v[a].drive(claim.v_mm_s[a]);
+  }
   return step(axes_, ctx);
 }
 
@@ -249,12 +243,12 @@ void EdmJob::set_reference(double x, double y, double z, double vx, double vy, d
 void EdmJob::hold_position() noexcept { set_reference(hold_x_, hold_y_, hold_z_, 0.0, 0.0, 0.0); }
 
 void EdmJob::set_move_from() noexcept {
-  move_from_x_ = hold_valid_ ? hold_x_ : x_mm.get();
-  move_from_y_ = hold_valid_ ? hold_y_ : y_mm.get();
-  move_from_z_ = hold_valid_ ? hold_z_ : z_mm.get();
-  lin_.load_x_mm.drive(move_from_x_);
-  lin_.load_y_mm.drive(move_from_y_);
-  lin_.load_z_mm.drive(move_from_z_);
+  move_from_x_ = hold_valid_ ? hold_x_ : pos.x().get();
+  move_from_y_ = hold_valid_ ? hold_y_ : pos.y().get();
+  move_from_z_ = hold_valid_ ? hold_z_ : pos.z().get();
+  lin_.load_pos.x().drive(move_from_x_);
+  lin_.load_pos.y().drive(move_from_y_);
+  lin_.load_pos.z().drive(move_from_z_);
   arc_.load_x_mm.drive(move_from_x_);
   arc_.load_y_mm.drive(move_from_y_);
 }
@@ -271,9 +265,9 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
   }
   if (step_ == Step::kLoad) {
     lin_.load.drive(false);
-    lin_.lx_mm.drive(b.target.x - move_from_x_);
-    lin_.ly_mm.drive(b.target.y - move_from_y_);
-    lin_.lz_mm.drive(b.target.z - move_from_z_);
+    lin_.length.x().drive(b.target.x - move_from_x_);
+    lin_.length.y().drive(b.target.y - move_from_y_);
+    lin_.length.z().drive(b.target.z - move_from_z_);
     const double f = b.kind == MotionKind::kRapid
                          ? params_.rapid_speed_mm_s
                          : (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s);
@@ -288,11 +282,11 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
   lin_.feed_override.drive(b.kind == MotionKind::kRapid ? std::min(feed_override_, 1.0)
                                                         : feed_override_);
   status = rt::worst(status, step(lin_, ctx));
-  set_reference(lin_.rx_mm.get(), lin_.ry_mm.get(), lin_.rz_mm.get(), lin_.vx_mm_s.get(),
-                lin_.vy_mm_s.get(), lin_.vz_mm_s.get());
-  hold_x_ = lin_.rx_mm.get();
-  hold_y_ = lin_.ry_mm.get();
-  hold_z_ = lin_.rz_mm.get();
+  set_reference(lin_.ref_pos.x().get(), lin_.ref_pos.y().get(), lin_.ref_pos.z().get(),
+                lin_.vel.x().get(), lin_.vel.y().get(), lin_.vel.z().get());
+  hold_x_ = lin_.ref_pos.x().get();
+  hold_y_ = lin_.ref_pos.y().get();
+  hold_z_ = lin_.ref_pos.z().get();
   return step_ == Step::kBusy && lin_.done.get() && !lin_.start.driven() && in_position();
 }
 
@@ -348,8 +342,8 @@ bool EdmJob::run_finish(const MotionBlock& b, bool hold) noexcept {
   set_hold(hold);
   const bool done = finish_.state.get() == static_cast<std::int64_t>(WallFinish::State::kDone);
   if (done) {
-    hold_x_ = x_mm.get();
-    hold_y_ = y_mm.get();
+    hold_x_ = pos.x().get();
+    hold_y_ = pos.y().get();
     polarity_positive_value_ = finish_.polarity_positive.get();
   }
   return done;
@@ -402,7 +396,7 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
        {&drill_.feed_override, &finish_.feed_override, &arc_.feed_override}) {
     in->drive(feed_override_);
   }
-  const double x = x_mm.get(), y = y_mm.get(), z = z_mm.get();
+  const double x = pos.x().get(), y = pos.y().get(), z = pos.z().get();
   const double still_mm = kStillSpeedMmS * ctx.dt_s;
   const bool still = std::abs(x - last_x_) <= still_mm && std::abs(y - last_y_) <= still_mm &&
                      std::abs(z - last_z_) <= still_mm;

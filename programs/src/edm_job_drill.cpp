@@ -39,9 +39,9 @@ class EdmJob::ProbeMovesOfJob final : public ProbeMoves {
 
   bool touch(bool begin, bool& ok, double& z) noexcept override {
     // The touch drives the axes; the loops follow where they are (no error builds up in them).
-    job_.hold_x_ = job_.x_mm.get();
-    job_.hold_y_ = job_.y_mm.get();
-    job_.hold_z_ = job_.z_mm.get();
+    job_.hold_x_ = job_.pos.x().get();
+    job_.hold_y_ = job_.pos.y().get();
+    job_.hold_z_ = job_.pos.z().get();
     job_.hold_position();
     if (begin) {
       if (!job_.manual_.begin_job_touch_z(ctx_)) {
@@ -76,7 +76,7 @@ void EdmJob::start_drill(double depth_mm, const DrillFrom& from) noexcept {
   drill_.contact_depth_mm.drive(from.contact_depth_mm);
   drill_.depth_mm.drive(depth_mm);
   drill_.start.drive(true);
-  probe_.drilling_at(z_mm.get(), true);
+  probe_.drilling_at(pos.z().get(), true);
 }
 
 bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
@@ -87,7 +87,7 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     const DepthProbe::End end = probe_.run(moves, hold_x_, hold_y_, drill_.wear_mm.get());
     if (end.measured) figures_.note_measured(end.depth_mm);
     if (end.over) {
-      hold_z_ = z_mm.get();
+      hold_z_ = pos.z().get();
       drill_returning_ = true;  // back to where the block began, as a rapid
       step_ = Step::kEnter;
     }
@@ -99,7 +99,7 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     drill_return_.kind = MotionKind::kRapid;
     drill_return_.line = b.line;
     drill_return_.col = b.col;
-    drill_return_.target = {x_mm.get(), y_mm.get(), z_mm.get()};
+    drill_return_.target = {pos.x().get(), pos.y().get(), pos.z().get()};
     figures_.begin_drill_block();
     const double depth = b.depth_mm > 0.0 ? b.depth_mm : -b.target.z;
     // A resumed hole counts on from its interrupted drill (the rough drilling too).
@@ -108,7 +108,7 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
                          .resume_wear_mm = b.resume_wear_mm};
     probe_.stop();
     if (probe_.params().enable && manual_.contact.connected()) {
-      start_drill(probe_.begin(hold_x_, hold_y_, z_mm.get(), depth), from);
+      start_drill(probe_.begin(hold_x_, hold_y_, pos.z().get(), depth), from);
     } else {
       start_drill(depth, from);
     }
@@ -117,12 +117,12 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
   }
   drill_.start.drive(false);
   set_hold(hold);
-  if (drill_.state.get() == kDrilling) probe_.drilling_at(z_mm.get(), false);
+  if (drill_.state.get() == kDrilling) probe_.drilling_at(pos.z().get(), false);
   figures_.note_drill(drill_.depth_reached_mm.get(),
                       probe_.wear_before_mm() + drill_.wear_mm.get());
   if (drill_.state.get() != kDone) return false;
   // Retracted out of the hole.
-  hold_z_ = z_mm.get();
+  hold_z_ = pos.z().get();
   if (probe_.drill_done(drill_.wear_mm.get(), drill_.touch_z_mm.get(),
                         drill_.depth_reached_mm.get())) {
     return false;  // the probe's moves follow

@@ -102,7 +102,7 @@ void ManualMotion::bind() {
   // After the YAML wiring: what is wired says what this machine can do.
   rt::ManualInfo info;
   info.available = true;
-  info.home = ref_x.connected() || ref_y.connected() || ref_z.connected();
+  info.home = any_switch_wired();
   info.touch = contact.connected();
   info.reference_required = params_.reference_required;
   info.deadman_ms = rt::to_seconds(params_.deadman) * 1e3;
@@ -118,9 +118,7 @@ void ManualMotion::activate() noexcept {
   status_ = {};
   stop_outputs();
   mode.set(0);
-  pos_set_x.set(false);
-  pos_set_y.set(false);
-  pos_set_z.set(false);
+  for (rt::Output<bool>& set : pos_set) set.set(false);
   if (manual_ != nullptr) {
     // Requests made before the first cycle are old news.
     rt::ManualRequest r;
@@ -144,9 +142,7 @@ void ManualMotion::enter_safe_state(const rt::SafeStateRequest& /*request*/) noe
 void ManualMotion::stop_outputs() noexcept {
   active.set(false);
   touch_mode.set(false);
-  vx_cmd_mm_s.set(0.0);
-  vy_cmd_mm_s.set(0.0);
-  vz_cmd_mm_s.set(0.0);
+  for (rt::Output<double>& v : v_cmd) v.set(0.0);
 }
 
 void ManualMotion::end_operation(bool ok, ManualError e, double t_s) noexcept {
@@ -162,12 +158,16 @@ void ManualMotion::end_operation(bool ok, ManualError e, double t_s) noexcept {
   status_.mode = ManualMode::kIdle;
 }
 
-double ManualMotion::pos(int axis) const noexcept {
-  return axis == 0 ? x_mm.get() : axis == 1 ? y_mm.get() : z_mm.get();
+double ManualMotion::axis_mm(int axis) const noexcept {
+  return pos[static_cast<std::size_t>(axis)].get();
 }
 
 bool ManualMotion::switch_on(int axis) const noexcept {
-  return axis == 0 ? ref_x.get() : axis == 1 ? ref_y.get() : ref_z.get();
+  return ref[static_cast<std::size_t>(axis)].get();
+}
+
+bool ManualMotion::any_switch_wired() const noexcept {
+  return ref.x().connected() || ref.y().connected() || ref.z().connected();
 }
 
 bool ManualMotion::is_referenced(int axis) const noexcept {
@@ -196,7 +196,7 @@ void ManualMotion::begin_move(int axis, double target, double speed) noexcept {
 }
 
 void ManualMotion::stop_now() noexcept {
-  prof_.pos = pos(axis_);
+  prof_.pos = axis_mm(axis_);
   prof_.vel = 0.0;
   prof_.target = prof_.pos;
   prof_.done = true;
@@ -222,15 +222,11 @@ void ManualMotion::step_profile(double dt) noexcept {
 
 void ManualMotion::command_axes() noexcept {
   const double kp = params_.kp_per_s;
-  double v[3];
   for (int k = 0; k < 3; ++k) {
-    const double ref = k == axis_ ? prof_.pos : hold_[k];
+    const double target = k == axis_ ? prof_.pos : hold_[k];
     const double ff = k == axis_ ? prof_.vel : 0.0;
-    v[k] = ff + kp * (ref - pos(k));
+    v_cmd[static_cast<std::size_t>(k)].set(ff + kp * (target - axis_mm(k)));
   }
-  vx_cmd_mm_s.set(v[0]);
-  vy_cmd_mm_s.set(v[1]);
-  vz_cmd_mm_s.set(v[2]);
 }
 
 void ManualMotion::finish(bool ok, ManualError e, const rt::CycleContext& ctx) noexcept {
@@ -273,7 +269,7 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
   status_.result = {};
   status_.result.seq = 0;
   if (was_idle) {
-    for (int k = 0; k < 3; ++k) hold_[k] = pos(k);
+    for (int k = 0; k < 3; ++k) hold_[k] = axis_mm(k);
     axis_ = 0;
     prof_ = {};
     prof_.pos = hold_[0];
@@ -330,7 +326,7 @@ void ManualMotion::start(const rt::ManualRequest& r, const rt::CycleContext& ctx
       break;
     }
     case ManualOp::kHome:
-      if (!(ref_x.connected() || ref_y.connected() || ref_z.connected())) {
+      if (!any_switch_wired()) {
         finish(false, ManualError::kNotAvailable, ctx);
         return;
       }
@@ -365,8 +361,7 @@ void ManualMotion::next_home_axis(const rt::CycleContext& ctx) noexcept {
   while (home_next_ < params_.home_order.size()) {
     const int a = axis_of(params_.home_order[home_next_++]);
     if (a < 0 || (home_todo_ >> a & 1U) == 0) continue;
-    const bool wired = a == 0 ? ref_x.connected() : a == 1 ? ref_y.connected() : ref_z.connected();
-    if (!wired) {
+    if (!ref[static_cast<std::size_t>(a)].connected()) {
       finish(false, ManualError::kNotAvailable, ctx);
       return;
     }
@@ -376,15 +371,13 @@ void ManualMotion::next_home_axis(const rt::CycleContext& ctx) noexcept {
     return;
   }
   finish(true, ManualError::kNone, ctx);
-  status_.result.x = x_mm.get();
-  status_.result.y = y_mm.get();
-  status_.result.z = z_mm.get();
+  status_.result.x = pos.x().get();
+  status_.result.y = pos.y().get();
+  status_.result.z = pos.z().get();
 }
 
 rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
-  pos_set_x.set(false);
-  pos_set_y.set(false);
-  pos_set_z.set(false);
+  for (rt::Output<bool>& set : pos_set) set.set(false);
   if (manual_ == nullptr) return rt::BlockStatus::kOk;
 
   const bool ready = enable.get() || job_op_;
@@ -419,9 +412,7 @@ rt::BlockStatus ManualMotion::update(const rt::CycleContext& ctx) noexcept {
 
   advance(ctx);
   if (step_ == Step::kHomeSettle) {  // the readings jump: no position correction now
-    vx_cmd_mm_s.set(0.0);
-    vy_cmd_mm_s.set(0.0);
-    vz_cmd_mm_s.set(0.0);
+    for (rt::Output<double>& v : v_cmd) v.set(0.0);
   } else if (step_ != Step::kIdle) {
     command_axes();
   }

@@ -79,8 +79,8 @@ void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
         const double v = axis_ == 0   ? params_.home_x_mm
                          : axis_ == 1 ? params_.home_y_mm
                                       : params_.home_z_mm;
-        (axis_ == 0 ? pos_value_x_mm : axis_ == 1 ? pos_value_y_mm : pos_value_z_mm).set(v);
-        (axis_ == 0 ? pos_set_x : axis_ == 1 ? pos_set_y : pos_set_z).set(true);
+        pos_value[static_cast<std::size_t>(axis_)].set(v);
+        pos_set[static_cast<std::size_t>(axis_)].set(true);
         settle_cycles_ = 0;
         step_ = Step::kHomeSettle;
       } else {
@@ -94,7 +94,7 @@ void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
       if (++settle_cycles_ >= 2) {
         manual_->bump_position_epoch();
         manual_->set_referenced(axis_);
-        for (int k = 0; k < 3; ++k) hold_[k] = pos(k);
+        for (int k = 0; k < 3; ++k) hold_[k] = axis_mm(k);
         stop_now();
         next_home_axis(ctx);
       } else if (settle_cycles_ == 1) {
@@ -105,9 +105,9 @@ void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
       // The mechanics follow the reference with a lag: the operation ends when every axis has
       // stood within kInPositionMm of its reference for kInPositionCycles (or after
       // kSettleLimit, whichever is first), so a jog's distance or a touch's return is exact.
-      bool in = std::abs(prof_.pos - pos(axis_)) <= kInPositionMm;
+      bool in = std::abs(prof_.pos - axis_mm(axis_)) <= kInPositionMm;
       for (int k = 0; k < 3; ++k) {
-        if (k != axis_) in = in && std::abs(hold_[k] - pos(k)) <= kInPositionMm;
+        if (k != axis_) in = in && std::abs(hold_[k] - axis_mm(k)) <= kInPositionMm;
       }
       settle_cycles_ = in ? settle_cycles_ + 1 : 0;
       if (settle_cycles_ >= kInPositionCycles || ctx.release >= settle_until_) {
@@ -150,7 +150,7 @@ void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
       break;
     case Step::kTouchSlow:
       if (contact.get()) {
-        found_ = pos(axis_);
+        found_ = axis_mm(axis_);
         stop_now();
         begin_move(axis_, prof_.pos - side_ * params_.touch_back_off_mm, params_.touch_fast_mm_s);
         step_ = Step::kTouchOff;
@@ -194,7 +194,7 @@ void ManualMotion::advance(const rt::CycleContext& ctx) noexcept {
           const double radius = 0.5 * params_.electrode_d_mm;
           status_.result.x = 0.5 * (contact_[0] + contact_[1]);
           status_.result.y = 0.5 * (contact_[2] + contact_[3]);
-          status_.result.z = z_mm.get();
+          status_.result.z = pos.z().get();
           // The Y pair is touched at the X centre: a true diameter (the X pair may be a chord).
           status_.result.size = (contact_[2] + radius) - (contact_[3] - radius);
         } else {
@@ -229,9 +229,9 @@ void ManualMotion::next_touch(const rt::CycleContext& ctx) noexcept {
   const double r = 0.5 * params_.electrode_d_mm;
   if (req_.target != TouchTarget::kCenter) {
     finish_settled(true, ManualError::kNone, ctx);
-    status_.result.x = x_mm.get();
-    status_.result.y = y_mm.get();
-    status_.result.z = z_mm.get();
+    status_.result.x = pos.x().get();
+    status_.result.y = pos.y().get();
+    status_.result.z = pos.z().get();
     switch (req_.target) {
       case TouchTarget::kZ: status_.result.z = found_; break;
       case TouchTarget::kXPlus: status_.result.x = found_ + r; break;

@@ -1,6 +1,7 @@
 // Named pins: a pin declared with its owner's table lists itself there, once, with its unit and
 // in declaration order; its default value still holds; a group of pins (PulseInputs-style)
-// constructed on the owner's table lists with the owner's own pins.
+// constructed on the owner's table lists with the owner's own pins; an axis triple (Xyz) lists its
+// three pins in X, Y, Z order, each the very element the block indexes.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/pin.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::rt {
 namespace {
@@ -69,6 +71,41 @@ TEST(PinTable, TheListedReferenceIsTheMemberItself) {
   EXPECT_EQ(r.refs[4].as_output<double>(), &block.v);
   block.v.set(7.0);
   EXPECT_DOUBLE_EQ(read_pin_as_double(r.refs[4]), 7.0);
+}
+
+class Axes final : public Block {
+ public:
+  BlockStatus update(const CycleContext& /*ctx*/) noexcept override { return BlockStatus::kOk; }
+
+  Input<bool> enable{pins_, "enable"};
+  Xyz<Input<double>> pos{pins_, {"x_mm", "y_mm", "z_mm"}, "mm"};
+  Xyz<Output<bool>> set{pins_, {"set_x", "set_y", "set_z"}};
+};
+
+TEST(PinTable, AnAxisTripleListsXYZInOrderAndEachListedPinIsTheElementIndexed) {
+  struct Refs final : PinVisitor {
+    std::vector<std::string> rows;
+    std::vector<PinRef> refs;
+    void on_pin(std::string_view name, PinRef ref, std::string_view unit) override {
+      rows.push_back(std::string(name) + " [" + std::string(unit) + "]");
+      refs.push_back(ref);
+    }
+  } r;
+  Axes block;
+  block.visit_pins(r);
+  const std::vector<std::string> expected = {"enable []", "x_mm [mm]", "y_mm [mm]", "z_mm [mm]",
+                                             "set_x []",  "set_y []",  "set_z []"};
+  ASSERT_EQ(r.rows, expected);
+  for (std::size_t a = 0; a < kAxes; ++a) {
+    EXPECT_EQ(r.refs[1 + a].as_input<double>(), &block.pos[a]) << a;
+    EXPECT_EQ(r.refs[4 + a].as_output<bool>(), &block.set[a]) << a;
+  }
+  EXPECT_EQ(&block.pos.z(), &block.pos[kAxisZ]);
+  // A write through the table is what the block reads on that axis, and on no other.
+  block.set.y().set(true);
+  EXPECT_DOUBLE_EQ(read_pin_as_double(r.refs[5]), 1.0);
+  EXPECT_DOUBLE_EQ(read_pin_as_double(r.refs[4]), 0.0);
+  EXPECT_DOUBLE_EQ(read_pin_as_double(r.refs[6]), 0.0);
 }
 
 }  // namespace

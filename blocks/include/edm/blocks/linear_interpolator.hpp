@@ -28,6 +28,7 @@
 #include "edm/blocks/move_interpolator.hpp"
 #include "edm/blocks/param_ranges.hpp"
 #include "edm/runtime/block.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::blocks {
 
@@ -50,18 +51,10 @@ class LinearInterpolator final : public MoveInterpolator<LinearInterpolatorParam
 
   // Pins (listed in declaration order; start, feed_mm_min, override, hold, load, busy and done are
   // MoveInterpolator's): a C++ PROGRAM connects them by member.
-  rt::Input<double> lx_mm{pins_, "lx_mm", "mm"};
-  rt::Input<double> ly_mm{pins_, "ly_mm", "mm"};
-  rt::Input<double> lz_mm{pins_, "lz_mm", "mm"};
-  rt::Input<double> load_x_mm{pins_, "load_x_mm", "mm"};
-  rt::Input<double> load_y_mm{pins_, "load_y_mm", "mm"};
-  rt::Input<double> load_z_mm{pins_, "load_z_mm", "mm"};
-  rt::Output<double> rx_mm{pins_, "rx_mm", "mm"};
-  rt::Output<double> ry_mm{pins_, "ry_mm", "mm"};
-  rt::Output<double> rz_mm{pins_, "rz_mm", "mm"};
-  rt::Output<double> vx_mm_s{pins_, "vx_mm_s", "mm/s"};
-  rt::Output<double> vy_mm_s{pins_, "vy_mm_s", "mm/s"};
-  rt::Output<double> vz_mm_s{pins_, "vz_mm_s", "mm/s"};
+  rt::Xyz<rt::Input<double>> length{pins_, {"lx_mm", "ly_mm", "lz_mm"}, "mm"};  // L
+  rt::Xyz<rt::Input<double>> load_pos{pins_, {"load_x_mm", "load_y_mm", "load_z_mm"}, "mm"};
+  rt::Xyz<rt::Output<double>> ref_pos{pins_, {"rx_mm", "ry_mm", "rz_mm"}, "mm"};  // R
+  rt::Xyz<rt::Output<double>> vel{pins_, {"vx_mm_s", "vy_mm_s", "vz_mm_s"}, "mm/s"};
 
  private:
   using Vec3 = std::array<double, 3>;

@@ -14,11 +14,13 @@
 //                              holds still: owner 0.
 // Inputs: manual (manual.active) and manual_v*, loop_v* are connected to the children's outputs
 // by the job; cycle_* are driven by the job from its running cycles (MachiningCycle::axes()).
-// Outputs owner_x/y/z show the decision. RT-safe update(); no parameters.
+// Outputs owner_x/y/z show the decision. The pins are axis triples (rt::Xyz, xyz_pins.hpp). RT-safe
+// update(); no parameters.
 
 #include <cstdint>
 
 #include "edm/runtime/block.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::programs {
 
@@ -27,39 +29,19 @@ class AxisArbiter final : public rt::Block {
   enum Owner : std::int64_t { kMove = 0, kCycle = 1, kManual = 2, kStopped = 3 };
 
   rt::Input<bool> manual{pins_, "manual"};
-  rt::Input<double> manual_vx_mm_s{pins_, "manual_vx_mm_s", "mm/s"};
-  rt::Input<double> manual_vy_mm_s{pins_, "manual_vy_mm_s", "mm/s"};
-  rt::Input<double> manual_vz_mm_s{pins_, "manual_vz_mm_s", "mm/s"};
-  rt::Input<bool> cycle_x{pins_, "cycle_x"};
-  rt::Input<bool> cycle_y{pins_, "cycle_y"};
-  rt::Input<bool> cycle_z{pins_, "cycle_z"};
-  rt::Input<double> cycle_vx_mm_s{pins_, "cycle_vx_mm_s", "mm/s"};
-  rt::Input<double> cycle_vy_mm_s{pins_, "cycle_vy_mm_s", "mm/s"};
-  rt::Input<double> cycle_vz_mm_s{pins_, "cycle_vz_mm_s", "mm/s"};
-  rt::Input<double> loop_vx_mm_s{pins_, "loop_vx_mm_s", "mm/s"};
-  rt::Input<double> loop_vy_mm_s{pins_, "loop_vy_mm_s", "mm/s"};
-  rt::Input<double> loop_vz_mm_s{pins_, "loop_vz_mm_s", "mm/s"};
-  rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
-  rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
-  rt::Output<double> vz_cmd_mm_s{pins_, "vz_cmd_mm_s", "mm/s"};
-  rt::Output<std::int64_t> owner_x{pins_, "owner_x"};
-  rt::Output<std::int64_t> owner_y{pins_, "owner_y"};
-  rt::Output<std::int64_t> owner_z{pins_, "owner_z"};
+  rt::Xyz<rt::Input<double>> manual_v{
+      pins_, {"manual_vx_mm_s", "manual_vy_mm_s", "manual_vz_mm_s"}, "mm/s"};
+  rt::Xyz<rt::Input<bool>> cycle{pins_, {"cycle_x", "cycle_y", "cycle_z"}};
+  rt::Xyz<rt::Input<double>> cycle_v{
+      pins_, {"cycle_vx_mm_s", "cycle_vy_mm_s", "cycle_vz_mm_s"}, "mm/s"};
+  rt::Xyz<rt::Input<double>> loop_v{
+      pins_, {"loop_vx_mm_s", "loop_vy_mm_s", "loop_vz_mm_s"}, "mm/s"};
+  rt::Xyz<rt::Output<double>> v_cmd{pins_, {"vx_cmd_mm_s", "vy_cmd_mm_s", "vz_cmd_mm_s"}, "mm/s"};
+  rt::Xyz<rt::Output<std::int64_t>> owner{pins_, {"owner_x", "owner_y", "owner_z"}};
 
   void activate() noexcept override;
   void enter_safe_state(const rt::SafeStateRequest& request) noexcept override;
   rt::BlockStatus update(const rt::CycleContext& ctx) noexcept override;
-
- private:
-  struct Axis {
-    const rt::Input<bool>& cycle;
-    const rt::Input<double>& cycle_v;
-    const rt::Input<double>& manual_v;
-    const rt::Input<double>& loop_v;
-    rt::Output<double>& cmd;
-    rt::Output<std::int64_t>& owner;
-  };
-  static void decide(const Axis& a, bool safe, bool manual_active) noexcept;
 };
 
 }  // namespace edm::programs

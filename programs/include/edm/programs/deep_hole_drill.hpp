@@ -151,9 +151,7 @@ class DeepHoleDrill final : public rt::BlockWithParams<DeepHoleDrillParams, rt::
   [[nodiscard]] bool running() const noexcept override {
     return state_value_ != State::kIdle && state_value_ != State::kDone;
   }
-  [[nodiscard]] AxisClaim axes() const noexcept override {
-    return {.z = true, .vz_mm_s = vz_cmd_mm_s.get()};
-  }
+  [[nodiscard]] AxisClaim axes() const noexcept override { return AxisClaim::z(vz_cmd_mm_s.get()); }
   [[nodiscard]] bool generator_on() const noexcept override { return gen_on.get(); }
   enum class State : std::int64_t {
     kIdle = 0,

@@ -93,6 +93,7 @@
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 #include "edm/runtime/job.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::programs {
 
@@ -116,9 +117,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Input<std::int64_t> n_normal{pins_, "n_normal"};
   rt::Input<std::int64_t> n_transient_arc{pins_, "n_transient_arc"};
   rt::Input<std::int64_t> n_stable_arc{pins_, "n_stable_arc"};
-  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
-  rt::Input<double> y_mm{pins_, "y_mm", "mm"};
-  rt::Input<double> z_mm{pins_, "z_mm", "mm"};
+  rt::Xyz<rt::Input<double>> pos{pins_, {"x_mm", "y_mm", "z_mm"}, "mm"};
   rt::Output<bool> gen_arm{pins_, "gen_arm"};
   rt::Output<bool> gen_on{pins_, "gen_on"};
   rt::Output<bool> polarity_positive{pins_, "polarity_positive"};

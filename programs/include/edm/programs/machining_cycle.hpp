@@ -10,11 +10,22 @@
 //   abort()         the job was stopped by the operator: end as in the safe state.
 // docs/runtime.md "Machining cycles" tells how a new cycle plugs in. RT-safe members.
 
+#include <array>
+
+#include "edm/runtime/xyz_pins.hpp"
+
 namespace edm::programs {
 
 struct AxisClaim {
-  bool x{false}, y{false}, z{false};
-  double vx_mm_s{0.0}, vy_mm_s{0.0}, vz_mm_s{0.0};
+  std::array<bool, rt::kAxes> claimed{};   // X, Y, Z (rt::kAxisX …)
+  std::array<double, rt::kAxes> v_mm_s{};  // the cycle's speed command of a claimed axis
+
+  static AxisClaim xy(double vx_mm_s, double vy_mm_s) noexcept {
+    return {{true, true, false}, {vx_mm_s, vy_mm_s, 0.0}};
+  }
+  static AxisClaim z(double vz_mm_s) noexcept {
+    return {{false, false, true}, {0.0, 0.0, vz_mm_s}};
+  }
 };
 
 class MachiningCycle {

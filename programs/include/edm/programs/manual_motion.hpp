@@ -49,6 +49,7 @@
 
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/manual.hpp"
+#include "edm/runtime/xyz_pins.hpp"
 
 namespace edm::machining {
 struct MachineTables;
@@ -84,25 +85,17 @@ struct ManualMotionParams {
 class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Block> {
  public:
   rt::Input<bool> enable{pins_, "enable"};  // READY and no job: the sequencer gives the axes
-  rt::Input<double> x_mm{pins_, "x_mm", "mm"};
-  rt::Input<double> y_mm{pins_, "y_mm", "mm"};
-  rt::Input<double> z_mm{pins_, "z_mm", "mm"};
-  rt::Input<bool> ref_x{pins_, "ref_x"};  // reference switches (wired: homing available)
-  rt::Input<bool> ref_y{pins_, "ref_y"};
-  rt::Input<bool> ref_z{pins_, "ref_z"};
+  rt::Xyz<rt::Input<double>> pos{pins_, {"x_mm", "y_mm", "z_mm"}, "mm"};
+  // Reference switches (wired: homing available).
+  rt::Xyz<rt::Input<bool>> ref{pins_, {"ref_x", "ref_y", "ref_z"}};
   rt::Input<bool> contact{pins_, "contact"};     // touch sensing (wired: touch available)
   rt::Output<bool> active{pins_, "active"};      // moving the axes: the sequencer passes vx/vy/vz
   rt::Output<std::int64_t> mode{pins_, "mode"};  // rt::ManualMode
-  rt::Output<double> vx_cmd_mm_s{pins_, "vx_cmd_mm_s", "mm/s"};
-  rt::Output<double> vy_cmd_mm_s{pins_, "vy_cmd_mm_s", "mm/s"};
-  rt::Output<double> vz_cmd_mm_s{pins_, "vz_cmd_mm_s", "mm/s"};
+  rt::Xyz<rt::Output<double>> v_cmd{pins_, {"vx_cmd_mm_s", "vy_cmd_mm_s", "vz_cmd_mm_s"}, "mm/s"};
   rt::Output<bool> touch_mode{pins_, "touch_mode"};
-  rt::Output<bool> pos_set_x{pins_, "pos_set_x"};
-  rt::Output<bool> pos_set_y{pins_, "pos_set_y"};
-  rt::Output<bool> pos_set_z{pins_, "pos_set_z"};
-  rt::Output<double> pos_value_x_mm{pins_, "pos_value_x_mm", "mm"};
-  rt::Output<double> pos_value_y_mm{pins_, "pos_value_y_mm", "mm"};
-  rt::Output<double> pos_value_z_mm{pins_, "pos_value_z_mm", "mm"};
+  rt::Xyz<rt::Output<bool>> pos_set{pins_, {"pos_set_x", "pos_set_y", "pos_set_z"}};
+  rt::Xyz<rt::Output<double>> pos_value{
+      pins_, {"pos_value_x_mm", "pos_value_y_mm", "pos_value_z_mm"}, "mm"};
   rt::Output<std::int64_t> referenced{pins_, "referenced"};  // mask: bit 0 X, 1 Y, 2 Z
 
   std::vector<rt::ParamError> configure(const rt::BlockSetup& setup) override;
@@ -162,8 +155,9 @@ class ManualMotion final : public rt::BlockWithParams<ManualMotionParams, rt::Bl
   void stop_now() noexcept;  // the reference stops where the axis is
   void step_profile(double dt) noexcept;
   void command_axes() noexcept;
-  [[nodiscard]] double pos(int axis) const noexcept;
+  [[nodiscard]] double axis_mm(int axis) const noexcept;  // pos[axis]
   [[nodiscard]] bool switch_on(int axis) const noexcept;
+  [[nodiscard]] bool any_switch_wired() const noexcept;  // homing is available
   [[nodiscard]] bool is_referenced(int axis) const noexcept;
   [[nodiscard]] bool limits(int axis, double& lo, double& hi) const noexcept;
   /// One cycle of the running operation's steps (manual_motion_steps.cpp).

@@ -109,7 +109,7 @@ class WallFinish final : public rt::BlockWithParams<WallFinishParams, rt::Compos
     return state_value_ != State::kIdle && state_value_ != State::kDone;
   }
   [[nodiscard]] AxisClaim axes() const noexcept override {
-    return {.x = true, .y = true, .vx_mm_s = vx_cmd_mm_s.get(), .vy_mm_s = vy_cmd_mm_s.get()};
+    return AxisClaim::xy(vx_cmd_mm_s.get(), vy_cmd_mm_s.get());
   }
   [[nodiscard]] bool generator_on() const noexcept override { return gen_on.get(); }
 
