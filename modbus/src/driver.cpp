@@ -66,44 +66,31 @@ struct ModbusDriver::Link {
 };
 
 void ModbusDriverParams::visit(rt::ParamVisitor& v) {
-  v.param("host", host,
-          {.description = "remote I/O host name or address (Modbus TCP server)",
-           .load_time_only = true});
-  v.param("port", port,
-          {.description = "its TCP port", .range = rt::closed(1, 65535), .load_time_only = true});
+  v.param("host", host, rt::load_time({"", "remote I/O host name or address (Modbus TCP server)"}));
+  v.param("port", port, rt::load_time({"", "its TCP port", rt::closed(1, 65535)}));
   v.param("unit_id", unit_id,
-          {.description = "Modbus unit identifier (slave id) sent in every request",
-           .range = rt::closed(0, 255),
-           .load_time_only = true});
+          rt::load_time(
+              {"", "Modbus unit identifier (slave id) sent in every request", rt::closed(0, 255)}));
   v.param("poll_interval", poll_interval,
-          {.unit = "s",
-           .description = "one exchange (write outputs, read inputs) this often",
-           .range = rt::closed(0.001, 10.0),
-           .load_time_only = true});
+          rt::load_time({"s", "one exchange (write outputs, read inputs) this often",
+                         rt::closed(0.001, 10.0)}));
   v.param("response_timeout", response_timeout,
-          {.unit = "s",
-           .description = "a request unanswered this long fails (the connection is reopened)",
-           .range = rt::closed(0.001, 10.0),
-           .load_time_only = true});
+          rt::load_time({"s", "a request unanswered this long fails (the connection is reopened)",
+                         rt::closed(0.001, 10.0)}));
   v.param("stale_cycles", stale_cycles,
-          {.description = "an input image older than this many I/O-task cycles is alarm 121 "
-                          "io_stale (the safe state)",
-           .range = rt::closed(1, 1000000),
-           .load_time_only = true});
+          rt::load_time({"",
+                         "an input image older than this many I/O-task cycles is alarm 121 "
+                         "io_stale (the safe state)",
+                         rt::closed(1, 1000000)}));
   v.param("reconnect_min", reconnect_min,
-          {.unit = "s",
-           .description = "first wait before reconnecting; doubles on each failure",
-           .range = rt::closed(0.001, 60.0),
-           .load_time_only = true});
+          rt::load_time({"s", "first wait before reconnecting; doubles on each failure",
+                         rt::closed(0.001, 60.0)}));
   v.param("reconnect_max", reconnect_max,
-          {.unit = "s",
-           .description = "the longest wait between reconnection attempts",
-           .range = rt::closed(0.001, 600.0),
-           .load_time_only = true});
+          rt::load_time(
+              {"s", "the longest wait between reconnection attempts", rt::closed(0.001, 600.0)}));
   v.param("online_pin", online_pin,
-          {.description = "name of a BOOL output pin, true while the input image is fresh "
-                          "(\"\": none)",
-           .load_time_only = true});
+          rt::load_time(
+              {"", "name of a BOOL output pin, true while the input image is fresh (\"\": none)"}));
 }
 
 std::vector<rt::ParamError> ModbusDriverParams::validate() const {

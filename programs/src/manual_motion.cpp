@@ -36,8 +36,8 @@ void ManualMotionParams::visit(rt::ParamVisitor& v) {
           {"s", "a continuous jog not refreshed for this long stops (dead-man)",
            rt::open_closed(0.0, 60.0)});
   v.param("home_order", home_order,
-          {.description = "the order in which the axes are referenced (X, Y, Z each at most once)",
-           .load_time_only = true});
+          rt::load_time(
+              {"", "the order in which the axes are referenced (X, Y, Z each at most once)"}));
   v.param("home_search_mm_s", home_search_mm_s,
           {"mm/s", "speed toward the reference switch", r::kSpeedMmS});
   v.param("home_latch_mm_s", home_latch_mm_s,
@@ -62,11 +62,9 @@ void ManualMotionParams::visit(rt::ParamVisitor& v) {
           {"mm", "electrode diameter: an edge lies one radius beyond the axis at contact",
            rt::closed(0.0, 1000.0)});
   v.param("reference_required", reference_required,
-          {.description = "programs are refused until every axis is referenced",
-           .load_time_only = true});
+          rt::load_time({"", "programs are refused until every axis is referenced"}));
   v.param("referenced_at_start", referenced_at_start,
-          {.description = "absolute encoders: every axis counts as referenced at power-on",
-           .load_time_only = true});
+          rt::load_time({"", "absolute encoders: every axis counts as referenced at power-on"}));
 }
 
 std::vector<rt::ParamError> ManualMotionParams::validate() const {

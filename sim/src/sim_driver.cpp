@@ -14,9 +14,7 @@ constexpr std::string_view kLiveNames[] = {"electrode_length_mm", "hole_depth_mm
 
 void SimDriverParams::visit(rt::ParamVisitor& v) {
   v.param("preset", preset,
-          {.unit = "",
-           .description = "drill | sink | wire: the defaults of every other parameter",
-           .load_time_only = true});
+          rt::load_time({"", "drill | sink | wire: the defaults of every other parameter"}));
   if (preset != loaded_preset) {
     if (auto p = SimParams::preset(preset)) {
       plant = *p;
@@ -24,10 +22,8 @@ void SimDriverParams::visit(rt::ParamVisitor& v) {
     loaded_preset = preset;
   }
   v.param("seed", seed,
-          {.unit = "",
-           .description = "random seed (every variate is keyed by seed, stream, pulse)",
-           .range = rt::kNonNegative,
-           .load_time_only = true});
+          rt::load_time({"", "random seed (every variate is keyed by seed, stream, pulse)",
+                         rt::kNonNegative}));
   plant.visit(v);
 }
 

@@ -96,25 +96,16 @@ struct FuzzyServoLUTParams {
     v.param("velocity_terms", velocity_terms, {"1", "output terms in units of v_max_mm_s"});
     v.param("rules", rules, {"", "'if open is L and short is Z then v is PB; ...'"});
     v.param("samples", samples,
-            {.unit = "",
-             .description = "points of the sampled output universe",
-             .range = rt::closed(3, 100000),
-             .load_time_only = true});
+            rt::load_time({"", "points of the sampled output universe", rt::closed(3, 100000)}));
     v.param("quant_num", quant_num,
-            {.unit = "",
-             .description = "table code y = round(quant_num * v / quant_den), v in paper units",
-             .range = rt::closed(1, 1e9),
-             .load_time_only = true});
-    v.param("quant_den", quant_den,
-            {.unit = "",
-             .description = "denominator of the table coding (paper: 366)",
-             .range = rt::closed(1, 1e9),
-             .load_time_only = true});
+            rt::load_time({"", "table code y = round(quant_num * v / quant_den), v in paper units",
+                           rt::closed(1, 1e9)}));
+    v.param(
+        "quant_den", quant_den,
+        rt::load_time({"", "denominator of the table coding (paper: 366)", rt::closed(1, 1e9)}));
     v.param("quant_v_full", quant_v_full,
-            {.unit = "",
-             .description = "paper velocity at a normalised output of +-1 (paper: 5)",
-             .range = rt::kPositive,
-             .load_time_only = true});
+            rt::load_time(
+                {"", "paper velocity at a normalised output of +-1 (paper: 5)", rt::kPositive}));
     v.param("v_max_mm_s", v_max_mm_s,
             {"mm/s", "speed at a normalised output of +-1", ranges::kSpeedMmS});
   }

@@ -56,10 +56,8 @@ struct GreyPredictorGM11Params {
 
   void visit(rt::ParamVisitor& v) {
     v.param("window", window,
-            {.unit = "samples",
-             .description = "samples in the GM(1,1) fit",
-             .range = rt::closed(4.0, static_cast<double>(kMaxWindow)),
-             .load_time_only = true});
+            rt::load_time({"samples", "samples in the GM(1,1) fit",
+                           rt::closed(4.0, static_cast<double>(kMaxWindow))}));
     v.param("horizon", horizon,
             {"samples", "prediction horizon p", rt::closed(0.0, static_cast<double>(kMaxHorizon))});
     v.param("paper_exp", paper_exp,

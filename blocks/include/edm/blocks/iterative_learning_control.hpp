@@ -67,10 +67,8 @@ struct IterativeLearningControlParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("n_samples", n_samples,
-            {.unit = "samples",
-             .description = "samples per cycle N",
-             .range = rt::closed(2.0, static_cast<double>(kMaxSamples)),
-             .load_time_only = true});
+            rt::load_time({"samples", "samples per cycle N",
+                           rt::closed(2.0, static_cast<double>(kMaxSamples))}));
     // Ranges (issue 31): model coefficients within ±1e6 (the sinking config: p0 0.005, k_delta
     // 1290), u and the error clamp in the position signal's unit, within ±1e12 (param_ranges.hpp).
     v.param("p0", p0,
@@ -88,11 +86,10 @@ struct IterativeLearningControlParams {
     v.param("u_max", u_max, {"", "upper clamp of u, >= u_min", ranges::kSignal});
     v.param("auto_cycle", auto_cycle, {"", "a cycle ends every n_samples without cycle_start"});
     v.param("warm_cycles", warm_cycles,
-            {.unit = "cycles",
-             .description = "complete cycles recorded from `track` before this block takes over "
-                            "(0: none; the warm-up starts at activation)",
-             .range = rt::closed(0.0, 1e6),
-             .load_time_only = true});
+            rt::load_time({"cycles",
+                           "complete cycles recorded from `track` before this block takes over (0: "
+                           "none; the warm-up starts at activation)",
+                           rt::closed(0.0, 1e6)}));
     v.param("e_max", e_max,
             {"",
              "> 0: clamp each sample's error to +-e_max, the range where y = k_delta*gap + b holds "

@@ -33,10 +33,8 @@ struct MovingAverageParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("window", window,
-            {.unit = "samples",
-             .description = "number of samples averaged",
-             .range = rt::closed(1.0, static_cast<double>(kMaxWindow)),
-             .load_time_only = true});
+            rt::load_time({"samples", "number of samples averaged",
+                           rt::closed(1.0, static_cast<double>(kMaxWindow))}));
   }
 };
 

@@ -33,10 +33,8 @@ struct RecursiveLeastSquaresParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("n_params", n_params,
-            {.unit = "1",
-             .description = "number of regressors phi0.. used (the estimate's dimension)",
-             .range = rt::closed(1.0, static_cast<double>(RlsCore::kMaxParams)),
-             .load_time_only = true});
+            rt::load_time({"1", "number of regressors phi0.. used (the estimate's dimension)",
+                           rt::closed(1.0, static_cast<double>(RlsCore::kMaxParams))}));
     v.param("lambda", lambda, {"1", "forgetting factor", rt::closed(1e-3, 1.0)});
     // Ranges (issue 31): the covariance start p0 up to 1e9 and its trace bound 1e12 (the defaults
     // 1e3 and 1e4), start values within ±1e6 (param_ranges.hpp).

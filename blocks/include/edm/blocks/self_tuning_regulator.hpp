@@ -87,10 +87,9 @@ struct SelfTuningRegulatorParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("delay_v", delay_v,
-            {.unit = "samples",
-             .description = "prediction delay d_v of the main model (shapes the regressor history)",
-             .range = rt::closed(0.0, static_cast<double>(kMaxDelay)),
-             .load_time_only = true});
+            rt::load_time({"samples",
+                           "prediction delay d_v of the main model (shapes the regressor history)",
+                           rt::closed(0.0, static_cast<double>(kMaxDelay))}));
     // Ranges (issue 31), seed 001: beta00 = -1 (within ±1000), u_v a multiple of us_per_unit_v
     // (0-100; the reference voltage itself below 400 V), ti and to up to 10 ms (PM §1: t_on
     // 1-1000 µs), start values within ±1e6, the RLS covariance p0 up to 1e9 and its trace 1e12.
@@ -135,13 +134,9 @@ struct SelfTuningRegulatorParams {
     v.param("y_rt_min", y_rt_min,
             {"1", "floor of the y_t reference, <= y_rt_good", rt::closed(0.0, 2.0)});
     v.param("k1_on_us", k1_on_us,
-            {.unit = "",
-             .description = "decoupling gain K1 = ti/(ti+to) on Us (paper: true)",
-             .load_time_only = true});
+            rt::load_time({"", "decoupling gain K1 = ti/(ti+to) on Us (paper: true)"}));
     v.param("alternate", alternate,
-            {.unit = "",
-             .description = "the two loops computed in turn, one per sample (paper: true)",
-             .load_time_only = true});
+            rt::load_time({"", "the two loops computed in turn, one per sample (paper: true)"}));
   }
   /// Rules a range cannot say: beta00 != 0, the min/initial/max orders, trace_max >= 2*p0.
   [[nodiscard]] std::vector<rt::ParamError> validate() const;

@@ -60,10 +60,8 @@ struct ShortRetractParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("history_capacity", history_capacity,
-            {.unit = "points",
-             .description = "path points kept (it sizes the path ring)",
-             .range = rt::closed(2.0, static_cast<double>(kMaxHistory)),
-             .load_time_only = true});
+            rt::load_time({"points", "path points kept (it sizes the path ring)",
+                           rt::closed(2.0, static_cast<double>(kMaxHistory))}));
     v.param("min_spacing_mm", min_spacing_mm,
             {"mm", "least distance between recorded points", rt::closed(0.0, 1.0e3)});
     v.param("short_cycles", short_cycles,

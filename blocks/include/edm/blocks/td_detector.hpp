@@ -51,10 +51,8 @@ struct TdDetectorParams {
 
   void visit(rt::ParamVisitor& v) {
     v.param("window", window,
-            {.unit = "cycles",
-             .description = "number of cycles pooled",
-             .range = rt::closed(1.0, static_cast<double>(kMaxWindow)),
-             .load_time_only = true});
+            rt::load_time({"cycles", "number of cycles pooled",
+                           rt::closed(1.0, static_cast<double>(kMaxWindow))}));
     v.param(
         "hold_when_empty", hold_when_empty,
         {"", "with no ignited pulse in the window keep the last td_us (else output empty_td_us)"});

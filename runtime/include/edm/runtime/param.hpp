@@ -11,8 +11,8 @@
 //     }
 //   };
 //
-// One row a parameter, the ParamSpec positional; the designated form ({.unit = …,
-// .load_time_only = true}) where a spec sets finite or load_time_only.
+// One row a parameter, the ParamSpec positional; load_time({…}) for a field only the config
+// sets; the designated form ({.unit = …, .finite = false}) for the rest.
 //
 // A Params struct may add `std::vector<ParamError> validate() const` for rules that tie fields
 // together (e.g. "max >= min"); it runs only once every field is in its own range.
@@ -115,6 +115,14 @@ struct ParamSpec {
   bool load_time_only{false};      // a runtime write is refused (sizes buffers, precomputed)
 };
 using ParamInfo = ParamSpec;  // the older name, kept for visitors outside the runtime
+
+/// `spec` for a field that only the config sets (a runtime write is refused: it sizes a buffer,
+/// or something is precomputed from it): `v.param("window", window, load_time({"samples",
+/// "number of samples averaged", closed(1, 4096)}))`.
+constexpr ParamSpec load_time(ParamSpec spec) noexcept {
+  spec.load_time_only = true;
+  return spec;
+}
 
 /// Visits the fields of a Params struct in declaration order.
 class ParamVisitor {
