@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <random>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -77,34 +78,49 @@ bool start(benchmark::State& state, B& block, const typename B::Params& p) {
   return true;
 }
 
-// Per-cycle means of the timed batches: 0.25 ns buckets up to 1 µs, the exact maximum beyond.
-class BatchHistogram {
+// Nanosecond figures in buckets of `width` up to buckets × width, the exact maximum beyond
+// (allocated at construction, before timing). A percentile is the largest value its bucket can
+// hold, or the maximum when that is lower: whole nanoseconds (Value = std::int64_t, width 1)
+// exactly, real ones within a bucket's width.
+template <class Value>
+class NsHistogram {
  public:
-  void add(double ns) {
-    const auto bucket = static_cast<std::size_t>(std::max(ns, 0.0) / kBucketNs);
-    ++counts_[std::min(bucket, kBuckets)];
+  NsHistogram(Value width, std::size_t buckets) : width_(width), counts_(buckets + 1, 0) {}
+  void add(Value ns) {
+    const auto bucket = static_cast<std::size_t>(std::max(ns, Value{0}) / width_);
+    ++counts_[std::min(bucket, counts_.size() - 1)];
     ++total_;
     max_ns_ = std::max(max_ns_, ns);
   }
   [[nodiscard]] double percentile(double q) const {
     const auto rank = static_cast<std::uint64_t>(q * static_cast<double>(total_));
     std::uint64_t seen = 0;
-    for (std::size_t i = 0; i < kBuckets; ++i) {
+    for (std::size_t i = 0; i + 1 < counts_.size(); ++i) {
       seen += counts_[i];
       if (seen > rank) {
-        return std::min(static_cast<double>(i + 1) * kBucketNs, max_ns_);
+        const std::size_t top = std::is_integral_v<Value> ? i : i + 1;
+        return std::min(static_cast<double>(top) * static_cast<double>(width_), max_ns());
       }
     }
-    return max_ns_;
+    return max_ns();
   }
-  [[nodiscard]] double max_ns() const { return max_ns_; }
+  [[nodiscard]] double max_ns() const { return static_cast<double>(max_ns_); }
 
  private:
-  static constexpr double kBucketNs = 0.25;
-  static constexpr std::size_t kBuckets = 4096;
-  std::array<std::uint64_t, kBuckets + 1> counts_{};  // last one: beyond 1 µs
+  Value width_;
+  std::vector<std::uint64_t> counts_;  // the last one: beyond the buckets
   std::uint64_t total_{0};
-  double max_ns_{0.0};
+  Value max_ns_{0};
+};
+
+// Per-cycle means of the timed batches: 0.25 ns buckets up to 1 µs.
+struct BatchHistogram : NsHistogram<double> {
+  BatchHistogram() : NsHistogram(0.25, 4096) {}
+};
+
+// Per-call times in whole nanoseconds: 1 ns buckets up to 64 µs.
+struct CallHistogram : NsHistogram<std::int64_t> {
+  CallHistogram() : NsHistogram(1, 65536) {}
 };
 
 // Adds the figures of a histogram (BatchHistogram, CallHistogram) to the benchmark's counters.
@@ -132,36 +148,6 @@ void run_cycles(benchmark::State& state, Fn&& one_cycle) {
   }
   report_percentiles(state, hist);
 }
-
-// Per-call times: 1 ns buckets up to 64 µs, the exact maximum beyond (allocated before timing).
-class CallHistogram {
- public:
-  CallHistogram() : counts_(kBuckets + 1, 0) {}
-  void add(std::int64_t ns) {
-    const auto bucket = static_cast<std::size_t>(std::max<std::int64_t>(ns, 0));
-    ++counts_[std::min(bucket, kBuckets)];
-    ++total_;
-    max_ns_ = std::max(max_ns_, ns);
-  }
-  [[nodiscard]] double percentile(double q) const {
-    const auto rank = static_cast<std::uint64_t>(q * static_cast<double>(total_));
-    std::uint64_t seen = 0;
-    for (std::size_t i = 0; i < kBuckets; ++i) {
-      seen += counts_[i];
-      if (seen > rank) {
-        return static_cast<double>(i);
-      }
-    }
-    return static_cast<double>(max_ns_);
-  }
-  [[nodiscard]] double max_ns() const { return static_cast<double>(max_ns_); }
-
- private:
-  static constexpr std::size_t kBuckets = 65536;
-  std::vector<std::uint64_t> counts_;
-  std::uint64_t total_{0};
-  std::int64_t max_ns_{0};
-};
 
 // Runs one_call once per iteration and times each call on its own (see the file comment).
 template <class Fn>

@@ -17,7 +17,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -309,15 +311,32 @@ void machine_ready(LibmodbusRemoteIo& io) {
   io.set_coil(0, true);
 }
 
-TEST(AllocationsModbus, NoneInsideCyclesWhileAJobDrillsWithTheRemoteIoExchanging) {
+// drill-modbus-sim against a remote I/O ready to drill, the driver's exchange thread running and
+// the first image in: where both tests start. Members go in reverse order: the cycles, the
+// exchange thread, the runtime, the remote I/O.
+class AllocationsModbus : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(io.ready()) << "libmodbus server: " << modbus_strerror(errno);
+    machine_ready(io);
+    runtime = build_drill_modbus_sim(io.port());
+    driver = &modbus_child(*runtime);
+    thread.emplace(runtime->driver());
+    ASSERT_TRUE(wait_for_image(*driver, io, 0)) << "the first image (start() tries it itself)";
+    cycles.emplace(*runtime);
+  }
+
   LibmodbusRemoteIo io;
-  ASSERT_TRUE(io.ready()) << "libmodbus server: " << modbus_strerror(errno);
-  machine_ready(io);
-  auto r = build_drill_modbus_sim(io.port());
-  modbus::ModbusDriver& d = modbus_child(*r);
-  DriverThread thread(r->driver());
-  ASSERT_TRUE(wait_for_image(d, io, 0)) << "the first image (start() tries it itself)";
-  Cycles c(*r);
+  std::unique_ptr<rt::Runtime> runtime;
+  modbus::ModbusDriver* driver{nullptr};
+  std::optional<DriverThread> thread;
+  std::optional<Cycles> cycles;
+};
+
+TEST_F(AllocationsModbus, NoneInsideCyclesWhileAJobDrillsWithTheRemoteIoExchanging) {
+  auto& r = runtime;
+  modbus::ModbusDriver& d = *driver;
+  Cycles& c = *cycles;
   std::size_t allocations = 0;
 
   // Idle: the image flows both ways. edmplc turns the pump off (no job: flushing off).
@@ -355,15 +374,10 @@ TEST(AllocationsModbus, NoneInsideCyclesWhileAJobDrillsWithTheRemoteIoExchanging
   EXPECT_EQ(allocations, 0u);
 }
 
-TEST(AllocationsModbus, NoneInsideCyclesWhenTheRemoteIoGoesAwayMidJob) {
-  LibmodbusRemoteIo io;
-  ASSERT_TRUE(io.ready()) << "libmodbus server: " << modbus_strerror(errno);
-  machine_ready(io);
-  auto r = build_drill_modbus_sim(io.port());
-  modbus::ModbusDriver& d = modbus_child(*r);
-  DriverThread thread(r->driver());
-  ASSERT_TRUE(wait_for_image(d, io, 0)) << "the first image (start() tries it itself)";
-  Cycles c(*r);
+TEST_F(AllocationsModbus, NoneInsideCyclesWhenTheRemoteIoGoesAwayMidJob) {
+  auto& r = runtime;
+  modbus::ModbusDriver& d = *driver;
+  Cycles& c = *cycles;
   std::size_t allocations = 0;
   // With M08: the job switches the flushing pump, a coil of the remote I/O (io.flush_pump), on.
   ASSERT_EQ(r->job().load(drill_job(/*flushing=*/true)), rt::LoadResult::kOk);

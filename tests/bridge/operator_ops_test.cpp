@@ -4,6 +4,8 @@
 // offset generation at cycle.start, and MDI that never replaces the loaded part program.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+
 #include "bridge_fixture.hpp"
 #include "edm/machining/motion_block.hpp"
 #include "programs/sim_machine.hpp"
@@ -15,6 +17,20 @@ namespace {
 using machining::MotionBlock;
 using machining::MotionKind;
 using namespace std::chrono_literals;
+
+MotionBlock dwell_block(double seconds, std::int32_t line) {
+  MotionBlock b;
+  b.kind = MotionKind::kDwell;
+  b.dwell_s = seconds;
+  b.line = line;
+  return b;
+}
+MotionBlock end_block(std::int32_t line) {
+  MotionBlock b;
+  b.kind = MotionKind::kEnd;
+  b.line = line;
+  return b;
+}
 
 constexpr const char* kOp = "op-secret-0123456789";
 constexpr const char* kViewer = "viewer-secret-0123456789";
@@ -181,13 +197,8 @@ TEST_F(OperatorOps, WorkOffsetsAreSetReadAndRefusedDuringAJob) {
   EXPECT_EQ(r.body["frames"]["G55"]["z"], -7.25);
   EXPECT_EQ(r.body["frames"]["G54"]["x"], 0.0);
   // A program interpreted with generation 1, then the offsets change: the start is refused.
-  MotionBlock dwell;
-  dwell.kind = MotionKind::kDwell;
-  dwell.dwell_s = 0.05;
-  dwell.line = 1;
-  MotionBlock end;
-  end.kind = MotionKind::kEnd;
-  end.line = 2;
+  MotionBlock dwell = dwell_block(0.05, 1);
+  const MotionBlock end = end_block(2);
   const std::vector<MotionBlock> prog{dwell, end};
   UploadOptions uo;
   uo.offsets_generation = 1;
@@ -211,10 +222,7 @@ TEST_F(OperatorOps, WorkOffsetsAreSetReadAndRefusedDuringAJob) {
 
 TEST_F(OperatorOps, ProgramsWaitForTheReferenceWhenRequired) {
   start("referenced_at_start: false, reference_required: true");
-  MotionBlock end;
-  end.kind = MotionKind::kEnd;
-  end.line = 1;
-  const std::vector<MotionBlock> prog{end};
+  const std::vector<MotionBlock> prog{end_block(1)};
   ASSERT_TRUE(op_.upload_program(prog));
   const Reply r = op_.request("cycle.start");
   expect_error(r, ErrorCode::kInvalidState);
@@ -231,13 +239,8 @@ TEST_F(OperatorOps, ProgramsWaitForTheReferenceWhenRequired) {
 
 TEST_F(OperatorOps, MdiRunsBesideTheLoadedProgramWithoutReplacingIt) {
   start();
-  MotionBlock dwell;
-  dwell.kind = MotionKind::kDwell;
-  dwell.dwell_s = 0.01;
-  dwell.line = 7;
-  MotionBlock end;
-  end.kind = MotionKind::kEnd;
-  end.line = 8;
+  const MotionBlock dwell = dwell_block(0.01, 7);
+  const MotionBlock end = end_block(8);
   const std::vector<MotionBlock> main_prog{dwell, dwell, end};
   ASSERT_TRUE(op_.upload_program(main_prog));
   expect_error(op_.request("cycle.start", {{"slot", "mdi"}}), ErrorCode::kInvalidState);

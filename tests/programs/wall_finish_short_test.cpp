@@ -7,8 +7,8 @@
 
 #include <cmath>
 
-#include "composite_rig.hpp"
 #include "edm/programs/wall_finish.hpp"
+#include "finish_rig.hpp"
 #include "support/param_access.hpp"
 
 namespace edm::test {
@@ -23,20 +23,14 @@ using programs::WallFinish;
 // twice that (transient), or for good (persistent).
 constexpr double kContactMm = 0.03;
 
-struct OrbitRig : CompositeRig<WallFinish> {
-  rt::Output<double> x_mm, y_mm, start_offset, final_offset;
+struct OrbitRig : FinishInputsRig {
   bool shorting{false};
   bool contact{false}, persistent{false}, cleared{false};
   double cx{0.0}, cy{0.0};
   std::int64_t short_cycles{0};
 
-  OrbitRig() : CompositeRig(WallFinishParams()) {
-    configure("cycle.finish");
-    in<double>("x_mm").connect(x_mm);
-    in<double>("y_mm").connect(y_mm);
-    in<double>("start_offset_mm").connect(start_offset);
-    in<double>("final_offset_mm").connect(final_offset);
-    activate();
+  OrbitRig() : FinishInputsRig(WallFinishParams()) {
+    configure_and_activate();
     short_cycles = block.read_param(param_index(block, "retract.short_cycles")).i;
     start_offset.set(0.2);
     final_offset.set(0.21);

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "composite_rig.hpp"
 #include "edm/programs/register.hpp"
+#include "finish_rig.hpp"
 #include "support/param_access.hpp"
 
 namespace edm::test {
@@ -23,19 +23,13 @@ namespace {
 using namespace std::chrono_literals;
 using programs::WallFinish;
 
-struct FinishRig : CompositeRig<WallFinish> {
+struct FinishRig : FinishInputsRig {
   WallFinish& wf{block};
-  rt::Output<double> x_mm, y_mm, start_offset, final_offset;
 
-  explicit FinishRig(const programs::WallFinishParams& p) : CompositeRig(p) {
+  explicit FinishRig(const programs::WallFinishParams& p) : FinishInputsRig(p) {
     // orbit.kr keeps WallFinish's default 1e-4 mm/µs: Td = 10 µs → Δr = 1 µm per revolution.
     EXPECT_TRUE(write_param(wf, "orbit.dr_max_mm", rt::ParamValue::of_real(0.005)).empty());
-    configure("cycle.finish");
-    in<double>("x_mm").connect(x_mm);
-    in<double>("y_mm").connect(y_mm);
-    in<double>("start_offset_mm").connect(start_offset);
-    in<double>("final_offset_mm").connect(final_offset);
-    activate();
+    configure_and_activate();
     x_mm.set(3.0);
     y_mm.set(-2.0);
   }

@@ -22,8 +22,8 @@ namespace edm::rt {
 namespace {
 
 namespace fs = std::filesystem;
-using TempDir = edm::test::TempDir;
 using edm::test::read_file;
+using edm::test::TempDir;
 using edm::test::write_file;
 
 const RetainMap kValues = {{"p.counter.holes", RetainValue::make_int(17)},
