@@ -204,7 +204,13 @@ TEST(ModbusDriver, EstopAndInterlockContactsAreInTheSafetyChain) {
   EXPECT_TRUE(eventually([&] { return io.get("co", 0) == 0; }));  // the pump off
 }
 
-std::string build_errors(const std::string& text) {
+// The errors of a config of `machine` (its version and machine sections) with one empty task.
+std::string machine_errors(const std::string& machine) {
+  const std::string text = machine + R"(tasks:
+  - {name: t, interval: 1ms, priority: 0, programs: [p]}
+programs:
+  - {name: p, blocks: []}
+)";
   rt::BlockRegistry blocks;
   rt::DriverRegistry drivers;
   rt::register_runtime_drivers(drivers);
@@ -240,12 +246,8 @@ machine:
       - {name: h, table: holding_register, address: 7, type: int32}
       - {name: i, table: holding_register, address: 8}
       - {table: coil, address: 9, colour: red}
-tasks:
-  - {name: t, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - {name: p, blocks: []}
 )";
-  const std::string e = build_errors(text);
+  const std::string e = machine_errors(text);
   EXPECT_NE(e.find("bad.yaml:8:26: I/O driver 'modbus': pins[0].table: unknown table 'coils'"),
             std::string::npos)
       << e;
@@ -274,16 +276,12 @@ machine:
         params: {port: 1502}
         pins:
           - {name: ai0, table: input_register, address: 0}
-tasks:
-  - {name: t, interval: 1ms, priority: 0, programs: [p]}
-programs:
-  - {name: p, blocks: []}
 )";
-  const std::string e = build_errors(text);
+  const std::string e = machine_errors(text);
   EXPECT_NE(e.find("pin 'io.ai0' is declared by two drivers"), std::string::npos) << e;
   std::string ok = text;
   ok.replace(ok.find("name: ai0"), 9, "name: door");
-  EXPECT_EQ(build_errors(ok), "");
+  EXPECT_EQ(machine_errors(ok), "");
 }
 
 }  // namespace
