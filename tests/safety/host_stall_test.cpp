@@ -159,7 +159,7 @@ bool start_rapid_to_x20(SafetyRig& m) {
 
 /// After a stall or a late wake-up of `ms` in the rapid: the slots were omitted, not run late, the
 /// axis followed within `tol_mm` (no alarm 140) and reached X 20.
-void expect_rapid_followed(SafetyRig& m, int ms, double worst_mm, double tol_mm) {
+void expect_rapid_followed(SafetyRig& m, double ms, double worst_mm, double tol_mm) {
   EXPECT_GE(m.runtime->tasks()[0]->stats().snapshot().omitted_cycles,
             static_cast<std::uint64_t>(ms) - 1);
   EXPECT_LT(worst_mm, tol_mm) << ms << " ms";
