@@ -111,6 +111,11 @@ test('home Z: the axis goes to its reference switch and is referenced', async ()
   assert.equal(r.op, 'home');
   assert.ok(r.ok, `home failed: ${r.error}`);
   await page.locator('#manual-result').filter({ hasText: 'home ok' }).waitFor({ timeout: T });
+  // The result can reach the page before the status stream's next position (a loaded CI
+  // machine: the last frame was still from the approach): wait for a status at the switch,
+  // failing below with the position the page has if none comes.
+  await page.waitForFunction(() => Math.abs((window.edm.status?.vars?.['io.z_mm'] ?? 0) - 15) < 0.01,
+    null, { timeout: T, polling: 50 }).catch(() => {});
   const p = await position();
   metrics.home_z_mm = p.z;
   assert.ok(Math.abs(p.z - 15) < 0.01, `Z ${p.z} after homing, the switch is at 15`);
