@@ -50,8 +50,12 @@ std::string soak_config(const std::string& shipped_yaml, std::string& error) {
   if (!replace_once(y, "{name: Z, min_mm: -60,", "{name: Z, min_mm: -1000,") ||
       !replace_once(
           y, "wall_sparks: true}",
-          fmt::format("wall_sparks: true, electrode_length_mm: {:.0f}}}", kSoakElectrodeMm))) {
-    error = "drill-sim.yaml changed: the Z axis or the io params line is not where it was";
+          fmt::format("wall_sparks: true, electrode_length_mm: {:.0f}}}", kSoakElectrodeMm)) ||
+      !replace_once(y, "electrode: {length_mm: 300}",
+                    fmt::format("electrode: {{length_mm: {:.0f}}}", kSoakElectrodeMm))) {
+    error =
+        "drill-sim.yaml changed: the Z axis, the io params line or machine.electrode is not "
+        "where it was";
     return {};
   }
   return "# edm-bench-soak: config/machines/drill-sim.yaml with Z min -1000 mm (not -60) and a "

@@ -84,9 +84,13 @@ int cmd_offset(const OffsetArgs& args, const edm::hmi::ConnectionSettings& setti
   }
   for (int i = 0; i < edm::hmi::kWorkFrames; ++i) {
     if (frame && *frame != i) continue;
-    std::printf("%s\n",
+    const double length = offsets.z_electrode_mm[static_cast<std::size_t>(i)];
+    std::printf("%s",
                 edm::hmi::format_frame(i, offsets.frame[static_cast<std::size_t>(i)]).c_str());
+    if (length > 0.0) std::printf("  (Z with a %.4f mm electrode)", length);
+    std::printf("\n");
   }
+  if (offsets.electrode_mm > 0.0) std::printf("electrode now %.4f mm\n", offsets.electrode_mm);
   return kExitOk;
 }
 

@@ -38,10 +38,12 @@ int cmd_status(const edm::hmi::ConnectionSettings& settings) {
       rep.part = "program #" + std::to_string(s.job_generation);
       rep.machine = machine;
       rep.targets.blocks = s.job_blocks;
+      rep.alarms_seen = false;  // the status has the last cause, not the job's alarms
       edm::hmi::fill_from_status(rep, s);
       std::fputs(edm::hmi::format_report(rep).c_str(), stdout);
     }
   }
+  if (!print_active_alarms(client)) return kExitFailure;
   std::printf("variables:\n");
   for (const auto& [name, value] : s.vars) {
     std::printf("  %-28s %.6g\n", name.c_str(), value);

@@ -1,14 +1,17 @@
 // edmhmi — the HMI process's command line (DESIGN §4, docs/hmi.md). One file per command group:
 // cmd_check.cpp (offline interpretation), cmd_run.cpp (upload, start, follow, report),
-// cmd_status.cpp (status, stats), cmd_machine.cpp (hold, resume, stop, estop, reset, override),
-// cmd_manual.cpp (home, jog, touch), cmd_offset.cpp (offset), cmd_mdi.cpp (mdi), cmd_watch.cpp
-// (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
+// cmd_status.cpp (status, stats), cmd_alarms.cpp (alarms), cmd_machine.cpp (hold, resume, stop,
+// estop, reset, override), cmd_manual.cpp (home, jog, touch), cmd_offset.cpp (offset), cmd_mdi.cpp
+// (mdi), cmd_watch.cpp (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
 
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <optional>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "cli.hpp"
 #include "cmd_fleet.hpp"
@@ -78,6 +81,9 @@ int run(int argc, char** argv) {
 
   app.add_subcommand("status", "machine state, job, key variables, last job's figures");
   app.add_subcommand("stats", "task statistics and bridge counters");
+  bool alarms_all = false;
+  app.add_subcommand("alarms", "the active alarms with their cause and remedy")
+      ->add_flag("--all", alarms_all, "also the history since edmplc started");
 
   WatchArgs watch;
   CLI::App* w = app.add_subcommand("watch", "print variables until Ctrl-C (or N samples)");
@@ -135,6 +141,12 @@ int run(int argc, char** argv) {
   of->add_option("WORDS", offset.words, "[G54..G59] [X<mm>] [Y<mm>] [Z<mm>]");
   of->add_flag("--json", offset.json, "print the frames as JSON (for check --offsets)");
 
+  std::vector<std::string> electrode_words;
+  CLI::App* el = app.add_subcommand(
+      "electrode",
+      "print the electrode length the job compensates with, or set it: electrode set 300");
+  el->add_option("WORDS", electrode_words, "[set <mm>]");
+
   std::string mdi_line;
   CLI::App* md = app.add_subcommand("mdi", "run one G-code line from where the electrode is");
   md->add_option("LINE", mdi_line, "the G-code line, quoted")->required();
@@ -189,6 +201,7 @@ int run(int argc, char** argv) {
   if (command == "run") return cmd_run(run, settings);
   if (command == "status") return cmd_status(settings);
   if (command == "stats") return cmd_stats(settings);
+  if (command == "alarms") return cmd_alarms(alarms_all, settings);
   if (command == "watch") return cmd_watch(watch, settings);
   if (command == "trace") return cmd_trace(trace, settings);
   if (command == "serve") {
@@ -204,6 +217,15 @@ int run(int argc, char** argv) {
   if (command == "jog") return cmd_jog(jog, settings);
   if (command == "touch") return cmd_touch(touch, settings);
   if (command == "offset") return cmd_offset(offset, settings);
+  if (command == "electrode") {
+    if (electrode_words.empty()) return cmd_electrode(-1.0, settings);
+    const std::optional<double> mm = electrode_words.size() == 2 && electrode_words[0] == "set"
+                                         ? edm::apps::finite_number(electrode_words[1])
+                                         : std::nullopt;
+    if (!mm || *mm <= 0.0)
+      return usage("electrode: expected `electrode` or `electrode set <mm>` (mm > 0)");
+    return cmd_electrode(*mm, settings);
+  }
   if (command == "mdi") return cmd_mdi(mdi_line, settings);
   return cmd_machine(command, settings);
 }

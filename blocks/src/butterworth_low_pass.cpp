@@ -38,7 +38,7 @@ void ButterworthLowPass::set_state(double v) noexcept { x1_ = x2_ = y1_ = y2_ = 
 rt::BlockStatus ButterworthLowPass::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
   if (!std::isfinite(x)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input", x);
   }
   if (!primed_) {
     set_state(x);

@@ -25,25 +25,28 @@ rt::BlockStatus DischargeStateCounter::update(const rt::CycleContext& /*ctx*/) n
   std::int64_t pulses = 0;
   for (const std::int64_t x : in) {
     if (x < 0 || x > kMaxCount) {
-      return rt::BlockStatus::kFault;
+      return fault("a pulse counter out of range", static_cast<double>(x));
     }
     pulses += x;
   }
   const std::int64_t h[3] = {hist_open_.get(), hist_short_.get(), hist_arc_.get()};
   for (const std::int64_t x : h) {
     if (x < 0 || x > kMask32) {
-      return rt::BlockStatus::kFault;
+      return fault("a pulse-history word out of range", static_cast<double>(x));
     }
   }
   const auto open = static_cast<std::uint32_t>(h[0]);
   const auto shorts = static_cast<std::uint32_t>(h[1]);
   const auto arcs = static_cast<std::uint32_t>(h[2]);
   if ((open & shorts) != 0 || (open & arcs) != 0 || (shorts & arcs) != 0) {
-    return rt::BlockStatus::kFault;  // a pulse has exactly one class
+    return fault(
+        "a pulse in two classes at once (the history words overlap)");  // a pulse has exactly one
+                                                                        // class
   }
   const std::int64_t m = params_.interval;
   if (m < 1) {
-    return rt::BlockStatus::kFault;  // parameters that bypassed validate()
+    return fault("interval below 1 (parameters that bypassed validation)",
+                 static_cast<double>(m));  // parameters that bypassed validate()
   }
   if (pulses == 0) {
     data_ready_.set(false);

@@ -87,7 +87,7 @@ rt::BlockStatus FuzzyServoLUT::update(const rt::CycleContext& /*ctx*/) noexcept 
   const std::int64_t o = open_count_.get();
   const std::int64_t s = short_count_.get();
   if (o < 0 || o > kWindow || s < 0 || s > kWindow) {
-    return rt::BlockStatus::kFault;
+    return fault("an open or short count outside the window", static_cast<double>(o));
   }
   v_mm_s_.set(params_.v_max_mm_s * table(static_cast<int>(o), static_cast<int>(s)));
   return rt::BlockStatus::kOk;

@@ -50,13 +50,13 @@ rt::BlockStatus GapControllerP::update(const rt::CycleContext& /*ctx*/) noexcept
     const double td = td_us.get();
     const double tdr_in = tdr_us.get();
     if (!std::isfinite(td) || !std::isfinite(tdr_in) || tdr_in < 0.0) {
-      return rt::BlockStatus::kFault;
+      return fault("a non-finite Td or Td_ref, or a negative Td_ref", td);
     }
     const double tdr = tdr_in > 0.0 ? tdr_in : p.tdr_default_us;
     error_us = tdr - td;
     vz = p.kg * error_us + p.ki * integral_us_s_;
     if (!std::isfinite(vz)) {  // finite inputs, but kg·error overflowed
-      return rt::BlockStatus::kFault;
+      return fault("the feed command overflowed (kg times the Td error)", error_us);
     }
   }
   // max/min rather than std::clamp: no undefined behaviour for limits that bypassed validate().

@@ -89,7 +89,7 @@ rt::BlockStatus GreyPredictorGM11::update(const rt::CycleContext& /*ctx*/) noexc
   const double x = in_.get();
   const std::size_t n = window_.capacity();
   if (!std::isfinite(x) || n == 0) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input, or not configured", x);
   }
   window_.push(x);
   const auto clamped = [this](double y) noexcept {

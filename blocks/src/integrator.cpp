@@ -27,12 +27,12 @@ rt::BlockStatus Integrator::update(const rt::CycleContext& /*ctx*/) noexcept {
   }
   const double x = in_.get();
   if (!std::isfinite(x)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input", x);
   }
   const double state = out_.get();
   if (!std::isfinite(state)) {
     out_.set(reset_value());
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite state: reset to its reset value", state);
   }
   const double lo = params_.min;
   const double hi = std::max(params_.max, lo);  // keeps std::clamp defined
@@ -40,7 +40,7 @@ rt::BlockStatus Integrator::update(const rt::CycleContext& /*ctx*/) noexcept {
   // not.
   const double y = state + k_dt_ * x;
   if (std::isnan(y)) {
-    return rt::BlockStatus::kFault;
+    return fault("the integral became NaN", y);
   }
   const double clamped = std::clamp(y, lo, hi);
   out_.set(clamped);

@@ -119,11 +119,12 @@ rt::BlockStatus IterativeLearningControl::update(const rt::CycleContext& /*ctx*/
   const bool rising = cycle_start_edge_(cycle_start_.get());
   const auto n = static_cast<std::int64_t>(u_.size());
   if (!std::isfinite(y) || !std::isfinite(ref) || n == 0) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite measurement or reference, or no learning samples", y);
   }
   const double track = track_.get();
   if (warm_ && (!track_.connected() || !std::isfinite(track))) {
-    return rt::BlockStatus::kFault;  // warm_cycles > 0 needs the applied position wired
+    return fault("warm_cycles > 0 needs the applied position (track) wired and finite",
+                 track);  // warm_cycles > 0 needs the applied position wired
   }
   const bool learning = enable_.get();
   if (idx_ >= 0) {

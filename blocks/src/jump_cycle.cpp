@@ -99,7 +99,7 @@ rt::BlockStatus JumpCycle::update(const rt::CycleContext& ctx) noexcept {
   const bool jumping = phase_ >= 0 && phase_ < up_n_ + down_n_;
   const double z = z_mm_.get();
   if (!std::isfinite(z)) {
-    status = rt::BlockStatus::kFault;
+    status = fault("a non-finite Z position", z);
   } else if (!jumping || phase_ == 0) {
     z_hold_.set(z);  // follows z, and holds its value of the jump's first cycle
   }
@@ -124,7 +124,7 @@ rt::BlockStatus JumpCycle::update(const rt::CycleContext& ctx) noexcept {
   const double v = vz_in_.get();
   if (!std::isfinite(v)) {
     vz_out_.set(0.0);
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite servo feed", v);
   }
   vz_out_.set(v);
   return status;

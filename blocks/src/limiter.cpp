@@ -24,7 +24,7 @@ void Limiter::activate() noexcept { has_prev_ = false; }
 rt::BlockStatus Limiter::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
   if (!std::isfinite(x)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input", x);
   }
   const double lo = params_.min;
   // std::clamp is undefined for hi < lo; a bad runtime write cannot get here (validate), but stay

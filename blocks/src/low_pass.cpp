@@ -20,7 +20,7 @@ void LowPass::activate() noexcept {
 rt::BlockStatus LowPass::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
   if (!std::isfinite(x)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input", x);
   }
   y_ += alpha_ * (x - y_);
   out_.set(y_);

@@ -33,7 +33,7 @@ void MovingAverage::activate() noexcept {
 rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept {
   const double x = in_.get();
   if (!std::isfinite(x) || window_.capacity() == 0) {  // capacity 0: not configured
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite input, or not configured", x);
   }
   const double old = window_.push(x);  // 0 until the window is full
   sum_.add(x);
@@ -47,7 +47,7 @@ rt::BlockStatus MovingAverage::update(const rt::CycleContext& /*ctx*/) noexcept 
   const double mean = sum_.value() / static_cast<double>(window_.size());
   full_.set(window_.full());
   if (!std::isfinite(mean)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite mean", mean);
   }
   out_.set(mean);
   return rt::BlockStatus::kOk;

@@ -27,7 +27,7 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
     const double fin = final_radius_mm.get();
     if (!std::isfinite(r0) || !std::isfinite(fin) || r0 < 0.0 || fin < r0) {
       publish();
-      return rt::BlockStatus::kFault;
+      return fault("a non-finite or negative start radius, or a final radius below it", r0);
     }
     radius_mm_ = r0;
     final_mm_ = fin;
@@ -49,7 +49,7 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
       sum_us_ += td;
       ++n_valid_;
     } else {
-      status = rt::BlockStatus::kFault;
+      status = fault("a non-finite Td while orbiting", td);
     }
   }
   ++n_samples_;
@@ -72,7 +72,7 @@ rt::BlockStatus OrbitExpander::update(const rt::CycleContext& /*ctx*/) noexcept 
         status = rt::BlockStatus::kSaturated;
       }
     } else {
-      status = rt::BlockStatus::kFault;
+      status = fault("a non-finite mean Td over the revolution", tdm);
     }
   }
   if (dr >= final_mm_ - radius_mm_) {

@@ -45,7 +45,7 @@ rt::BlockStatus PositionLoop::update(const rt::CycleContext& /*ctx*/) noexcept {
     in_pos_count_ = 0;
     in_position.set(false);
     following_error_fault.set(fault_latched_);
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite reference, feed-forward or position", x);
   }
   error_mm.set(e);
   in_pos_count_ = std::abs(e) <= p.in_pos_tol_mm ? std::min(in_pos_count_ + 1, p.in_pos_cycles)
@@ -61,7 +61,8 @@ rt::BlockStatus PositionLoop::update(const rt::CycleContext& /*ctx*/) noexcept {
     integral_mm_s_ = 0.0;
     v_cmd_mm_s.set(0.0);
     saturated.set(false);
-    return fault_latched_ ? rt::BlockStatus::kFault : rt::BlockStatus::kOk;
+    return fault_latched_ ? fault("following error beyond f_err_max_mm (latched until reset)", e)
+                          : rt::BlockStatus::kOk;
   }
 
   const double v_lim = p.v_max_mm_s;
@@ -75,7 +76,7 @@ rt::BlockStatus PositionLoop::update(const rt::CycleContext& /*ctx*/) noexcept {
   if (std::isnan(v)) {  // only from absurd gains (0·Inf); keep the state clean
     v_cmd_mm_s.set(0.0);
     saturated.set(false);
-    return rt::BlockStatus::kFault;
+    return fault("the velocity command is NaN (absurd gains)");
   }
   integral_mm_s_ = integral;
   const double v_cmd = std::clamp(v, -v_lim, v_lim);

@@ -50,7 +50,7 @@ rt::BlockStatus RecursiveLeastSquares::update(const rt::CycleContext& /*ctx*/) n
     finite = finite && std::isfinite(phi[i]);
   }
   if (!finite) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite regressor or measurement");
   }
   const double y_hat = rls_.predict(phi);
   y_hat_.set(y_hat);
@@ -61,7 +61,7 @@ rt::BlockStatus RecursiveLeastSquares::update(const rt::CycleContext& /*ctx*/) n
   }
   const RlsCore::Result r = rls_.update(phi, y, params_.lambda, params_.trace_max);
   if (!r.ok) {
-    return rt::BlockStatus::kFault;
+    return fault("the RLS update diverged (covariance not positive or not finite)");
   }
   for (std::size_t i = 0; i < rls_.n(); ++i) {
     theta_[i].set(rls_.theta(i));

@@ -30,7 +30,7 @@ rt::BlockStatus Select::update(const rt::CycleContext& /*ctx*/) noexcept {
   const bool sel = g_.get() || params_.select;
   const double src = sel ? in1_.get() : in0_.get();
   if (!std::isfinite(src)) {
-    return rt::BlockStatus::kFault;
+    return fault("the selected input is not finite", src);
   }
   if (has_prev_ && sel != sel_) {
     ramp_total_s_ = rt::to_seconds(params_.ramp_time);

@@ -72,7 +72,7 @@ rt::BlockStatus SelfTuningFuzzyPI::update(const rt::CycleContext& /*ctx*/) noexc
   const double rab_f_in = rab_f_.get();
   const double ref_in = rab_ref_.get();
   if (!std::isfinite(rab_p_in) || !std::isfinite(rab_f_in) || !std::isfinite(ref_in)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite Rab, filtered Rab or reference", rab_p_in);
   }
   const double rab_p = std::clamp(rab_p_in, 0.0, 1.0);  // a ratio; predictions may overshoot
   const double rab_f = std::clamp(rab_f_in, 0.0, 1.0);
@@ -116,7 +116,8 @@ rt::BlockStatus SelfTuningFuzzyPI::update(const rt::CycleContext& /*ctx*/) noexc
   const double u_next = u_ + du * p.ku * scale;
   const double v_next = v_ + du * p.kv * scale;
   if (!std::isfinite(u_next) || !std::isfinite(v_next)) {
-    return rt::BlockStatus::kFault;  // finite inputs, but the product overflowed
+    return fault("the outputs u, v overflowed",
+                 u_next);  // finite inputs, but the product overflowed
   }
   u_ = std::min(std::max(u_next, p.u_min_us), p.u_max_us);
   v_ = std::min(std::max(v_next, p.v_min_v), p.v_max_v);

@@ -65,7 +65,7 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
   const double rt_in = y_rt_ref_.get();
   if (!std::isfinite(phi_e) || !std::isfinite(phi_e2) || !std::isfinite(phi_a) ||
       !std::isfinite(phi_s) || !std::isfinite(rv_in) || !std::isfinite(rt_in)) {
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite state ratio or reference", phi_a);
   }
   // K1 = ti/tp of the period just measured (the off time commanded last sample).
   const double k1 = p.ti_us / (p.ti_us + u_t_);
@@ -120,12 +120,12 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
     const RlsCore::Result rv =
         main_.update(phi_v, y_v - p.beta00 * hist_v_[d], p.lambda, p.trace_max);
     if (!rv.ok) {
-      return rt::BlockStatus::kFault;
+      return fault("the main loop's RLS update diverged");
     }
     // Minimum-variance law: the model's prediction put on the reference.
     const double u_v_raw = (y_rv - main_.theta(0) * hist_v_[0] - main_.theta(1)) / p.beta00;
     if (!std::isfinite(u_v_raw)) {
-      return rt::BlockStatus::kFault;
+      return fault("the main loop's command is not finite", u_v_raw);
     }
     const double u_v = std::clamp(u_v_raw, p.u_v_min, p.u_v_max);
     for (std::size_t i = hist_v_.size() - 1; i > 0; --i) {
@@ -140,11 +140,11 @@ rt::BlockStatus SelfTuningRegulator::update(const rt::CycleContext& /*ctx*/) noe
     const double one[1] = {1.0};
     const RlsCore::Result rt_res = aux_.update(one, y_t - beta10 * u_t_, p.lambda, p.trace_max);
     if (!rt_res.ok) {
-      return rt::BlockStatus::kFault;
+      return fault("the auxiliary loop's RLS update diverged");
     }
     const double u_t_raw = (y_rt - aux_.theta(0)) / beta10;
     if (!std::isfinite(u_t_raw)) {
-      return rt::BlockStatus::kFault;
+      return fault("the auxiliary loop's command is not finite", u_t_raw);
     }
     u_t_ = std::clamp(u_t_raw, p.to_min_us, p.to_max_us);
     sat_t_ = u_t_ != u_t_raw;

@@ -114,7 +114,7 @@ void ShortRetract::start_retract(bool from_head) noexcept {
 rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
   const ShortRetractParams& p = params_;
   if (history_.capacity() == 0) {  // not configured
-    return rt::BlockStatus::kFault;
+    return fault("not configured (no short history)");
   }
   if (reset.get()) {
     alarm_ = false;
@@ -236,7 +236,11 @@ rt::BlockStatus ShortRetract::update(const rt::CycleContext& /*ctx*/) noexcept {
   tries.set(tries_);
   alarm.set(alarm_);
   hold.set(alarm_);
-  return alarm_ || input_fault ? rt::BlockStatus::kFault : rt::BlockStatus::kOk;
+  if (input_fault) return fault("a non-finite axis position");
+  if (alarm_) {
+    return fault("the short persists after max_tries retracts", static_cast<double>(tries_));
+  }
+  return rt::BlockStatus::kOk;
 }
 
 }  // namespace edm::blocks

@@ -34,15 +34,18 @@ rt::BlockStatus TdDetector::update(const rt::CycleContext& /*ctx*/) noexcept {
   const auto in_range = [](std::int64_t x) noexcept { return x >= 0 && x <= kMaxCount; };
   if (window_.capacity() == 0 || !in_range(c.td_sum_ns) || !in_range(c.td_count) ||
       !in_range(c.n_open) || !in_range(c.n_short) || !in_range(c.n_total)) {
-    return rt::BlockStatus::kFault;  // ring empty: not configured
+    return fault("a pulse counter out of range, or not configured",
+                 static_cast<double>(c.n_total));  // ring empty: not configured
   }
   if (c.n_total == 0) {
     c.n_total = c.td_count + c.n_open + c.n_short;  // unwired: the classes add up to all pulses
   } else if (c.n_total < c.td_count || c.n_total < c.n_open + c.n_short) {
-    return rt::BlockStatus::kFault;  // a ratio above 1: the counters disagree
+    return fault("the pulse counters disagree (a class above the total)",
+                 static_cast<double>(c.n_total));  // a ratio above 1: the counters disagree
   }
   if (c.td_count == 0 && c.td_sum_ns != 0) {
-    return rt::BlockStatus::kFault;  // a delay sum without pulses
+    return fault("a delay sum without pulses",
+                 static_cast<double>(c.td_sum_ns));  // a delay sum without pulses
   }
 
   cycle_short_ratio.set(

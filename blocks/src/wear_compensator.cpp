@@ -43,7 +43,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
     have_release_ = false;
   } else if (!std::isfinite(wear)) {  // a corrupt restored value
     wear = 0.0;
-    status = rt::BlockStatus::kFault;
+    status = fault("a non-finite restored wear: reset to 0", wear);
   }
   // The time since the last cycle, not the period: omitted cycles (the axis kept its last
   // command) count too.
@@ -61,14 +61,14 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
     vz_out_mm_s.set(0.0);
     vd_mm_s.set(0.0);
     wear_mm.set(wear);
-    return rt::BlockStatus::kFault;
+    return fault("a non-finite feed", vz_in);
   }
   // High-water mark of the front: only depth never reached before is erosion progress.
   front_mm_ += vz_in * elapsed_s;
   if (!std::isfinite(front_mm_)) {  // absurd feeds: restart the tracking, compensate nothing
     front_mm_ = 0.0;
     deepest_mm_ = 0.0;
-    status = rt::BlockStatus::kFault;
+    status = fault("the front tracking overflowed (absurd feeds): restarted", front_mm_);
   }
   double new_depth_mm = 0.0;
   if (-front_mm_ > deepest_mm_) {
@@ -79,7 +79,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
   if (enable.get() && new_depth_mm > 0.0) {
     const double ratio_in = wear_ratio.get();
     if (!std::isfinite(ratio_in)) {
-      status = rt::BlockStatus::kFault;
+      status = fault("a non-finite wear ratio", ratio_in);
     } else {
       // No estimate (<= 0; an unwired input reads 0): the parameter's θ. With the default 0 this
       // is the input itself, sign of zero included.
@@ -90,7 +90,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
         status = rt::BlockStatus::kSaturated;
       }
       const double area_in = area_ratio.get();
-      if (!std::isfinite(area_in)) status = rt::BlockStatus::kFault;
+      if (!std::isfinite(area_in)) status = fault("a non-finite area ratio", area_in);
       const double areas = area_in > 0.0 && std::isfinite(area_in) ? area_in : area_ratio_;
       vd = ratio * areas * new_depth_mm / dt_s_;  // v_bottom = new depth per cycle
     }
@@ -101,7 +101,7 @@ rt::BlockStatus WearCompensator::update(const rt::CycleContext& ctx) noexcept {
     vz_out_mm_s.set(vz_in);
     vd_mm_s.set(0.0);
     wear_mm.set(wear);
-    return rt::BlockStatus::kFault;
+    return fault("the compensated feed or the wear overflowed", vz_in);
   }
   vz_out_mm_s.set(vz_out);
   vd_mm_s.set(vd);

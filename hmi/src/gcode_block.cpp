@@ -41,7 +41,7 @@ constexpr CodeGroup kCodeGroups[] = {
     {'G', {540, 550, 560, 570}, 4, &Block::frame_g, "work-frame codes (modal group 12: G54..G59)"},
     {'G', {580, 590}, 2, &Block::frame_g, "work-frame codes (modal group 12: G54..G59)"},
     {'G', {170}, 1, &Block::plane_g, "plane codes (modal group 2)"},
-    {'G', {210}, 1, &Block::units_g, "unit codes (modal group 6)"},
+    {'G', {200, 210}, 2, &Block::units_g, "unit codes (modal group 6: G20 G21)"},
     {'G', {900, 910}, 2, &Block::distance_g, "distance-mode codes (modal group 3: G90 G91)"},
     {'M', {20, 300}, 2, &Block::stop_m, "program-end codes (modal group 4: M02 M30)"},
     {'M', {30, 50}, 2, &Block::rotation_m, "rotation codes (modal group 7: M03 M05)"},
@@ -87,8 +87,6 @@ class Sorter {
     } else if (code == 922 || code == 923) {
       error(b, &w,
             word_text(w) + " is not supported: G92 offsets are not retained; G92.1 clears them");
-    } else if (code == 200) {
-      error(b, &w, word_text(w) + " (inch units) is not supported: this dialect is mm only (G21)");
     } else {
       error(b, &w, "unknown G code " + word_text(w));
     }

@@ -20,7 +20,7 @@ struct Block {
   const Word* nonmodal_g{nullptr};      // group 0: G04 G160 G92 G92.1
   const Word* frame_g{nullptr};         // group 12: G54 .. G59
   const Word* plane_g{nullptr};         // group 2: G17
-  const Word* units_g{nullptr};         // group 6: G21
+  const Word* units_g{nullptr};         // group 6: G20 G21
   const Word* distance_g{nullptr};      // group 3: G90 G91
   const Word* stop_m{nullptr};          // group 4: M02 M30
   const Word* rotation_m{nullptr};      // group 7: M03 M05

@@ -149,6 +149,7 @@ void Interpreter::process_line(std::string_view line, int line_no) {
     return;
   }
   if (result_.errors.size() != errors_before) return;  // a malformed line is not executed
+  apply_units(lexed.words);
   Block b;
   const bool sorted = sort_block(lexed.words, line_no, b, result_.errors);
   if (result_.errors.size() > opt_.max_errors) {
@@ -157,6 +158,27 @@ void Interpreter::process_line(std::string_view line, int line_no) {
     return;
   }
   if (sorted) execute(b);
+}
+
+void Interpreter::apply_units(std::vector<Word>& words) {
+  for (const Word& w : words) {
+    if (w.letter == 'G' && code10(w) == 200) inch_ = true;
+    if (w.letter == 'G' && code10(w) == 210) inch_ = false;
+  }
+  if (!inch_) return;
+  constexpr double kMmPerInch = 25.4;  // exact, by definition
+  for (Word& w : words) {
+    switch (w.letter) {
+      case 'X':
+      case 'Y':
+      case 'Z':
+      case 'I':
+      case 'J':
+      case 'R':
+      case 'F': w.value *= kMmPerInch; break;
+      default: break;
+    }
+  }
 }
 
 /// The soft limits (end points, arc and orbit extents, drilling travel) are checked by
@@ -169,6 +191,7 @@ void Interpreter::process_line(std::string_view line, int line_no) {
 void Interpreter::check_blocks() {
   machining::ProgramCheckOptions o;
   o.arc_tolerance_mm = opt_.arc_tolerance_mm;
+  o.electrode_mm = opt_.offsets.electrode_mm;
   const bool clean = result_.errors.empty();
   for (const machining::ProgramIssue& is :
        machining::check_program(result_.blocks, tables_, opt_.start_mm, o)) {

@@ -31,6 +31,9 @@ class Interpreter {
   void error(int line, int col, std::string message);
   void error(const Block& b, const Word* at, std::string message);
   void process_line(std::string_view line, int line_no);
+  /// G20/G21 of this line set the units (before anything else of the block, as RS274/NGC
+  /// orders it); in inches, the length words (X Y Z I J R) and F become mm and mm/min.
+  void apply_units(std::vector<Word>& words);
   void execute(const Block& b);
   void check_blocks();
   bool need_feed(const Block& b, const Word* at, const char* what);
@@ -71,6 +74,7 @@ class Interpreter {
   int frame_{0};           // 0 = G54 .. 5 = G59
   machining::Vec3 g92_{};  // the program's G92 offset (mm), added to the frame's
   bool g92_active_{false};
+  bool inch_{false};  // G20: lengths and feeds in the program are inches (inch/min)
 
   bool opened_{false};
   bool closed_{false};

@@ -34,6 +34,7 @@ MotionBlock Interpreter::make(MotionKind kind, const Block& b, const Word* at) c
   mb.col = at != nullptr ? at->col : (b.first != nullptr ? b.first->col : 1);
   mb.target = pos_;
   mb.condition = armed_;
+  mb.electrode_ref_mm = opt_.offsets.z_electrode_mm[static_cast<std::size_t>(frame_)];
   return mb;
 }
 

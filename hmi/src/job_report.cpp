@@ -59,8 +59,11 @@ void position_rows(const JobReport& r, Row&& row) {
   if (!f.x_mm || !f.y_mm || !f.z_mm) return;
   const machining::Vec3 machine{*f.x_mm, *f.y_mm, *f.z_mm};
   if (frame) {
-    row("end position", xyz(to_work(machine, frame->offset_mm)) + " " + frame_name(frame->frame) +
-                            " = " + xyz(machine) + " machine");
+    // The tip, in work coordinates (what the program says); the spindle, in machine ones.
+    machining::Vec3 tip = to_work(machine, frame->offset_mm);
+    tip.z -= f.z_comp_mm.value_or(0.0);
+    row("end position",
+        xyz(tip) + " " + frame_name(frame->frame) + " = " + xyz(machine) + " machine");
   } else {
     row("end position", xyz(machine) + " machine");
   }
@@ -102,6 +105,7 @@ JobFigures figures_from_status(const bridge::StatusMessage& s) {
       {"io.x_mm", &JobFigures::x_mm},
       {"io.y_mm", &JobFigures::y_mm},
       {"io.z_mm", &JobFigures::z_mm},
+      {"cnc.job.z_comp_mm", &JobFigures::z_comp_mm},
   };
   for (const auto& [name, value] : s.vars) {
     if (!std::isfinite(value)) continue;
@@ -211,14 +215,18 @@ std::string format_report(const JobReport& r) {
     out += buf + value + "\n";
   };
   out += "job report: " + r.part + (r.machine.empty() ? "" : " on " + r.machine) + "\n";
-  std::string outcome = r.outcome;
+  std::string outcome = r.outcome + (r.dry_run ? " (dry run)" : "");
   if (r.cause != 0) outcome += " (machine " + r.state + ", alarm " + std::to_string(r.cause) + ")";
   row("outcome", outcome);
   row("blocks", std::to_string(r.blocks_done) + " of " + std::to_string(r.targets.blocks));
   const JobFigures& f = r.end;
   row("machining time",
       f.time_s ? format_duration(*f.time_s) + fmt(" (%.1f s)", *f.time_s) : std::string("n/a"));
-  if (r.targets.deepest_drill_mm > 0.0) {
+  if (r.targets.deepest_drill_mm > 0.0 && r.dry_run) {
+    // The generator never armed and the drilling blocks were skipped: there is no hole to judge.
+    row("depth reached",
+        fmt("not drilled: a dry run (program %.4f mm)", r.targets.deepest_drill_mm));
+  } else if (r.targets.deepest_drill_mm > 0.0) {
     std::string depth = f.depth_mm ? fmt("%.4f mm", *f.depth_mm) : std::string("n/a");
     depth += fmt(" (program %.4f mm", r.targets.deepest_drill_mm);
     if (f.depth_mm) depth += fmt(", error %+.4f mm", *f.depth_mm - r.targets.deepest_drill_mm);
@@ -243,7 +251,9 @@ std::string format_report(const JobReport& r) {
   row("pulses", f.pulses ? fmt("%.0f", *f.pulses) : std::string("n/a"));
   row("short circuits", percent(f.short_fraction()));
   row("arcs", percent(f.arc_fraction()));
-  if (r.alarms.empty()) {
+  if (!r.alarms_seen) {
+    // Nothing watched the job's alarms: the outcome row has the machine's last cause.
+  } else if (r.alarms.empty()) {
     row("alarms", "none");
   } else {
     row("alarms", std::to_string(r.alarms.size()));

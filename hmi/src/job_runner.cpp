@@ -230,6 +230,7 @@ RunResult run_job(bridge::Client& client, const RunRequest& req, const RunCallba
   result.report.part = req.part;
   result.report.machine = req.machine;
   result.report.targets = program_targets(req.blocks, req.frames);
+  result.report.dry_run = req.dry_run;
   result.report.electrode_at_start_mm = figures_from_status(before).electrode_mm;
   if (req.detach) {
     result.outcome = RunOutcome::kDetached;

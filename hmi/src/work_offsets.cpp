@@ -46,7 +46,9 @@ bool offsets_from_json(const bridge::Json& j, WorkOffsets& out, std::string& err
       return false;
     }
     machining::Vec3& v = o.frame[static_cast<std::size_t>(*i)];
-    for (auto [key, field] : {std::pair{"x", &v.x}, std::pair{"y", &v.y}, std::pair{"z", &v.z}}) {
+    double& length = o.z_electrode_mm[static_cast<std::size_t>(*i)];
+    for (auto [key, field] : {std::pair{"x", &v.x}, std::pair{"y", &v.y}, std::pair{"z", &v.z},
+                              std::pair{"z_electrode_mm", &length}}) {
       const auto it = f.find(key);
       if (it == f.end()) continue;
       if (!it->is_number() || !std::isfinite(it->get<double>())) {
@@ -55,6 +57,17 @@ bool offsets_from_json(const bridge::Json& j, WorkOffsets& out, std::string& err
       }
       *field = it->get<double>();
     }
+    if (length < 0.0) {
+      error = name + ".z_electrode_mm: an electrode length cannot be negative";
+      return false;
+    }
+  }
+  if (const auto e = j.find("electrode_mm"); e != j.end()) {
+    if (!e->is_number() || !std::isfinite(e->get<double>()) || e->get<double>() < 0.0) {
+      error = "electrode_mm: not a length (a finite number of mm, >= 0)";
+      return false;
+    }
+    o.electrode_mm = e->get<double>();
   }
   out = o;
   return true;
@@ -64,9 +77,13 @@ bridge::Json to_json(const WorkOffsets& offsets) {
   bridge::Json frames = bridge::Json::object();
   for (int i = 0; i < kWorkFrames; ++i) {
     const machining::Vec3& v = offsets.frame[static_cast<std::size_t>(i)];
-    frames[frame_name(i)] = {{"x", v.x}, {"y", v.y}, {"z", v.z}};
+    frames[frame_name(i)] = {
+        {"x", v.x},
+        {"y", v.y},
+        {"z", v.z},
+        {"z_electrode_mm", offsets.z_electrode_mm[static_cast<std::size_t>(i)]}};
   }
-  return {{"frames", frames}};
+  return {{"frames", frames}, {"electrode_mm", offsets.electrode_mm}};
 }
 
 std::string format_frame(int index, const machining::Vec3& v) {

@@ -124,22 +124,23 @@ class Checker {
         arc_bounding_box(from.x - b.centre.x, from.y - b.centre.y, b.target.x - b.centre.x,
                          b.target.y - b.centre.y, cw, b.turns > 0);
     const std::string extent = std::string(cw ? "G02" : "G03") + " arc: ";
-    check_point(i, b, {b.centre.x + box.min_x, b.centre.y + box.min_y, b.target.z}, extent);
-    check_point(i, b, {b.centre.x + box.max_x, b.centre.y + box.max_y, b.target.z}, extent, false);
+    check_point(i, b, {b.centre.x + box.min_x, b.centre.y + box.min_y, from.z}, extent);
+    check_point(i, b, {b.centre.x + box.max_x, b.centre.y + box.max_y, from.z}, extent, false);
   }
 
   /// The Z axis of a drilling block travels the wear-compensated z_travel_mm (eq. 9-11), past
   /// the nominal bottom; reported when the bottom itself is inside (else the end point says it).
-  void check_drill_travel(std::size_t i, const MotionBlock& b, const Vec3& from) {
+  /// `to`: the block's end where the job puts it (electrode length compensation included).
+  void check_drill_travel(std::size_t i, const MotionBlock& b, const Vec3& from, const Vec3& to) {
     const AxisLimits* z = tables_.axis('Z');
     const double axis_end = from.z - b.z_travel_mm;
-    if (z == nullptr || beyond('Z', b.target.z) != nullptr || beyond('Z', axis_end) == nullptr) {
+    if (z == nullptr || beyond('Z', to.z) != nullptr || beyond('Z', axis_end) == nullptr) {
       return;
     }
-    const double wear = b.z_travel_mm - (from.z - b.target.z);
+    const double wear = b.z_travel_mm - (from.z - to.z);
     limit_issue(i, b, 'Z',
                 "drilling with wear pre-compensation moves Z to " + mm(axis_end) + " mm (nominal " +
-                    mm(b.target.z) + " - wear " + mm(wear) + " mm), beyond the Z soft limit (" +
+                    mm(to.z) + " - wear " + mm(wear) + " mm), beyond the Z soft limit (" +
                     mm(z->min_mm) + ".." + mm(z->max_mm) + " mm)");
   }
 
@@ -185,28 +186,35 @@ std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
       continue;
     }
     if (b.feed_mm_s < 0.0) c.issue(i, b, "negative feed");
+    // Where the job puts the block: Z shifted by the length the electrode lost since the block's
+    // work frame was set (EdmJob compensates rapids and feeds; arcs keep that Z and a drill goes
+    // its travel down from it, so their ends shift alike).
+    Vec3 end = b.target;
+    if (options.electrode_mm > 0.0 && b.electrode_ref_mm > 0.0) {
+      end.z += options.electrode_mm - b.electrode_ref_mm;
+    }
     switch (b.kind) {
       case MotionKind::kRapid:
       case MotionKind::kLinear:
-        c.check_point(i, b, b.target, "");
-        pos = b.target;
+        c.check_point(i, b, end, "");
+        pos = end;
         break;
       case MotionKind::kArcCw:
       case MotionKind::kArcCcw:
         if (b.turns < 0) c.issue(i, b, "negative number of turns");
         c.check_arc(i, b, pos);
-        pos = b.target;
+        pos = end;
         break;
       case MotionKind::kDrill:
-        if (b.target.z >= pos.z) c.issue(i, b, "a drilling block must move Z down (toward -Z)");
-        if (b.target.x != pos.x || b.target.y != pos.y) {
+        if (end.z >= pos.z) c.issue(i, b, "a drilling block must move Z down (toward -Z)");
+        if (end.x != pos.x || end.y != pos.y) {
           c.issue(i, b, "a drilling block must not move X or Y");
         }
         if (!(b.z_travel_mm > 0.0)) c.issue(i, b, "a drilling block needs a positive Z travel");
         if (b.condition < 1) c.issue(i, b, "drilling needs an armed machining condition (E1..)");
-        c.check_point(i, b, b.target, "");
-        c.check_drill_travel(i, b, pos);
-        pos = b.target;
+        c.check_point(i, b, end, "");
+        c.check_drill_travel(i, b, pos, end);
+        pos = end;
         break;
       case MotionKind::kOrbitFinish:
         if (!(b.final_radius_mm > 0.0)) c.issue(i, b, "orbit finishing needs a final radius > 0");

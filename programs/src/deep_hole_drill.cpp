@@ -290,7 +290,7 @@ rt::BlockStatus DeepHoleDrill::update_self(const rt::CycleContext& ctx) noexcept
           v = std::clamp(v, -gap_.params().v_feed_max_mm_s, gap_.params().v_retract_max_mm_s);
         } else {
           v = 0.0;
-          status = rt::worst(status, rt::BlockStatus::kFault);
+          status = fault("a non-finite servo feed (vz_servo_mm_s)");
         }
       }
       v *= retract_.v_scale.get();

@@ -54,6 +54,7 @@ std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) 
   job_ = setup.job;
   if (job_ != nullptr) job_->attach_runner();
   tables_ = setup.tables;
+  electrode_ = setup.electrode;  // none (a test rig): no length compensation
   if (machine_ == nullptr || job_ == nullptr || tables_ == nullptr) {
     errs.push_back({"", "EdmJob needs the runtime's machine, job store and tables"});
     return errs;
@@ -214,6 +215,19 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
   gen_on.set(false);
 }
 
+double EdmJob::z_compensation(const MotionBlock& b) const noexcept {
+  if (electrode_ == nullptr || b.electrode_ref_mm <= 0.0 || !electrode_->known()) return 0.0;
+  return electrode_->length_mm() - b.electrode_ref_mm;
+}
+
+void EdmJob::wear_electrode() noexcept {
+  if (electrode_ == nullptr || electrode_at_start_mm_ <= 0.0) return;
+  // Never 0 (that is "unknown"): an electrode worn to nothing reads 1 µm.
+  // A resumed hole's wear includes its interrupted job's, which that job already took off.
+  const double worn = figures_.job_wear_mm.get() - resumed_wear_mm_;
+  electrode_->set_length_mm(std::max(1e-3, electrode_at_start_mm_ - worn));
+}
+
 void EdmJob::select_condition(int e) noexcept {
   condition_ = e > 0 ? tables_->condition(e) : nullptr;
   gen_arm.set(condition_ != nullptr && !dry_run.get());  // a dry run never arms the generator
@@ -267,7 +281,10 @@ bool EdmJob::run_linear(const MotionBlock& b, const rt::CycleContext& ctx, bool 
     lin_.load.drive(false);
     lin_.length.x().drive(b.target.x - move_from_x_);
     lin_.length.y().drive(b.target.y - move_from_y_);
-    lin_.length.z().drive(b.target.z - move_from_z_);
+    const double comp =
+        b.kind == MotionKind::kRapid || b.kind == MotionKind::kLinear ? z_compensation(b) : 0.0;
+    z_comp_mm.set(comp);
+    lin_.length.z().drive(b.target.z + comp - move_from_z_);
     const double f = b.kind == MotionKind::kRapid
                          ? params_.rapid_speed_mm_s
                          : (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s);
@@ -426,6 +443,10 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
       state_value_ = State::kRun;
       state.set(1);
       figures_.begin(ctx.release);
+      // A dry run never sparks: it wears nothing.
+      electrode_at_start_mm_ =
+          electrode_ != nullptr && !job_->current_options().dry_run ? electrode_->length_mm() : 0.0;
+      resumed_wear_mm_ = 0.0;
       step_ = Step::kEnter;
       condition_ = nullptr;
       gen_arm.set(false);
@@ -475,6 +496,8 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   status = rt::worst(status, step(pz_, ctx));
 
   status = rt::worst(status, command_axes(ctx));
+  if (state_value_ == State::kRun) wear_electrode();
+  electrode_mm.set(electrode_ != nullptr ? electrode_->length_mm() : 0.0);
   if (drill_.running()) hold_z_ = z;
   bool generator = false;
   for (const MachiningCycle* c : cycles_) generator = generator || c->generator_on();

@@ -101,6 +101,7 @@ bool EdmJob::run_drill(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     drill_return_.col = b.col;
     drill_return_.target = {pos.x().get(), pos.y().get(), pos.z().get()};
     figures_.begin_drill_block();
+    resumed_wear_mm_ += b.resume_wear_mm;
     const double depth = b.depth_mm > 0.0 ? b.depth_mm : -b.target.z;
     // A resumed hole counts on from its interrupted drill (the rough drilling too).
     const DrillFrom from{.depth_done_mm = b.depth_done_mm,

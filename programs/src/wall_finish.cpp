@@ -260,7 +260,10 @@ rt::BlockStatus WallFinish::update_self(const rt::CycleContext& ctx) noexcept {
     if (!spark_out_ && params_.no_spark_timeout > rt::Duration::zero() &&
         dark_s_ >= rt::to_seconds(params_.no_spark_timeout)) {
       no_spark.set(true);  // the task raises the block-fault alarm: safe state, job aborted
-      status = rt::BlockStatus::kFault;
+      status = fault(
+          "no spark for no_spark_timeout while orbiting: the electrode does not reach "
+          "the wall (worn shorter than the job assumed, or a wrong offset)",
+          dark_s_);
     }
     retracting = handle_short(ctx, status);
     if (retracting || short_pins.short_now.get()) {

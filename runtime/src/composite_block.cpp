@@ -90,12 +90,14 @@ void CompositeBlock::enter_safe_state(const SafeStateRequest& request) noexcept 
 
 BlockStatus CompositeBlock::update(const CycleContext& ctx) noexcept {
   fault_source_ = nullptr;
+  child_cause_ = {};
   return update_self(ctx);
 }
 
 BlockStatus CompositeBlock::step(Block& child, const CycleContext& ctx) noexcept {
   const BlockStatus s = child.update(ctx);
   if (s == BlockStatus::kFault) {
+    child_cause_ = child.fault_cause();  // with the source: the last child that faulted
     if (const char* inner = child.fault_source(); inner != nullptr) {
       fault_source_ = inner;
     } else {

@@ -20,7 +20,7 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "io", "axes", "safety", "realtime"});
+  auto m = r_.map(v, {"name", "io", "electrode", "axes", "safety", "realtime"});
   if (!m) {
     return;
   }
@@ -40,6 +40,26 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
   }
   if (const Field* f = m->find("realtime")) {
     parse_realtime(f->value, out.realtime);
+  }
+  if (const Field* f = m->find("electrode")) {
+    parse_electrode(f->value, out.electrode);
+  }
+}
+
+void Parser::parse_electrode(const Value& v, ElectrodeSpec& out) {
+  out.loc = v.loc;
+  auto m = r_.map(v, {"length_mm"});
+  if (!m) {
+    return;
+  }
+  if (const Field* f = r_.require(*m, "length_mm")) {
+    if (auto l = r_.real(f->value)) {
+      if (!(*l > 0.0 && *l <= 10000.0)) {
+        r_.error(f->value, "must be in (0, 10000] mm (the electrode's length)");
+      } else {
+        out.length_mm = *l;
+      }
+    }
   }
 }
 

@@ -180,6 +180,8 @@ bool Machine::raise(const Alarm& in) noexcept {
         l.source.store(a.source, std::memory_order_relaxed);
         l.first_ns.store(a.time.count(), std::memory_order_relaxed);
         l.count.store(1, std::memory_order_relaxed);
+        l.text.store(a.text != nullptr ? a.text : "", std::memory_order_relaxed);
+        l.value.store(a.value, std::memory_order_relaxed);
         l.state.store(2, std::memory_order_release);
         break;
       }
@@ -225,7 +227,9 @@ std::size_t Machine::active_alarms(ActiveAlarm* out, std::size_t capacity) const
     out[n++] = ActiveAlarm{l.code.load(std::memory_order_relaxed),
                            l.source.load(std::memory_order_relaxed),
                            TimePoint{l.first_ns.load(std::memory_order_relaxed)},
-                           l.count.load(std::memory_order_relaxed)};
+                           l.count.load(std::memory_order_relaxed),
+                           l.text.load(std::memory_order_relaxed),
+                           l.value.load(std::memory_order_relaxed)};
   }
   return n;
 }

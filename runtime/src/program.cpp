@@ -29,12 +29,14 @@ BlockStatus Program::run(const CycleContext& ctx) noexcept {
         // A C++ PROGRAM names the child that raised the fault ("cnc.job.drill.gap").
         const char* inner = e.block->fault_source();
         e.fault_source = inner != nullptr ? inner : e.full_name.c_str();
+        const FaultCause why = e.block->fault_cause();
         Alarm a;
         a.code = AlarmCode::kBlockFault;
         a.severity = AlarmSeverity::kFault;
         a.time = ctx.release;
         a.source = e.fault_source;
-        a.text = "block reported a fault";
+        a.text = why.text != nullptr ? why.text : "block reported a fault (it gave no cause)";
+        a.value = why.value;
         machine_->raise(a);
       }
       worst = BlockStatus::kFault;

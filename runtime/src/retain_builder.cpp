@@ -96,15 +96,15 @@ class RetainBuilder {
       vars.insert(vars.end(), std::make_move_iterator(job_vars.begin()),
                   std::make_move_iterator(job_vars.end()));
     }
-    {  // the work offsets G54…G59 are retained whenever there is a retain file
-      auto offset_vars = retain_offsets::variables(rt_.work_offsets_);
+    {  // the work offsets G54…G59 and the electrode length whenever there is a retain file
+      auto offset_vars = retain_offsets::variables(rt_.work_offsets_, rt_.electrode_);
       vars.insert(vars.end(), std::make_move_iterator(offset_vars.begin()),
                   std::make_move_iterator(offset_vars.end()));
     }
     RetainLoadResult loaded = load_retain_file(path);
     switch (loaded.status) {
       case RetainLoadStatus::kLoaded:
-        retain_offsets::take(loaded.values, rt_.work_offsets_);
+        retain_offsets::take(loaded.values, rt_.work_offsets_, rt_.electrode_);
         if (job_record) {
           rt_.interrupted_job_ = retain_job::take(loaded.values);
           if (rt_.interrupted_job_) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "edm/runtime/alarm_help.hpp"
 #include "edm/runtime/rt_environment.hpp"
 #include "edm/runtime/scheduler.hpp"
 
@@ -43,12 +44,15 @@ void Runtime::drain_alarms() {
   Alarm a;
   while (machine_.pop_alarm(a)) {
     const double t_s = to_seconds(a.time);  // the release time of the cycle that raised it
+    const std::string_view remedy = alarm_help(a.code).remedy;
     if (a.severity == AlarmSeverity::kFault) {
-      spdlog::error("ALARM {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
-                    to_string(a.code), a.source, t_s, a.text, a.value);
+      spdlog::error("ALARM {} ({}) from {} at t={:.6f}s: {} [value {}]; remedy: {}",
+                    static_cast<int>(a.code), to_string(a.code), a.source, t_s, a.text, a.value,
+                    remedy);
     } else {
-      spdlog::warn("alarm {} ({}) from {} at t={:.6f}s: {} [value {}]", static_cast<int>(a.code),
-                   to_string(a.code), a.source, t_s, a.text, a.value);
+      spdlog::warn("alarm {} ({}) from {} at t={:.6f}s: {} [value {}]; remedy: {}",
+                   static_cast<int>(a.code), to_string(a.code), a.source, t_s, a.text, a.value,
+                   remedy);
     }
     for (const auto& listener : alarm_listeners_) {
       listener(a);

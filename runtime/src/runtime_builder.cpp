@@ -60,6 +60,7 @@ class RuntimeBuilder {
     rt_.reset(new Runtime());
     rt_->config_ = cfg_;
     rt_->tables_ = to_machine_tables(cfg_);
+    rt_->electrode_.set_length_mm(cfg_.machine.electrode.length_mm);  // retain may override
     make_tasks();
     make_driver();
     make_programs();
@@ -238,7 +239,8 @@ class RuntimeBuilder {
   }
 
   BlockSetup setup(std::string_view instance, Duration period) {
-    return BlockSetup{instance, period, &rt_->machine_, &rt_->job_, &rt_->tables_, &rt_->manual_};
+    return {instance,      period,        &rt_->machine_,  &rt_->job_,
+            &rt_->tables_, &rt_->manual_, &rt_->electrode_};
   }
 
   void make_programs() {

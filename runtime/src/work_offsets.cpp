@@ -23,15 +23,28 @@ std::array<WorkFrame, WorkOffsets::kFrames> WorkOffsets::all() const {
 }
 
 WorkFrame WorkOffsets::set(int index, std::optional<double> x, std::optional<double> y,
-                           std::optional<double> z) {
+                           std::optional<double> z, double z_electrode_mm) {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (index < 0 || index >= kFrames) return {};
   WorkFrame& f = frames_[static_cast<std::size_t>(index)];
   if (x && std::isfinite(*x)) f.x = *x;
   if (y && std::isfinite(*y)) f.y = *y;
-  if (z && std::isfinite(*z)) f.z = *z;
+  if (z && std::isfinite(*z)) {
+    f.z = *z;
+    f.z_electrode_mm = std::isfinite(z_electrode_mm) && z_electrode_mm > 0.0 ? z_electrode_mm : 0.0;
+  }
   ++generation_;
   return f;
+}
+
+void WorkOffsets::restore(int index, const WorkFrame& frame) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (index < 0 || index >= kFrames) return;
+  auto finite = [](double v) { return std::isfinite(v) ? v : 0.0; };
+  frames_[static_cast<std::size_t>(index)] = {
+      finite(frame.x), finite(frame.y), finite(frame.z),
+      frame.z_electrode_mm > 0.0 ? finite(frame.z_electrode_mm) : 0.0};
+  ++generation_;
 }
 
 std::uint64_t WorkOffsets::generation() const {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <set>
 
@@ -29,6 +30,7 @@ MotionBlock random_block(std::mt19937_64& rng) {
   b.final_radius_mm = (n(rng) % 2 == 0) ? 0.0 : x(rng);
   b.dwell_s = 1e-9 * x(rng);
   b.on = n(rng) % 2 == 0;
+  b.electrode_ref_mm = n(rng) % 3 == 0 ? 0.0 : 50.0 + std::abs(x(rng)) / 10.0;
   return b;
 }
 
@@ -121,6 +123,20 @@ TEST(Codec, one_block_record_matches_python_struct_pack) {
   b.condition = 1;
   b.z_travel_mm = 10.6;
   EXPECT_EQ(format_checksum(program_checksum(std::span(&b, 1))), "0ef656b5");
+  // A block of a work frame carries its electrode length: 8 more bytes, '<Bii6didi7dBd' (issue
+  // 33); a block without one keeps the 130-byte record above (older clients' checksums hold).
+  b.electrode_ref_mm = 289.5;
+  EXPECT_EQ(format_checksum(program_checksum(std::span(&b, 1))), "be2a376e");
+  MotionBlock back;
+  std::string why;
+  ASSERT_TRUE(from_json(to_json(b), back, why)) << why;
+  EXPECT_EQ(back.electrode_ref_mm, 289.5);
+  for (const char* bad :
+       {R"({"kind":"rapid","electrode_ref_mm":-1})", R"({"kind":"rapid","electrode_ref_mm":1e5})",
+        R"({"kind":"rapid","electrode_ref_mm":"300"})"}) {
+    EXPECT_FALSE(from_json(Json::parse(bad), back, why)) << bad;
+    EXPECT_NE(why.find("'electrode_ref_mm'"), std::string::npos) << bad << " -> " << why;
+  }
 }
 
 TEST(Codec, checksum_text_round_trips_and_rejects_junk) {

@@ -140,6 +140,7 @@ class OpStates : public ::testing::Test {
     }
     if (op == "touch") return {{"target", "z"}};
     if (op == "offset.set") return {{"frame", "G54"}, {"x", 1.0}};
+    if (op == "electrode.set") return {{"length_mm", 300.0}};
     return Json::object();
   }
 

@@ -276,5 +276,61 @@ TEST_F(OperatorOps, MdiRunsBesideTheLoadedProgramWithoutReplacingIt) {
   EXPECT_EQ(rt_->job().progress().block_count, 3U);
 }
 
+// A machine stops before a hole it cannot finish (issue 33): cycle.start compares the program's
+// planned wear (eq. 9-11, hole by hole) with the electrode left less the supervisor's margin,
+// and refuses naming the first hole the electrode would not finish. A dry run wears nothing.
+TEST_F(OperatorOps, ACycleStartIsRefusedWhenTheElectrodeCannotFinishTheProgram) {
+  start();
+  MotionBlock e1;
+  e1.kind = MotionKind::kCondition;
+  e1.condition = 1;
+  e1.line = 3;
+  const double z = var("io.z_mm");
+  std::vector<MotionBlock> prog{e1};
+  for (const std::int32_t line : {4, 6}) {  // two 8 mm holes (the check is offline: one XY does)
+    if (line == 6) {
+      MotionBlock up;
+      up.kind = MotionKind::kRapid;
+      up.line = 5;
+      up.target = {var("io.x_mm"), var("io.y_mm"), z};
+      prog.push_back(up);
+    }
+    MotionBlock hole;
+    hole.kind = MotionKind::kDrill;
+    hole.line = line;
+    hole.condition = 1;
+    hole.target = {var("io.x_mm"), var("io.y_mm"), z - 8.0};
+    hole.depth_mm = 8.0;
+    hole.z_travel_mm = 8.0 * 1.6;
+    hole.feed_mm_s = 1.0;
+    prog.push_back(hole);
+  }
+  prog.push_back(end_block(7));
+  ASSERT_TRUE(op_.upload_program(prog));
+  const Json planned = op_.request("electrode.get").body;
+  ASSERT_EQ(planned["length_mm"], 300.0);
+
+  // 13 mm of electrode: 8 usable above the 5 mm margin; the first hole plans ~6.6 mm, both ~13.
+  ASSERT_TRUE(op_.request("electrode.set", {{"length_mm", 13.0}}));
+  const Reply r = op_.request("cycle.start");
+  expect_error(r, ErrorCode::kInvalidState);
+  EXPECT_NE(r.message.find("run out in the hole of line 6"), std::string::npos) << r.message;
+  EXPECT_EQ(r.details["line"], 6) << r.details;
+  EXPECT_EQ(rt_->machine().state(), rt::MachineState::kReady) << "nothing started";
+
+  // A dry run never erodes: it may start.
+  ASSERT_TRUE(op_.request("cycle.start", {{"dry_run", true}}));
+  ASSERT_TRUE(op_.request("cycle.stop"));
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (rt_->job().active() || rt_->machine().state() != rt::MachineState::kReady) {
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline);
+    std::this_thread::sleep_for(10ms);
+  }
+  // Enough electrode: the start is accepted.
+  ASSERT_TRUE(op_.request("electrode.set", {{"length_mm", 40.0}}));
+  EXPECT_TRUE(op_.request("cycle.start"));
+  ASSERT_TRUE(op_.request("cycle.stop"));
+}
+
 }  // namespace
 }  // namespace edm::bridge::test

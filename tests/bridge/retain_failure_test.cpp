@@ -98,6 +98,52 @@ TEST_F(RetainFailure, offset_set_answers_retain_failed_changes_nothing_and_raise
   EXPECT_EQ(rt_->work_offsets().get(1).z, -3.25);
 }
 
+// The electrode length (issue 33): set by the operator, recorded with a work frame's new Z, kept
+// across a restart; refused and unchanged when the file cannot be written; bad input refused.
+TEST_F(RetainFailure, electrode_set_is_retained_with_the_frames_or_refused_and_unchanged) {
+  Reply r = c_.request("electrode.get");
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(r.body["length_mm"], 300.0) << "drill-sim's machine.electrode";
+  EXPECT_EQ(r.body["known"], true);
+  r = c_.request("offset.set", {{"frame", "G54"}, {"z", -2.0}});
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(r.body["z_electrode_mm"], 300.0) << "a new Z records the length it was set with";
+  r = c_.request("electrode.set", {{"length_mm", 250.5}});
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(r.body["length_mm"], 250.5);
+  EXPECT_EQ(r.body["retained"], true);
+  r = c_.request("offset.get");
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(r.body["frames"]["G54"]["z_electrode_mm"], 300.0) << "the frame keeps its length";
+  EXPECT_EQ(r.body["electrode_mm"], 250.5);
+  r = c_.request("offset.set", {{"frame", "G54"}, {"x", 4.0}});
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(r.body["z_electrode_mm"], 300.0) << "only a new Z records a new length";
+
+  for (const Json& bad : {Json{{"length_mm", -1.0}}, Json{{"length_mm", 0.0}},
+                          Json{{"length_mm", 2e4}}, Json{{"length_mm", "300"}}, Json::object()}) {
+    expect_error(c_.request("electrode.set", bad), ErrorCode::kBadRequest);
+  }
+  EXPECT_EQ(rt_->electrode().length_mm(), 250.5) << "refused requests change nothing";
+
+  break_the_store();
+  r = c_.request("electrode.set", {{"length_mm", 200.0}});
+  expect_error(r, ErrorCode::kRetainFailed);
+  EXPECT_NE(r.message.find("the electrode length is unchanged"), std::string::npos) << r.message;
+  EXPECT_EQ(rt_->electrode().length_mm(), 250.5) << "not kept, so not set";
+  EXPECT_TRUE(alarm_183());
+  mend_the_store();
+  r = c_.request("electrode.set", {{"length_mm", 240.25}});
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_FALSE(alarm_183()) << "cleared by the next good write";
+
+  shut();
+  build();
+  EXPECT_EQ(rt_->electrode().length_mm(), 240.25) << "the retained length wins over the config's";
+  EXPECT_EQ(rt_->work_offsets().get(0).z, -2.0);
+  EXPECT_EQ(rt_->work_offsets().get(0).z_electrode_mm, 300.0);
+}
+
 TEST_F(RetainFailure, a_background_write_failure_raises_183_once_and_a_good_one_clears_it) {
   break_the_store();
   ASSERT_EQ(rt_->retain()->sync(), rt::RetainStore::SyncResult::kFailed);

@@ -45,11 +45,10 @@ TEST(EdmhmiCheck, GoodProgramPrintsASummaryAndExitsZero) {
 TEST(EdmhmiCheck, BadProgramPrintsLocatedErrorsAndExitsTwo) {
   edm::test::TempDir dir;
   const std::string part = dir.file("bad.nc");
-  std::ofstream(part) << "G00 X0\nG20\nG00 X500\nM30\n";
+  std::ofstream(part) << "G00 X0\nG18\nG00 X500\nM30\n";
   const Outcome r = edmhmi({"check", part});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.output.find(part + ":2:1: 'G20' (inch units) is not supported"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find(part + ":2:1: 'G18' is not supported"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(part + ":3:5: X 500.000 mm is beyond the X soft limit"),
             std::string::npos)
       << r.output;

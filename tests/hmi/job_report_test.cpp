@@ -198,6 +198,34 @@ TEST(FormatReport, ShowsTheDepthErrorAndFractionsFromTheNumbers) {
   EXPECT_NE(text.find(row("alarms", "none")), std::string::npos) << text;
 }
 
+// A dry run moves without drilling: its report says so and reports no depth error (issue 33: it
+// read "error -12.0000 mm").
+TEST(FormatReport, ADryRunIsLabelledAndHasNoDepthError) {
+  JobReport r = sample_report();
+  r.dry_run = true;
+  r.end.depth_mm = 0.0;
+  const std::string text = format_report(r);
+  EXPECT_NE(text.find(row("outcome", "finished (dry run)")), std::string::npos) << text;
+  EXPECT_NE(text.find(row("depth reached", "not drilled: a dry run (program 15.0000 mm)")),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("error"), std::string::npos) << text;
+}
+
+// `edmhmi status` knows the machine's last cause, not the job's alarms: it must not print
+// "FAULT (alarm 110)" and then "alarms none" (issue 33).
+TEST(FormatReport, AReportWhoseAlarmsWereNotWatchedClaimsNone) {
+  JobReport r = sample_report();
+  r.outcome = "aborted";
+  r.state = "FAULT";
+  r.cause = 110;
+  r.alarms_seen = false;
+  const std::string text = format_report(r);
+  EXPECT_NE(text.find(row("outcome", "aborted (machine FAULT, alarm 110)")), std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("alarms"), std::string::npos) << text;
+}
+
 TEST(FormatReport, AbortedJobShowsCauseAlarmsAndMissingFigures) {
   JobReport r = sample_report();
   r.outcome = "aborted";

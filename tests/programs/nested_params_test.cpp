@@ -226,6 +226,12 @@ TEST(NestedParams, AFaultNamesTheChildThatRaisedIt) {
   }
   EXPECT_TRUE(named) << seen;
   EXPECT_EQ(r->machine().state(), rt::MachineState::kFault);
+  // Issue 33: the alarm says why, in the td detector's words, with the value that tripped it.
+  for (std::size_t k = 0; k < n; ++k) {
+    if (alarms[k].code != rt::AlarmCode::kBlockFault) continue;
+    EXPECT_STREQ(alarms[k].text, "a pulse counter out of range, or not configured");
+    EXPECT_TRUE(std::isfinite(alarms[k].value)) << "the total of the counters that disagreed";
+  }
 }
 
 }  // namespace

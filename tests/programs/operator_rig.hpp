@@ -28,6 +28,7 @@ struct OperatorRig {
   rt::VirtualClock clock;
   std::unique_ptr<rt::VirtualScheduler> sched;
   rt::TimePoint now{};
+  std::uint64_t jobs_before_start{0};  // the job store's count when start_program() started one
 
   /// `sim_params`: extra simulator parameters ("work_surface_z_mm: -7.3, …"); `manual`: the
   /// job's manual child's parameters ("referenced_at_start: false, …"); `machine`: a drill
@@ -87,28 +88,40 @@ struct OperatorRig {
     r.value = mm;
     return request(r);
   }
-  /// Checks `blocks` from the current position as program.commit does, loads them into `slot`,
-  /// starts and runs until the job ends (or `limit`); true when it finished.
-  bool run_program(std::vector<machining::MotionBlock> blocks, rt::JobSlot slot,
-                   rt::Duration limit = std::chrono::seconds(600)) {
+  /// Checks `blocks` from the current position as program.commit does, loads them into `slot`
+  /// and starts them; false (a test failure) when refused.
+  bool start_program(std::vector<machining::MotionBlock> blocks, rt::JobSlot slot) {
     const machining::Vec3 at{read("io.x_mm"), read("io.y_mm"), read("io.z_mm")};
-    const auto issues = machining::check_program(blocks, runtime->tables(), at);
+    machining::ProgramCheckOptions check;
+    check.electrode_mm = runtime->electrode().length_mm();  // as program.commit checks
+    const auto issues = machining::check_program(blocks, runtime->tables(), at, check);
     EXPECT_TRUE(issues.empty()) << "line " << issues.front().line << ": " << issues.front().message;
     if (!issues.empty()) return false;
     auto& job = runtime->job();
     const auto loaded =
         slot == rt::JobSlot::kMdi ? job.load_mdi(std::move(blocks)) : job.load(std::move(blocks));
     EXPECT_EQ(loaded, rt::LoadResult::kOk);
-    const std::uint64_t started = job.progress().jobs_started;
     job.set_start_options({slot, false});
-    EXPECT_EQ(runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+    jobs_before_start = job.progress().jobs_started;
+    const auto started = runtime->machine().command(rt::MachineCommand::kStart);
+    EXPECT_EQ(started, rt::CommandResult::kOk);
+    return loaded == rt::LoadResult::kOk && started == rt::CommandResult::kOk;
+  }
+  /// Runs until the started job has ended (or `limit`, or a safe state); true when it finished.
+  bool run_to_end(rt::Duration limit = std::chrono::seconds(600)) {
+    auto& job = runtime->job();
     const rt::TimePoint end = now + limit;
-    while (now < end) {
+    while (now < end && !rt::is_safe_state(runtime->machine().state())) {
       run_for(std::chrono::milliseconds(10));
-      if (job.progress().jobs_started > started && !job.active()) break;
-      if (rt::is_safe_state(runtime->machine().state())) break;
+      if (job.progress().jobs_started > jobs_before_start && !job.active()) break;
     }
     return job.progress().outcome == rt::JobOutcome::kFinished;
+  }
+  /// Checks `blocks` from the current position as program.commit does, loads them into `slot`,
+  /// starts and runs until the job ends (or `limit`); true when it finished.
+  bool run_program(std::vector<machining::MotionBlock> blocks, rt::JobSlot slot,
+                   rt::Duration limit = std::chrono::seconds(600)) {
+    return start_program(std::move(blocks), slot) && run_to_end(limit);
   }
   rt::ManualResult touch(rt::TouchTarget t) {
     rt::ManualRequest r;

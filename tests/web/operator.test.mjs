@@ -446,6 +446,12 @@ test('E-stop, then reset', async () => {
   await page.locator('#btn-estop').click();
   await state().filter({ hasText: 'ESTOP' }).waitFor({ timeout: T });
   await page.locator('#alarms li').first().waitFor({ timeout: T });
+  // Issue 33: the alarm says its source, why, and what to do (the texts of docs/safety.md).
+  const first = page.locator('#alarms li', { hasText: '130 estop' }).first();
+  await first.waitFor({ timeout: T });
+  assert.match(await first.locator('.alarm-head').textContent(), /^130 estop · /);
+  assert.match(await first.locator('.alarm-cause').textContent(), /^Cause: the emergency stop/);
+  assert.match(await first.locator('.alarm-remedy').textContent(), /^Remedy: .*release the E-stop/);
   await page.screenshot({ path: join(out, 'estop.png') });
   await page.locator('#btn-ack').click();
   await page.locator('#alarm-count').waitFor({ state: 'hidden', timeout: T });

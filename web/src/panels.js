@@ -5,10 +5,22 @@ const fmt = (v, d = 3) => (typeof v === 'number' && Number.isFinite(v) ? v.toFix
 
 export function renderAlarms(alarms, isOperator) {
   const ul = $('alarms');
+  // Text nodes only: an alarm's strings come from the machine and are never parsed as HTML.
+  const line = (cls, text) => {
+    const d = document.createElement('div');
+    d.className = cls;
+    d.textContent = text;
+    return d;
+  };
   ul.replaceChildren(...alarms.slice(-50).reverse().map((a) => {
     const li = document.createElement('li');
     li.className = `${a.severity} ${a.acked ? 'acked' : 'new'}`;
-    li.textContent = `${a.code} ${a.name} (${a.severity}, ${a.source}) ${a.text}`;
+    const when = a.wall ? new Date(a.wall).toLocaleTimeString() : '';
+    const value = typeof a.value === 'number' ? ` [${fmt(a.value, 4)}]` : '';
+    li.append(line('alarm-head', `${a.code} ${a.name} · ${a.source} · ${when} (t ${fmt(a.t_s, 3)} s)`),
+      line('alarm-text', `${a.text}${value}`));
+    if (a.cause) li.append(line('alarm-cause', `Cause: ${a.cause}`));
+    if (a.remedy) li.append(line('alarm-remedy', `Remedy: ${a.remedy}`));
     return li;
   }));
   const open = alarms.filter((a) => !a.acked).length;

@@ -95,6 +95,7 @@ Json to_json(const MotionBlock& b) {
   put_unless_default(j, "final_radius_mm", b.final_radius_mm, d.final_radius_mm);
   put_unless_default(j, "dwell_s", b.dwell_s, d.dwell_s);
   put_unless_default(j, "on", b.on, d.on);
+  put_unless_default(j, "electrode_ref_mm", b.electrode_ref_mm, d.electrode_ref_mm);
   return j;
 }
 
@@ -139,6 +140,9 @@ bool from_json(const Json& j, MotionBlock& out, std::string& error) {
       ok = finite_number(v, b.final_radius_mm);
     } else if (key == "dwell_s") {
       ok = finite_number(v, b.dwell_s);
+    } else if (key == "electrode_ref_mm") {
+      ok = finite_number(v, b.electrode_ref_mm) && b.electrode_ref_mm >= 0.0 &&
+           b.electrode_ref_mm <= 1e4;
     } else if (key == "on") {
       ok = v.is_boolean();
       if (ok) {
@@ -166,7 +170,7 @@ void Crc32::update(std::span<const std::uint8_t> bytes) noexcept {
 }
 
 void Crc32::update(const MotionBlock& b) noexcept {
-  std::array<std::uint8_t, kBlockRecordBytes> rec{};
+  std::array<std::uint8_t, kBlockRecordBytes + sizeof(double)> rec{};
   std::uint8_t* p = rec.data();
   *p++ = static_cast<std::uint8_t>(b.kind);
   put_le(p, b.line);
@@ -187,7 +191,14 @@ void Crc32::update(const MotionBlock& b) noexcept {
   put_le(p, b.final_radius_mm);
   put_le(p, b.dwell_s);
   *p++ = b.on ? 1 : 0;
-  update(rec);
+  // The electrode length of a block in a work frame follows, when there is one: a client that
+  // never sends it (before issue 33) keeps its 130-byte records.
+  if (b.electrode_ref_mm != 0.0) {
+    put_le(p, b.electrode_ref_mm);
+    update(rec);
+  } else {
+    update(std::span<const std::uint8_t>(rec.data(), kBlockRecordBytes));
+  }
 }
 
 std::uint32_t program_checksum(std::span<const MotionBlock> blocks) noexcept {

@@ -68,6 +68,9 @@ constexpr OpSpec kOps[] = {
     {"manual.status", kView, states(kAll), ops::op_manual_status},
     {"offset.get", kView, states(kAll), ops::op_offset_get},
     {"offset.set", kOper, states(kNotDuringAJob), ops::op_offset_set},
+    {"electrode.get", kView, states(kAll), ops::op_electrode_get},
+    {"electrode.set", kOper, states(kNotDuringAJob), ops::op_electrode_set},
+    {"alarms.get", kView, states(kAll), ops::op_alarms_get},
 };
 
 // A row without a handler, or a name twice, does not compile.
@@ -98,7 +101,7 @@ std::string audit_detail(const std::string& op, const Json& msg) {
       add(key, ops::brief_name(it->get_ref<const std::string&>()));
     }
   }
-  for (const char* key : {"value", "distance", "velocity", "percent", "x", "y", "z"}) {
+  for (const char* key : {"value", "distance", "velocity", "percent", "x", "y", "z", "length_mm"}) {
     if (auto it = msg.find(key); it != msg.end() && it->is_primitive()) {
       // A number, boolean or null dumps as plain ASCII; a string is quoted and escaped.
       add(key, it->is_string() ? ops::brief_name(it->get_ref<const std::string&>())

@@ -243,7 +243,9 @@ Body op_program_commit(Session& s, const Json& msg) {
   const machining::Vec3 start{rt.variables().read("io.x_mm").value_or(0.0),
                               rt.variables().read("io.y_mm").value_or(0.0),
                               rt.variables().read("io.z_mm").value_or(0.0)};
-  const auto issues = machining::check_program(u.blocks, rt.tables(), start);
+  machining::ProgramCheckOptions check;
+  check.electrode_mm = rt.electrode().length_mm();
+  const auto issues = machining::check_program(u.blocks, rt.tables(), start, check);
   if (!issues.empty()) {
     Json list = Json::array();
     for (std::size_t i = 0; i < issues.size() && i < kMaxIssuesReported; ++i) {
@@ -263,6 +265,7 @@ Body op_program_commit(Session& s, const Json& msg) {
   const std::size_t n = u.blocks.size();
   const rt::JobSlot slot = u.slot;
   const std::optional<std::uint64_t> offsets = u.offsets_generation;
+  std::vector<machining::HoleWear> wear = machining::planned_wear(u.blocks, rt.tables());
   const rt::LoadResult loaded = slot == rt::JobSlot::kMdi ? rt.job().load_mdi(std::move(u.blocks))
                                                           : rt.job().load(std::move(u.blocks), got);
   if (loaded != rt::LoadResult::kOk) {
@@ -271,6 +274,7 @@ Body op_program_commit(Session& s, const Json& msg) {
   }
   s.end_upload();
   srv.committed_offsets[static_cast<std::size_t>(slot)] = offsets;
+  srv.committed_wear[static_cast<std::size_t>(slot)] = std::move(wear);
   srv.counters.programs_committed.fetch_add(1, std::memory_order_relaxed);
   s.log(spdlog::level::info, "committed {} of {} blocks (crc32 {})",
         slot == rt::JobSlot::kMdi ? "an MDI program" : "a program", n, format_checksum(got));

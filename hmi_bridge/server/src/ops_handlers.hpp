@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "edm/bridge/op_table.hpp"
+#include "edm/runtime/machine.hpp"
 
 namespace edm::bridge::ops {
 
@@ -48,7 +49,17 @@ Body op_jog(Session& s, const Json& msg);
 Body op_jog_stop(Session& s, const Json& msg);
 Body op_touch(Session& s, const Json& msg);
 Body op_manual_status(Session& s, const Json& msg);
+
+// ops_offsets.cpp: the work offsets and the electrode length (retained).
 Body op_offset_get(Session& s, const Json& msg);
 Body op_offset_set(Session& s, const Json& msg);
+Body op_electrode_get(Session& s, const Json& msg);
+Body op_electrode_set(Session& s, const Json& msg);
+
+// ops_alarms.cpp: the active alarms and the history, each with its cause and remedy.
+Body op_alarms_get(Session& s, const Json& msg);
+/// One alarm as the `alarm` event and the history carry it (source, text, value, machine and
+/// wall time, cause, remedy).
+Json alarm_json(const rt::Alarm& a, std::chrono::system_clock::time_point wall);
 
 }  // namespace edm::bridge::ops

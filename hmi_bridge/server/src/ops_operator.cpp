@@ -1,17 +1,44 @@
 // The operator functions' ops (ops_handlers.hpp; docs/protocol.md "Operator functions"):
 //   home, jog, jog.stop, touch, manual.status   → rt::ManualControl (the runtime's ManualMotion)
-//   offset.get, offset.set                      → rt::WorkOffsets (retained)
+// (offset.* and electrode.*: ops_offsets.cpp)
 #include "ops_operator.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "ops_handlers.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge::ops {
 namespace {
+
+/// The program's planned wear against the electrode left (the estimate less the supervisor's
+/// margin, alarm 160): a refusal naming the first hole the electrode could not finish, or nullopt
+/// (it suffices, or its length is unknown). A machine stops before a hole it cannot finish.
+std::optional<Body> electrode_too_short(rt::Runtime& rt,
+                                        const std::vector<machining::HoleWear>& holes) {
+  const double length = rt.electrode().length_mm();
+  if (!(length > 0.0) || holes.empty()) return std::nullopt;
+  const double margin = rt.config().machine.safety.electrode_margin_mm;
+  const double usable = length - margin;
+  for (const machining::HoleWear& h : holes) {
+    if (h.cumulative_mm <= usable) continue;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "the electrode would run out in the hole of line %d: the program wears an "
+                  "estimated %.3f mm by its end, %.3f mm through that hole; %.3f mm of the "
+                  "%.3f mm electrode is usable (margin %.3f mm): change the electrode "
+                  "(edmhmi electrode set) first",
+                  h.line, holes.back().cumulative_mm, h.cumulative_mm, usable > 0 ? usable : 0.0,
+                  length, margin);
+    return error(ErrorCode::kInvalidState, text,
+                 Json{{"line", h.line}, {"needed_mm", h.cumulative_mm}, {"usable_mm", usable}});
+  }
+  return std::nullopt;
+}
 
 constexpr char kAxisNames[3] = {'X', 'Y', 'Z'};
 
@@ -172,65 +199,6 @@ Body op_manual_status(Session& s, const Json& /*msg*/) {
   return out;
 }
 
-namespace {
-
-Json frame_json(const rt::WorkFrame& f) { return Json{{"x", f.x}, {"y", f.y}, {"z", f.z}}; }
-
-}  // namespace
-
-Body op_offset_get(Session& s, const Json& /*msg*/) {
-  auto& w = s.server().rt.work_offsets();
-  Json frames = Json::object();
-  const auto all = w.all();
-  for (int i = 0; i < rt::WorkOffsets::kFrames; ++i) {
-    frames[rt::WorkOffsets::frame_name(i)] = frame_json(all[static_cast<std::size_t>(i)]);
-  }
-  return Json{{"frames", std::move(frames)}, {"generation", w.generation()}};
-}
-
-Body op_offset_set(Session& s, const Json& msg) {
-  auto& rt = s.server().rt;
-  const Json* f = field(msg, "frame", [](const Json& j) { return j.is_string(); });
-  const auto index =
-      f != nullptr ? rt::WorkOffsets::frame_index(f->get_ref<const std::string&>()) : std::nullopt;
-  if (!index) return error(ErrorCode::kBadRequest, "'frame' must be one of G54 … G59");
-  std::optional<double> v[3];
-  const char* keys[3] = {"x", "y", "z"};
-  for (int k = 0; k < 3; ++k) {
-    auto it = msg.find(keys[k]);
-    if (it == msg.end()) continue;
-    if (!it->is_number() || !std::isfinite(it->get<double>()) ||
-        std::abs(it->get<double>()) > 1e5) {
-      return error(ErrorCode::kBadRequest,
-                   std::string("'") + keys[k] + "' must be a finite number of mm (|v| ≤ 1e5)");
-    }
-    v[k] = it->get<double>();
-  }
-  if (!v[0] && !v[1] && !v[2]) {
-    return error(ErrorCode::kBadRequest, "give at least one of 'x', 'y', 'z'");
-  }
-  const rt::WorkFrame before = rt.work_offsets().get(*index);
-  const rt::WorkFrame nf = rt.work_offsets().set(*index, v[0], v[1], v[2]);
-  // On disk before the reply. A write that fails (the store raises alarm 183) undoes the change:
-  // the operator must never believe an offset is kept that the next start will not have.
-  if (rt.retain() != nullptr && rt.retain()->sync() == rt::RetainStore::SyncResult::kFailed) {
-    rt.work_offsets().set(*index, before.x, before.y, before.z);
-    s.log(spdlog::level::warn, "{} not set: the retain file could not be written",
-          rt::WorkOffsets::frame_name(*index));
-    return error(ErrorCode::kRetainFailed,
-                 "the work offset could not be retained (alarm 183: the retain file '" +
-                     rt.retain()->path() + "' could not be written); " +
-                     rt::WorkOffsets::frame_name(*index) + " is unchanged");
-  }
-  s.log(spdlog::level::info, "set {} to X{} Y{} Z{}", rt::WorkOffsets::frame_name(*index), nf.x,
-        nf.y, nf.z);
-  Json out = frame_json(nf);
-  out["frame"] = rt::WorkOffsets::frame_name(*index);
-  out["generation"] = rt.work_offsets().generation();
-  out["retained"] = rt.retain() != nullptr;  // false: this run retains nothing (no retain file)
-  return out;
-}
-
 Json manual_info_json(const rt::ManualInfo& info) {
   return Json{
       {"available", info.available},
@@ -300,6 +268,12 @@ std::optional<Body> prepare_start(Session& s, const Json& msg) {
                        std::to_string(*gen) + ", now " +
                        std::to_string(rt.work_offsets().generation()) +
                        "): interpret and commit it again");
+    }
+    if (!o.dry_run) {
+      if (auto refused =
+              electrode_too_short(rt, srv.committed_wear[static_cast<std::size_t>(o.slot)])) {
+        return refused;
+      }
     }
   }
   rt.job().set_start_options(o);

@@ -7,6 +7,7 @@
 #include <future>
 #include <set>
 
+#include "ops_handlers.hpp"
 #include "server_impl.hpp"
 
 namespace edm::bridge {
@@ -350,13 +351,12 @@ std::vector<std::shared_ptr<Session>> Server::Impl::live_sessions() const {
 }
 
 void Server::Impl::on_alarm(const rt::Alarm& a) {
-  Json body = {{"code", static_cast<int>(a.code)},
-               {"name", std::string(rt::to_string(a.code))},
-               {"severity", a.severity == rt::AlarmSeverity::kFault ? "fault" : "warning"},
-               {"t_s", rt::to_seconds(a.time)},
-               {"source", std::string(a.source)},
-               {"text", std::string(a.text)},
-               {"value", std::isfinite(a.value) ? Json(a.value) : Json(nullptr)}};
+  const Json body = ops::alarm_json(a, std::chrono::system_clock::now());
+  alarm_history.push_back(body);
+  if (alarm_history.size() > kAlarmHistory) {
+    alarm_history.pop_front();
+    ++alarms_forgotten;
+  }
   for (const auto& s : live_sessions()) {
     if (s->wants(kTopicAlarm)) {
       s->send_event("alarm", body);

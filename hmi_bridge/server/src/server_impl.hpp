@@ -30,6 +30,7 @@
 #include "edm/bridge/status_board.hpp"
 #include "edm/bridge/trace_tap.hpp"
 #include "edm/bridge/transport.hpp"
+#include "edm/machining/wear_precomp.hpp"
 #include "edm/runtime/log_escape.hpp"
 #include "edm/runtime/log_limiter.hpp"
 #include "edm/runtime/runtime.hpp"
@@ -109,6 +110,9 @@ struct Server::Impl {
   /// Per job slot (main, MDI): the work-offset generation the committed program was interpreted
   /// with (program.begin's offsets_generation), checked again at cycle.start.
   std::array<std::optional<std::uint64_t>, 2> committed_offsets;
+  /// Per job slot: the electrode wear the committed program is planned with, hole by hole
+  /// (machining::planned_wear), checked against the electrode left at cycle.start.
+  std::array<std::vector<machining::HoleWear>, 2> committed_wear;
   ServerOptions opt;
   TokenSet tokens;
   std::shared_ptr<asio::ssl::context> tls;  // null: plain TCP
@@ -128,6 +132,10 @@ struct Server::Impl {
     Impl* target{nullptr};
   };
   std::shared_ptr<AlarmLink> alarm_link{std::make_shared<AlarmLink>()};
+  /// The alarms raised since the start, newest last, capped (alarms.get). Server thread only.
+  static constexpr std::size_t kAlarmHistory = 500;
+  std::deque<Json> alarm_history;
+  std::uint64_t alarms_forgotten{0};  // dropped from the history's front by the cap
   std::uint16_t bound_port{0};
   std::uint64_t next_session_id{1};
 

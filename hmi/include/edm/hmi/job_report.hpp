@@ -26,6 +26,9 @@ struct JobFigures {
   std::optional<double> time_s, pulses, shorts, arcs, depth_mm, wear_mm;
   std::optional<double> hole_depth_mm, electrode_mm, wall_radius_mm;
   std::optional<double> x_mm, y_mm, z_mm;
+  /// The job's electrode length compensation of its last move (cnc.job.z_comp_mm): the spindle
+  /// Z is the tip's plus this, so the tip in work coordinates is machine − offset − this.
+  std::optional<double> z_comp_mm;
 
   [[nodiscard]] std::optional<double> short_fraction() const;
   [[nodiscard]] std::optional<double> arc_fraction() const;
@@ -96,6 +99,9 @@ struct JobReport {
   std::optional<double> electrode_at_start_mm;  // io.electrode_mm before cycle.start
   std::vector<std::string> alarms;              // "code name: text" as they came
   int fault_alarms{0};                          // of them, with fault severity
+  bool dry_run{false};     // the motion only: nothing was drilled, so no depth error is reported
+  bool alarms_seen{true};  // `alarms` were watched during the job (not so for `edmhmi status`,
+                           // which has the machine's last cause only: no "alarms none" then)
 };
 
 /// The machine's side of a report from one status: outcome, state, the alarm cause (only while in

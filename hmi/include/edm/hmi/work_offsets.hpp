@@ -22,6 +22,12 @@ inline constexpr int kWorkFrames = 6;  // G54 .. G59
 struct WorkOffsets {
   /// frame[0] is G54, frame[5] G59: each frame's origin in machine coordinates (mm).
   std::array<machining::Vec3, kWorkFrames> frame{};
+  /// The electrode length each frame's Z was set with (0: unknown): a block interpreted in the
+  /// frame carries it, and the job moves its Z by the length lost since.
+  std::array<double, kWorkFrames> z_electrode_mm{};
+  /// The electrode length when the offsets were read (`offset.get`'s electrode_mm; 0: unknown):
+  /// what the program check compensates with.
+  double electrode_mm{0.0};
   friend bool operator==(const WorkOffsets&, const WorkOffsets&) = default;
 };
 
@@ -41,10 +47,10 @@ std::optional<int> frame_index(std::string_view name);
 /// machine − offset, axis by axis.
 machining::Vec3 to_work(const machining::Vec3& machine, const machining::Vec3& offset) noexcept;
 
-/// The frames of an `offset.get` reply ({"frames": {"G54": {"x", "y", "z"}, ...}}) or of the
-/// same object saved to a file. Frames absent from `j` stay zero; an axis absent from a frame is
-/// 0. False with `error` set when `j` is not that shape (a non-finite or non-number coordinate, an
-/// unknown frame name).
+/// The frames of an `offset.get` reply ({"frames": {"G54": {"x", "y", "z", "z_electrode_mm"},
+/// ...}}) or of the same object saved to a file. Frames absent from `j` stay zero; an axis absent
+/// from a frame is 0. False with `error` set when `j` is not that shape (a non-finite or non-number
+/// coordinate, an unknown frame name).
 bool offsets_from_json(const bridge::Json& j, WorkOffsets& out, std::string& error);
 /// {"frames": {"G54": {"x", "y", "z"}, ...}} — what offsets_from_json reads back.
 bridge::Json to_json(const WorkOffsets& offsets);

@@ -67,6 +67,9 @@ struct MotionBlock {
   double final_radius_mm{0.0};    // kOrbitFinish: final hole radius (mm, absolute, > 0)
   double dwell_s{0.0};            // kDwell
   bool on{false};                 // kRotation / kFlushing
+  double electrode_ref_mm{0.0};   // the electrode length the block's Z assumes (its work frame's
+                                  // Z was set with it): the job moves Z by the length lost since
+                                  // (rt::Electrode); 0 = none (machine coordinates, or unknown)
   friend bool operator==(const MotionBlock&, const MotionBlock&) = default;
 };
 

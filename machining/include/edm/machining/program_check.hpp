@@ -29,6 +29,11 @@ struct ProgramCheckOptions {
   std::size_t max_blocks{1'000'000};
   double arc_tolerance_mm{0.002};  // |start − centre| vs |end − centre|
   double max_dwell_s{3600.0};
+  /// The electrode length now (rt::Electrode; 0: unknown). A rapid or feed with an
+  /// electrode_ref_mm is checked where the job will put it: Z shifted by the length lost since its
+  /// work frame's Z was set (the wear of the program's own holes, which lowers it further, is not
+  /// known here).
+  double electrode_mm{0.0};
 };
 
 /// Every problem found (empty = accepted): non-finite numbers, unknown conditions, end points and

@@ -13,6 +13,13 @@
 // travel lz' and the travel eq. (8) produces agree. lz is the depth actually eroded: the part of
 // the block below the work surface (Z0 of the program), no wear is planned for the air above it.
 
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "edm/machining/machine_tables.hpp"
+#include "edm/machining/motion_block.hpp"
+
 namespace edm::machining {
 
 struct WearPrecomp {
@@ -28,5 +35,18 @@ WearPrecomp wear_precompensate(double lz_mm, double wear_ratio, double area_rati
 /// Eq. (9): machining time of lz at the workpiece removal rate mrr_w (mm³/s) through area A
 /// (mm²); 0 when mrr_w ≤ 0.
 double machining_time_s(double lz_mm, double mrr_w_mm3_s, double area_mm2) noexcept;
+
+/// One drilling block of a program and the electrode wear planned through it.
+struct HoleWear {
+  std::size_t block{0};     // index in the program
+  std::int32_t line{0};     // its G-code line
+  double cumulative_mm{0};  // Σ δ (eq. 10) of the program's drilling blocks up to this one
+};
+/// The wear a program is planned with, hole by hole: δ of each drilling block's depth still to
+/// erode (depth_mm − depth_done_mm; a machine-coordinate program's −target.z) at its
+/// condition's θ and A_hole/A_e, as the interpreter plans it. A block of an unknown condition plans
+/// no wear (check_program refuses it).
+std::vector<HoleWear> planned_wear(std::span<const MotionBlock> program,
+                                   const MachineTables& tables);
 
 }  // namespace edm::machining

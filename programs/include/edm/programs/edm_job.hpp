@@ -92,6 +92,7 @@
 #include "edm/programs/wall_finish.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
+#include "edm/runtime/electrode.hpp"
 #include "edm/runtime/job.hpp"
 #include "edm/runtime/xyz_pins.hpp"
 
@@ -131,6 +132,10 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Output<std::int64_t> line{pins_, "line"};
   rt::Output<std::int64_t> jobs_finished{pins_, "jobs_finished"};
   rt::Output<bool> dry_run{pins_, "dry_run"};  // the running job is a dry run
+  // Electrode length compensation (rt::Electrode): the estimate now (0: unknown) and the Z shift
+  // of the move running (length now − the length its work frame's Z was set with).
+  rt::Output<double> electrode_mm{pins_, "electrode_mm", "mm"};
+  rt::Output<double> z_comp_mm{pins_, "z_comp_mm", "mm"};
 
  protected:
   std::vector<rt::ParamError> configure_self(const rt::BlockSetup& setup) override;
@@ -168,6 +173,12 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   [[nodiscard]] bool in_position() const noexcept;
   /// The running cycles' axes to the arbiter, then the arbiter's decision. RT-safe.
   rt::BlockStatus command_axes(const rt::CycleContext& ctx) noexcept;
+  /// The Z shift that puts the tip where block b's work frame assumed it: the electrode length
+  /// lost since the frame's Z was set (shorter: lower). 0 without a known length on both sides.
+  [[nodiscard]] double z_compensation(const machining::MotionBlock& b) const noexcept;
+  /// The electrode estimate is the length at the job's start less the wear the job estimated
+  /// (job_wear_mm, seed 004 eq. 8). RT-safe.
+  void wear_electrode() noexcept;
 
   DeepHoleDrill& drill_;
   WallFinish& finish_;
@@ -184,7 +195,10 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::ManualControl* manual_control_{nullptr};
   rt::JobStore* job_{nullptr};
   const machining::MachineTables* tables_{nullptr};
+  rt::Electrode* electrode_{nullptr};
   JobFigures figures_{pins_};
+  double electrode_at_start_mm_{0.0};  // the estimate when the running job began (0: unknown)
+  double resumed_wear_mm_{0.0};        // wear of earlier jobs that resumed holes count on from
 
   State state_value_{State::kIdle};
   Step step_{Step::kEnter};

@@ -12,6 +12,7 @@
 // Pins are public Input<T>/Output<T> members, so a C++ PROGRAM connects its children by member.
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -31,6 +32,7 @@ namespace edm::rt {
 class Clock;
 class JobStore;
 class ManualControl;
+class Electrode;
 
 enum class BlockStatus : std::int8_t { kOk = 0, kSaturated = 1, kFault = -1 };
 
@@ -44,6 +46,14 @@ constexpr BlockStatus worst(BlockStatus a, BlockStatus b) noexcept {
   }
   return BlockStatus::kOk;
 }
+
+/// Why a block reported kFault, for its alarm (issue 33: "alarms that say why"). `text` is a
+/// static string in words ("no spark for the timeout while orbiting"); `value` the quantity that
+/// tripped it (NaN: none). RT-safe to copy.
+struct FaultCause {
+  const char* text{nullptr};
+  double value{std::numeric_limits<double>::quiet_NaN()};
+};
 
 /// What a block sees each cycle. RT-safe to read.
 struct CycleContext {
@@ -66,6 +76,7 @@ struct BlockSetup {
   JobStore* job{nullptr};     // the loaded part program (job sequencers)
   const machining::MachineTables* tables{nullptr};  // conditions and soft limits of the config
   ManualControl* manual{nullptr};  // the operator's manual motion requests (job sequencers)
+  Electrode* electrode{nullptr};   // the electrode length estimate (job sequencers)
 };
 
 class Block : public SafeStateHandler {
@@ -97,6 +108,9 @@ class Block : public SafeStateHandler {
   /// child ("cnc.job.drill.gap"), or nullptr for the block itself. RT-safe; the string lives as
   /// long as the block.
   [[nodiscard]] virtual const char* fault_source() const noexcept { return nullptr; }
+  /// After update() returned kFault: why, as the block (or its faulting child) said it with
+  /// fault(); text nullptr when it gave no cause. RT-safe.
+  [[nodiscard]] virtual FaultCause fault_cause() const noexcept { return fault_cause_; }
 
   // Runtime parameter access (variable registry). Blocks get these from BlockWithParams.
   /// Number of parameter fields.
@@ -112,8 +126,19 @@ class Block : public SafeStateHandler {
   virtual void commit_params() {}
 
  protected:
+  /// Records why and returns kFault: `return fault("a non-finite input", x);`. `text` must be a
+  /// static string. RT-safe.
+  BlockStatus fault(const char* text,
+                    double value = std::numeric_limits<double>::quiet_NaN()) noexcept {
+    fault_cause_ = {text, value};
+    return BlockStatus::kFault;
+  }
+
   /// This block's named pins, in declaration order; declared before any derived member.
   PinTable pins_;
+
+ private:
+  FaultCause fault_cause_{};
 };
 
 /// Base for blocks with a Params struct: live parameters (read by update()) and a shadow copy

@@ -55,6 +55,10 @@ class CompositeBlock : public Block {
   /// Forgets the last cycle's fault source, then update_self(). RT-safe.
   BlockStatus update(const CycleContext& ctx) noexcept final;
   [[nodiscard]] const char* fault_source() const noexcept final { return fault_source_; }
+  /// A faulting child's cause when a child faulted this cycle, else the composite's own.
+  [[nodiscard]] FaultCause fault_cause() const noexcept final {
+    return child_cause_.text != nullptr ? child_cause_ : Block::fault_cause();
+  }
 
   [[nodiscard]] std::size_t child_count() const noexcept { return children_.size(); }
 
@@ -89,6 +93,7 @@ class CompositeBlock : public Block {
   std::vector<Child> children_;
   ChildParams child_params_;  // the children's parameters, "<child>.<param>"
   const char* fault_source_{nullptr};
+  FaultCause child_cause_{};
 };
 
 }  // namespace edm::rt

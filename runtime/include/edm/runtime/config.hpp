@@ -162,9 +162,17 @@ struct RealtimeSpec {
   SourceLoc loc;
 };
 
+/// `machine.electrode`: the electrode the machine starts with when nothing is retained (the
+/// length estimate of electrode.hpp; 0: unknown, no length compensation).
+struct ElectrodeSpec {
+  double length_mm{0.0};
+  SourceLoc loc;
+};
+
 struct MachineSpec {
   std::string name;
   IoSpec io;
+  ElectrodeSpec electrode;
   std::vector<AxisSpec> axes;
   SafetySpec safety;
   RealtimeSpec realtime;

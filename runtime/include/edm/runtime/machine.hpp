@@ -90,6 +90,8 @@ struct ActiveAlarm {
   const char* source{""};
   TimePoint first{};       // release time of the cycle that first raised it
   std::uint64_t count{0};  // raises while latched, the first included
+  const char* text{""};    // the first occurrence's text (why) and value
+  double value{0.0};
 };
 
 /// What a safe-state hook is told.
@@ -185,6 +187,8 @@ class Machine {
     std::atomic<const char*> source{""};
     std::atomic<Duration::rep> first_ns{0};
     std::atomic<std::uint64_t> count{0};
+    std::atomic<const char*> text{""};
+    std::atomic<double> value{0.0};
   };
 
   std::atomic<MachineState> state_{MachineState::kOff};

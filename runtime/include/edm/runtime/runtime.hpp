@@ -16,6 +16,7 @@
 #include "edm/machining/machine_tables.hpp"
 #include "edm/runtime/clock.hpp"
 #include "edm/runtime/config.hpp"
+#include "edm/runtime/electrode.hpp"
 #include "edm/runtime/io_driver.hpp"
 #include "edm/runtime/job.hpp"
 #include "edm/runtime/machine.hpp"
@@ -115,6 +116,9 @@ class Runtime {
   [[nodiscard]] ManualControl& manual() noexcept { return manual_; }
   /// The work offsets G54…G59 (retained with the job record when there is a retain file).
   [[nodiscard]] WorkOffsets& work_offsets() noexcept { return work_offsets_; }
+  /// The electrode length estimate (electrode.hpp; `machine.electrode` gives the first one,
+  /// retained like the work offsets).
+  [[nodiscard]] Electrode& electrode() noexcept { return electrode_; }
   /// The safety supervisor of `machine.safety`, or nullptr when the config has none.
   [[nodiscard]] const Supervisor* supervisor() const noexcept { return supervisor_.get(); }
   /// Adds a consumer of every alarm (besides the log): called on the controlling thread, in
@@ -139,6 +143,7 @@ class Runtime {
   JobStore job_;
   ManualControl manual_;
   WorkOffsets work_offsets_;
+  Electrode electrode_;
   std::unique_ptr<IoDriver> driver_;
   std::unique_ptr<Supervisor> supervisor_;  // after driver_: it points into the driver's pins
   std::vector<std::unique_ptr<Program>> programs_;

@@ -3,7 +3,8 @@
 // machine coordinates of the work's zero. The runtime keeps them (set by the bridge's offset.set,
 // typically from a touch-off) and retains them beside the job record, so they survive a restart
 // and kill -9; the HMI reads them (offset.get) to interpret a part program into machine
-// coordinates. The real-time side never reads them: programs arrive in machine coordinates.
+// coordinates. The real-time side never reads them: programs arrive in machine coordinates, each
+// block with the electrode length its frame's Z was set with (electrode.hpp).
 //
 // Thread-safety: every member may be called from any non-RT thread (an internal mutex); nothing
 // is RT-safe.
@@ -19,6 +20,7 @@ namespace edm::rt {
 
 struct WorkFrame {
   double x{0.0}, y{0.0}, z{0.0};
+  double z_electrode_mm{0.0};  // the electrode's length when z was set (Electrode; 0: unknown)
   friend bool operator==(const WorkFrame&, const WorkFrame&) = default;
 };
 
@@ -33,9 +35,12 @@ class WorkOffsets {
   [[nodiscard]] WorkFrame get(int index) const;
   [[nodiscard]] std::array<WorkFrame, kFrames> all() const;
   /// Sets the given axes of one frame (nullopt keeps the axis); returns the new frame. The
-  /// values must be finite (the caller checks; a non-finite one is ignored here).
+  /// values must be finite (the caller checks; a non-finite one is ignored here). A new z
+  /// records `z_electrode_mm`, the electrode length it was set with (0: unknown).
   WorkFrame set(int index, std::optional<double> x, std::optional<double> y,
-                std::optional<double> z);
+                std::optional<double> z, double z_electrode_mm = 0.0);
+  /// Sets a whole frame as it was (undo, the retain store's restore). Non-finite fields are 0.
+  void restore(int index, const WorkFrame& frame);
   /// Increments on every set(): the HMI's programs name the generation they were built with.
   [[nodiscard]] std::uint64_t generation() const;
 

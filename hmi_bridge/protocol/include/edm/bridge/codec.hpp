@@ -24,7 +24,8 @@ using Json = nlohmann::json;
 // ---- motion blocks ------------------------------------------------------------------------
 // {"kind": "drill", "line": 12, "col": 1, "target": [x, y, z], "centre": [x, y, z], "turns": 0,
 //  "feed_mm_s": 0.5, "condition": 1, "z_travel_mm": 10.6, "final_radius_mm": 0, "dwell_s": 0,
-//  "on": false}. Only `kind` is required; absent fields take the MotionBlock defaults, and the
+//  "on": false, "electrode_ref_mm": 300}. Only `kind` is required; absent fields take the
+//  MotionBlock defaults, and the
 // encoder leaves out fields equal to their default (a 100,000-block upload stays small).
 
 Json to_json(const machining::MotionBlock& b);
@@ -38,8 +39,9 @@ bool from_json(const Json& j, machining::MotionBlock& out, std::string& error);
 //   u8 kind, i32 line, i32 col, f64 target.x/y/z, f64 centre.x/y/z, i32 turns, f64 feed_mm_s,
 //   i32 condition, f64 z_travel_mm, f64 depth_mm, f64 depth_done_mm, f64 resume_touch_z_mm,
 //   f64 resume_wear_mm, f64 final_radius_mm, f64 dwell_s, u8 on
-// (Python: struct.pack('<Bii6didi7dB', ...)). It covers the decoded values, so it catches a
-// lost, repeated or reordered chunk and any number the JSON round trip changed.
+// (Python: struct.pack('<Bii6didi7dB', ...)), followed by f64 electrode_ref_mm when it is not 0
+// ('<Bii6didi7dBd', 138 bytes). It covers the decoded values, so it catches a lost, repeated or
+// reordered chunk and any number the JSON round trip changed.
 inline constexpr std::size_t kBlockRecordBytes = 130;
 
 // Incremental: update() in any number of pieces gives the CRC of their concatenation.
