@@ -123,6 +123,8 @@ int cmd_offset(const OffsetArgs& args, const edm::hmi::ConnectionSettings& setti
 int cmd_electrode(double length_mm, const edm::hmi::ConnectionSettings& settings);
 /// `edmhmi alarms [--all]`: the active alarms with cause and remedy; --all adds the history.
 int cmd_alarms(bool all, const edm::hmi::ConnectionSettings& settings);
+/// `edmhmi jobs [--csv] [--limit N]`: the job log, newest last.
+int cmd_jobs(bool csv, int limit, const edm::hmi::ConnectionSettings& settings);
 /// Prints the active alarms as `alarms` does (status); false, and why, when they cannot be read.
 bool print_active_alarms(edm::bridge::Client& client);
 int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& settings);

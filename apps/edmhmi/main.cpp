@@ -1,8 +1,9 @@
 // edmhmi — the HMI process's command line (DESIGN §4, docs/hmi.md). One file per command group:
 // cmd_check.cpp (offline interpretation), cmd_run.cpp (upload, start, follow, report),
-// cmd_status.cpp (status, stats), cmd_alarms.cpp (alarms), cmd_machine.cpp (hold, resume, stop,
-// estop, reset, override), cmd_manual.cpp (home, jog, touch), cmd_offset.cpp (offset), cmd_mdi.cpp
-// (mdi), cmd_watch.cpp (watch, trace). Exit codes: 0 ok, 1 runtime failure or alarm, 2 bad input.
+// cmd_status.cpp (status, stats), cmd_alarms.cpp (alarms), cmd_jobs.cpp (jobs), cmd_machine.cpp
+// (hold, resume, stop, estop, reset, override), cmd_manual.cpp (home, jog, touch), cmd_offset.cpp
+// (offset), cmd_mdi.cpp (mdi), cmd_watch.cpp (watch, trace). Exit codes: 0 ok, 1 runtime failure or
+// alarm, 2 bad input.
 
 #include <csignal>
 #include <cstdio>
@@ -81,6 +82,12 @@ int run(int argc, char** argv) {
 
   app.add_subcommand("status", "machine state, job, key variables, last job's figures");
   app.add_subcommand("stats", "task statistics and bridge counters");
+  bool jobs_csv = false;
+  int jobs_limit = 50;
+  CLI::App* jb = app.add_subcommand("jobs", "the job log: each job that ended, with its figures");
+  jb->add_flag("--csv", jobs_csv, "the whole log as CSV");
+  jb->add_option("--limit", jobs_limit, "the newest N jobs (1..1000, default 50)")
+      ->check(CLI::Range(1, 1000));
   bool alarms_all = false;
   app.add_subcommand("alarms", "the active alarms with their cause and remedy")
       ->add_flag("--all", alarms_all, "also the history since edmplc started");
@@ -202,6 +209,7 @@ int run(int argc, char** argv) {
   if (command == "status") return cmd_status(settings);
   if (command == "stats") return cmd_stats(settings);
   if (command == "alarms") return cmd_alarms(alarms_all, settings);
+  if (command == "jobs") return cmd_jobs(jobs_csv, jobs_csv ? 1000 : jobs_limit, settings);
   if (command == "watch") return cmd_watch(watch, settings);
   if (command == "trace") return cmd_trace(trace, settings);
   if (command == "serve") {

@@ -182,7 +182,10 @@ std::string retain_target_problem(const std::string& path) noexcept {
 }
 
 void write_retain_file_atomic(const std::string& path, const RetainMap& values) {
-  const std::string text = format_retain_file(values);
+  write_file_atomic(path, format_retain_file(values));
+}
+
+void write_file_atomic(const std::string& path, std::string_view text) {
   // Checked before any temp file exists: a device, FIFO, directory or link is never renamed over.
   if (const std::string problem = retain_target_problem(path); !problem.empty()) {
     throw_io(EINVAL, path, problem);

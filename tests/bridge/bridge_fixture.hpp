@@ -22,6 +22,7 @@
 
 #include "edm/bridge/client.hpp"
 #include "edm/bridge/server.hpp"
+#include "edm/machining/motion_block.hpp"
 #include "support/bridge_test_config.hpp"
 #include "support/runtime_fixture.hpp"
 #include "support/runtime_thread.hpp"
@@ -226,6 +227,21 @@ inline void expect_no_gaps(const std::vector<Json>& events) {
     ASSERT_EQ(events[i]["seq"].get<std::uint64_t>(), events[i - 1]["seq"].get<std::uint64_t>() + 1)
         << "at event " << i;
   }
+}
+
+/// A program's blocks for tests that only need a job to run: a dwell, the end.
+inline machining::MotionBlock dwell_block(double seconds, std::int32_t line) {
+  machining::MotionBlock b;
+  b.kind = machining::MotionKind::kDwell;
+  b.dwell_s = seconds;
+  b.line = line;
+  return b;
+}
+inline machining::MotionBlock end_block(std::int32_t line) {
+  machining::MotionBlock b;
+  b.kind = machining::MotionKind::kEnd;
+  b.line = line;
+  return b;
 }
 
 }  // namespace edm::bridge::test

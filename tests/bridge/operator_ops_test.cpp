@@ -18,20 +18,6 @@ using machining::MotionBlock;
 using machining::MotionKind;
 using namespace std::chrono_literals;
 
-MotionBlock dwell_block(double seconds, std::int32_t line) {
-  MotionBlock b;
-  b.kind = MotionKind::kDwell;
-  b.dwell_s = seconds;
-  b.line = line;
-  return b;
-}
-MotionBlock end_block(std::int32_t line) {
-  MotionBlock b;
-  b.kind = MotionKind::kEnd;
-  b.line = line;
-  return b;
-}
-
 constexpr const char* kOp = "op-secret-0123456789";
 constexpr const char* kViewer = "viewer-secret-0123456789";
 
@@ -138,6 +124,8 @@ TEST_F(OperatorOps, BadRequestsAreRefusedPrecisely) {
       {"offset.set", {{"frame", "G54"}}},
       {"offset.set", {{"frame", "G54"}, {"x", "abc"}}},
       {"offset.set", {{"frame", "G54"}, {"x", 1e9}}},
+      {"offset.set", {{"frame", "G55"}, {"y", 5000.0}}},  // drill-sim: Y −100 .. 100
+      {"offset.set", {{"frame", "G55"}, {"z", -60.001}}},
       {"cycle.start", {{"slot", "other"}}},
       {"cycle.start", {{"dry_run", "yes"}}},
       {"program.begin", {{"blocks", 1}, {"slot", "x"}}},
@@ -184,8 +172,23 @@ TEST_F(OperatorOps, ManualMotionOnlyWhenReadyAndIdle) {
   EXPECT_EQ(stopped["result"]["error"], "stopped by the operator");
 }
 
+TEST_F(OperatorOps, AWorkOriginAtTheSoftLimitsIsKept) {
+  start();
+  const Reply r =
+      op_.request("offset.set", {{"frame", "G56"}, {"x", 100.0}, {"y", -100.0}, {"z", -60.0}});
+  ASSERT_TRUE(r) << r.message;
+  EXPECT_EQ(rt_->work_offsets().get(2).y, -100.0);
+}
+
 TEST_F(OperatorOps, WorkOffsetsAreSetReadAndRefusedDuringAJob) {
   start();
+  // An origin the machine cannot reach is refused with the limits; one at a limit is kept.
+  Reply far = op_.request("offset.set", {{"frame", "G55"}, {"y", 5000.0}});
+  EXPECT_EQ(far.code, ErrorCode::kBadRequest);
+  EXPECT_NE(far.message.find("'y' 5000 mm is outside the Y soft limits (-100 .. 100 mm)"),
+            std::string::npos)
+      << far.message;
+  EXPECT_EQ(rt_->work_offsets().generation(), 0U) << "nothing changed";
   Reply r = op_.request("offset.set", {{"frame", "G55"}, {"x", 12.5}, {"z", -7.25}});
   ASSERT_TRUE(r) << r.body;
   EXPECT_EQ(r.body["frame"], "G55");
@@ -318,14 +321,15 @@ TEST_F(OperatorOps, ACycleStartIsRefusedWhenTheElectrodeCannotFinishTheProgram) 
   EXPECT_EQ(r.details["line"], 6) << r.details;
   EXPECT_EQ(rt_->machine().state(), rt::MachineState::kReady) << "nothing started";
 
-  // A dry run never erodes: it may start.
+  // A dry run never erodes: it may start (it ends within a few cycles: nothing to drill).
+  const std::uint64_t before = rt_->job().progress().jobs_started;
   ASSERT_TRUE(op_.request("cycle.start", {{"dry_run", true}}));
-  ASSERT_TRUE(op_.request("cycle.stop"));
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   while (rt_->job().active() || rt_->machine().state() != rt::MachineState::kReady) {
     ASSERT_LT(std::chrono::steady_clock::now(), deadline);
     std::this_thread::sleep_for(10ms);
   }
+  EXPECT_EQ(rt_->job().progress().jobs_started, before + 1) << "the dry run ran";
   // Enough electrode: the start is accepted.
   ASSERT_TRUE(op_.request("electrode.set", {{"length_mm", 40.0}}));
   EXPECT_TRUE(op_.request("cycle.start"));

@@ -71,6 +71,7 @@ constexpr OpSpec kOps[] = {
     {"electrode.get", kView, states(kAll), ops::op_electrode_get},
     {"electrode.set", kOper, states(kNotDuringAJob), ops::op_electrode_set},
     {"alarms.get", kView, states(kAll), ops::op_alarms_get},
+    {"jobs.get", kView, states(kAll), ops::op_jobs_get},
 };
 
 // A row without a handler, or a name twice, does not compile.

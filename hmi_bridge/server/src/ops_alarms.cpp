@@ -17,8 +17,9 @@ namespace {
 
 Json value_json(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
-// "2026-12-03T12:34:56.789Z"
-std::string iso_utc(std::chrono::system_clock::time_point t) {
+}  // namespace
+
+std::string wall_time(std::chrono::system_clock::time_point t) {
   const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(t.time_since_epoch());
   const std::time_t secs = static_cast<std::time_t>(ms.count() / 1000);
   std::tm tm{};
@@ -28,6 +29,8 @@ std::string iso_utc(std::chrono::system_clock::time_point t) {
   std::snprintf(buf + n, sizeof buf - n, ".%03dZ", static_cast<int>(ms.count() % 1000));
   return buf;
 }
+
+namespace {
 
 void add_help(Json& j, rt::AlarmCode code) {
   const rt::AlarmHelp h = rt::alarm_help(code);
@@ -42,7 +45,7 @@ Json alarm_json(const rt::Alarm& a, std::chrono::system_clock::time_point wall) 
             {"name", std::string(rt::to_string(a.code))},
             {"severity", a.severity == rt::AlarmSeverity::kFault ? "fault" : "warning"},
             {"t_s", rt::to_seconds(a.time)},
-            {"wall", iso_utc(wall)},
+            {"wall", wall_time(wall)},
             {"source", std::string(a.source)},
             {"text", std::string(a.text)},
             {"value", value_json(a.value)}};

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <optional>
+#include <string>
 
 #include "edm/bridge/op_table.hpp"
 #include "edm/runtime/machine.hpp"
@@ -56,10 +57,15 @@ Body op_offset_set(Session& s, const Json& msg);
 Body op_electrode_get(Session& s, const Json& msg);
 Body op_electrode_set(Session& s, const Json& msg);
 
+// server_jobs.cpp: the job log.
+Body op_jobs_get(Session& s, const Json& msg);
+
 // ops_alarms.cpp: the active alarms and the history, each with its cause and remedy.
 Body op_alarms_get(Session& s, const Json& msg);
 /// One alarm as the `alarm` event and the history carry it (source, text, value, machine and
 /// wall time, cause, remedy).
 Json alarm_json(const rt::Alarm& a, std::chrono::system_clock::time_point wall);
+/// UTC to the millisecond, as the alarms and the job log carry it: "2026-12-03T12:34:56.789Z".
+std::string wall_time(std::chrono::system_clock::time_point t);
 
 }  // namespace edm::bridge::ops

@@ -76,6 +76,16 @@ Body op_offset_set(Session& s, const Json& msg) {
                    std::string("'") + keys[k] + "' must be a finite number of mm (|v| ≤ 1e5)");
     }
     v[k] = it->get<double>();
+    // The work origin is a point of the machine: inside the axis's soft limits (issue 33: G55 Y
+    // 5000 was accepted on a ±100 mm machine, and every program in that frame then refused).
+    const char axis = static_cast<char>('X' + k);
+    if (const machining::AxisLimits* lim = rt.tables().axis(axis);
+        lim != nullptr && (*v[k] < lim->min_mm || *v[k] > lim->max_mm)) {
+      return error(ErrorCode::kBadRequest,
+                   fmt::format("'{}' {} mm is outside the {} soft limits ({} .. {} mm): the work "
+                               "origin must be a point the machine reaches",
+                               keys[k], *v[k], axis, lim->min_mm, lim->max_mm));
+    }
   }
   if (!v[0] && !v[1] && !v[2]) {
     return error(ErrorCode::kBadRequest, "give at least one of 'x', 'y', 'z'");

@@ -136,6 +136,9 @@ void Server::Impl::start() {
     status_var_names.push_back(name);
   }
   board = std::make_unique<StatusBoard>(rt.machine(), rt.job(), pins);
+  job_log = std::make_unique<JobLog>(rt.retain_path().empty() ? "" : rt.retain_path() + ".jobs.csv",
+                                     kJobLogCap);
+  job_watch.started = rt.job().progress().jobs_started;
   rt::Task* io_task = nullptr;
   for (const auto& t : rt.tasks()) {
     if (t->driver() != nullptr) {
@@ -353,6 +356,10 @@ std::vector<std::shared_ptr<Session>> Server::Impl::live_sessions() const {
 void Server::Impl::on_alarm(const rt::Alarm& a) {
   const Json body = ops::alarm_json(a, std::chrono::system_clock::now());
   alarm_history.push_back(body);
+  if (std::string& seen = job_watch.recent; seen.size() < 4000) {
+    seen += (seen.empty() ? "" : "; ") + std::to_string(static_cast<int>(a.code)) + " " +
+            std::string(rt::to_string(a.code)) + " " + a.source + ": " + a.text;
+  }
   if (alarm_history.size() > kAlarmHistory) {
     alarm_history.pop_front();
     ++alarms_forgotten;
@@ -366,6 +373,7 @@ void Server::Impl::on_alarm(const rt::Alarm& a) {
 
 void Server::Impl::progress_tick() {
   const rt::JobProgress p = rt.job().progress();
+  watch_jobs(p);
   if (!same_progress(p, last_progress)) {
     last_progress = p;
     const Json body = progress_json(p);

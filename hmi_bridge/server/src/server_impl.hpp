@@ -34,6 +34,7 @@
 #include "edm/runtime/log_escape.hpp"
 #include "edm/runtime/log_limiter.hpp"
 #include "edm/runtime/runtime.hpp"
+#include "job_log.hpp"
 
 namespace boost::asio::ssl {
 class context;
@@ -136,6 +137,20 @@ struct Server::Impl {
   static constexpr std::size_t kAlarmHistory = 500;
   std::deque<Json> alarm_history;
   std::uint64_t alarms_forgotten{0};  // dropped from the history's front by the cap
+  /// The job log (server_jobs.cpp): each job that ended, beside the retain file.
+  static constexpr std::size_t kJobLogCap = 1000;
+  std::unique_ptr<JobLog> job_log;
+  struct JobWatch {
+    std::uint64_t started{0};  // JobProgress::jobs_started last seen
+    bool active{false};        // a job began and its entry is not written yet
+    int settle_ticks{-1};      // ticks left before an ended job is logged (its alarms arrive)
+    JobLogEntry entry;         // filled as the job runs
+    rt::JobProgress end;       // the progress when it ended
+    std::string recent;        // alarms since the last tick (a job that began within it has them)
+  } job_watch;
+  /// Once per progress tick: notes a job's start and end and logs it (server_jobs.cpp).
+  void watch_jobs(const rt::JobProgress& p);
+  void log_job();
   std::uint16_t bound_port{0};
   std::uint64_t next_session_id{1};
 

@@ -120,6 +120,8 @@ struct RetainLoadResult {
 /// previous or the new complete file. Throws std::system_error (what() names the path and the
 /// step) on failure, after removing the temp file; std::invalid_argument on an invalid name.
 void write_retain_file_atomic(const std::string& path, const RetainMap& values);
+/// The same atomic write for any text (the bridge's job log).
+void write_file_atomic(const std::string& path, std::string_view text);
 
 /// Moves a corrupt or unreadable retain file out of the way, to `path.corrupt` (or
 /// `path.corrupt.1` … `.corrupt.99` when taken), so the runtime may write a new one without
