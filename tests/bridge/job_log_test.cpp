@@ -70,6 +70,12 @@ TEST(JobLogFile, AFileThatCannotBeReadIsSetAsideAndANewLogBegins) {
     EXPECT_TRUE(std::filesystem::exists(path + ".bad"));
     std::filesystem::remove(path + ".bad");
   }
+  // A file too large for a job log is set aside without being read (a sparse 17 MiB file).
+  std::ofstream(path, std::ios::trunc).close();
+  std::filesystem::resize_file(path, 17u << 20);
+  JobLog big(path, 10);
+  EXPECT_NE(big.load_error().find("larger than 16 MiB"), std::string::npos) << big.load_error();
+  EXPECT_TRUE(std::filesystem::exists(path + ".bad"));
 }
 
 // Through the bridge, on drill-sim with a state directory: a finished job, a stopped one and one

@@ -102,7 +102,9 @@ void JobLog::load() {
   std::error_code ec;
   if (!std::filesystem::exists(path_, ec)) return;
   std::string text;
-  {
+  // Sized before it is read: a huge file put there is refused, never read into memory.
+  const auto bytes = std::filesystem::file_size(path_, ec);
+  if (!ec && bytes <= kMaxFileBytes) {
     std::ifstream in(path_, std::ios::binary);
     std::ostringstream ss;
     ss << in.rdbuf();
@@ -111,7 +113,7 @@ void JobLog::load() {
   std::size_t at = 0;
   std::vector<std::string> f;
   try {
-    if (text.size() > kMaxFileBytes) throw std::runtime_error("larger than 16 MiB");
+    if (ec || bytes > kMaxFileBytes) throw std::runtime_error("larger than 16 MiB, or unreadable");
     if (!read_record(text, at, f) || f != columns()) throw std::runtime_error("not a job log");
     while (read_record(text, at, f)) {
       if (f.size() == 1 && f[0].empty()) continue;
