@@ -1,6 +1,7 @@
 // Config parser, one function per section: keys, types and ranges. See config_parser.cpp.
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "config_parser_impl.hpp"
@@ -48,7 +49,7 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
 
 void Parser::parse_electrode(const Value& v, ElectrodeSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"length_mm"});
+  auto m = r_.map(v, {"length_mm", "tool_setter"});
   if (!m) {
     return;
   }
@@ -60,6 +61,26 @@ void Parser::parse_electrode(const Value& v, ElectrodeSpec& out) {
         out.length_mm = *l;
       }
     }
+  }
+  if (const Field* f = m->find("tool_setter")) {
+    auto t = r_.map(f->value, {"x_mm", "y_mm", "z_mm"});
+    if (!t) return;
+    ToolSetterSpec ts;
+    ts.loc = f->value.loc;
+    bool ok = true;
+    for (auto [key, dst] : {std::pair{"x_mm", &ts.x_mm}, {"y_mm", &ts.y_mm}, {"z_mm", &ts.z_mm}}) {
+      const Field* g = r_.require(*t, key);
+      const auto x = g != nullptr ? r_.real(g->value) : std::nullopt;
+      if (!x) {
+        ok = false;
+      } else if (!std::isfinite(*x) || std::abs(*x) > 1e5) {
+        r_.error(g->value, "must be a finite number of mm (|v| <= 1e5)");
+        ok = false;
+      } else {
+        *dst = *x;
+      }
+    }
+    if (ok) out.tool_setter = ts;
   }
 }
 

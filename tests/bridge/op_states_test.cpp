@@ -141,6 +141,14 @@ class OpStates : public ::testing::Test {
     if (op == "touch") return {{"target", "z"}};
     if (op == "offset.set") return {{"frame", "G54"}, {"x", 1.0}};
     if (op == "electrode.set") return {{"length_mm", 300.0}};
+    if (op == "electrode.change") {
+      return {{"id", "E1"},
+              {"kind", "tube"},
+              {"size_mm", 1.0},
+              {"material", "copper"},
+              {"new_length_mm", 300.0}};
+    }
+    if (op == "electrode.measure") return {{"reference", "setter"}};
     return Json::object();
   }
 

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@ namespace edm::bridge {
 namespace {
 
 constexpr std::size_t kMaxFileBytes = 16u << 20;  // a log of its cap is far smaller
+constexpr std::size_t kFirstColumns = 17;         // the columns of the first version
 
 std::string quoted(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
@@ -90,7 +92,9 @@ const std::vector<std::string>& JobLog::columns() {
                                                     "electrode_start_mm",
                                                     "electrode_end_mm",
                                                     "cause",
-                                                    "alarms"};
+                                                    "alarms",
+                                                    "electrode",
+                                                    "holes"};
   return kColumns;
 }
 
@@ -114,10 +118,15 @@ void JobLog::load() {
   std::vector<std::string> f;
   try {
     if (ec || bytes > kMaxFileBytes) throw std::runtime_error("larger than 16 MiB, or unreadable");
-    if (!read_record(text, at, f) || f != columns()) throw std::runtime_error("not a job log");
+    // A log written before the electrode and holes columns has the first 17 of them.
+    if (!read_record(text, at, f) || f.size() < kFirstColumns || f.size() > columns().size() ||
+        !std::equal(f.begin(), f.end(), columns().begin())) {
+      throw std::runtime_error("not a job log");
+    }
+    const std::size_t width = f.size();
     while (read_record(text, at, f)) {
       if (f.size() == 1 && f[0].empty()) continue;
-      if (f.size() != columns().size()) throw std::runtime_error("a row of the wrong width");
+      if (f.size() != width) throw std::runtime_error("a row of the wrong width");
       JobLogEntry e;
       e.n = static_cast<std::uint64_t>(to_double(f[0]));
       e.start = f[1];
@@ -136,6 +145,8 @@ void JobLog::load() {
       e.electrode_end_mm = to_double(f[14]);
       e.cause = static_cast<int>(to_double(f[15]));
       e.alarms = f[16];
+      if (width > 17) e.electrode = f[17];
+      if (width > 18) e.holes = static_cast<std::int64_t>(to_double(f[18]));
       next_n_ = std::max(next_n_, e.n + 1);
       entries_.push_back(std::move(e));
       if (entries_.size() > cap_) entries_.pop_front();
@@ -171,7 +182,9 @@ std::string JobLog::csv() const {
                                number(e.electrode_start_mm),
                                number(e.electrode_end_mm),
                                std::to_string(e.cause),
-                               quoted(e.alarms)};
+                               quoted(e.alarms),
+                               quoted(e.electrode),
+                               std::to_string(e.holes)};
     for (std::size_t i = 0; i < std::size(row); ++i) out += (i ? "," : "") + row[i];
     out += "\n";
   }

@@ -70,6 +70,8 @@ constexpr OpSpec kOps[] = {
     {"offset.set", kOper, states(kNotDuringAJob), ops::op_offset_set},
     {"electrode.get", kView, states(kAll), ops::op_electrode_get},
     {"electrode.set", kOper, states(kNotDuringAJob), ops::op_electrode_set},
+    {"electrode.change", kOper, states(mask_of(S::kIdle)), ops::op_electrode_change},
+    {"electrode.measure", kOper, states(mask_of(S::kIdle)), ops::op_electrode_measure},
     {"alarms.get", kView, states(kAll), ops::op_alarms_get},
     {"jobs.get", kView, states(kAll), ops::op_jobs_get},
 };
@@ -97,7 +99,7 @@ std::string audit_detail(const std::string& op, const Json& msg) {
     d += '=';
     d += text;
   };
-  for (const char* key : {"name", "frame", "axis", "axes", "target", "slot"}) {
+  for (const char* key : {"name", "frame", "axis", "axes", "target", "slot", "id", "reference"}) {
     if (auto it = msg.find(key); it != msg.end() && it->is_string()) {
       add(key, ops::brief_name(it->get_ref<const std::string&>()));
     }

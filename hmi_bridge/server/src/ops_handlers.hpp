@@ -3,6 +3,7 @@
 // role and state checks passed. Server thread only.
 
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -51,11 +52,19 @@ Body op_jog_stop(Session& s, const Json& msg);
 Body op_touch(Session& s, const Json& msg);
 Body op_manual_status(Session& s, const Json& msg);
 
-// ops_offsets.cpp: the work offsets and the electrode length (retained).
+// ops_offsets.cpp: the work offsets (retained).
 Body op_offset_get(Session& s, const Json& msg);
 Body op_offset_set(Session& s, const Json& msg);
+/// Syncs the retain file after a change; when the file cannot be written, undo() restores the
+/// old value and the error names what stays unchanged. nullopt: kept (or nothing is retained).
+std::optional<Body> retained_or_undone(Session& s, const std::string& what,
+                                       const std::function<void()>& undo);
+
+// ops_electrode.cpp: the electrode in the spindle, its length and the electrode table.
 Body op_electrode_get(Session& s, const Json& msg);
 Body op_electrode_set(Session& s, const Json& msg);
+Body op_electrode_change(Session& s, const Json& msg);
+Body op_electrode_measure(Session& s, const Json& msg);
 
 // server_jobs.cpp: the job log.
 Body op_jobs_get(Session& s, const Json& msg);

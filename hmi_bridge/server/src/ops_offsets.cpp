@@ -1,8 +1,8 @@
-// The ops of the operator's retained machine data (ops_handlers.hpp; docs/protocol.md "Work
-// offsets and the electrode"):
+// The ops of the work offsets (ops_handlers.hpp; docs/protocol.md "Work offsets and the
+// electrode"):
 //   offset.get, offset.set        → rt::WorkOffsets G54…G59, each Z with the electrode length it
 //                                   was set with
-//   electrode.get, electrode.set  → rt::Electrode, the length estimate the job compensates with
+// (the electrode's ops: ops_electrode.cpp)
 // A change is on disk before the reply, or undone and refused (retain_failed, alarm 183).
 #include <spdlog/spdlog.h>
 
@@ -23,8 +23,8 @@ Json frame_json(const rt::WorkFrame& f) {
   return Json{{"x", f.x}, {"y", f.y}, {"z", f.z}, {"z_electrode_mm", f.z_electrode_mm}};
 }
 
-/// Syncs the retain file after a change; when the file cannot be written, undo() restores the
-/// old value and the error names what stays unchanged. nullopt: kept (or nothing is retained).
+}  // namespace
+
 std::optional<Body> retained_or_undone(Session& s, const std::string& what,
                                        const std::function<void()>& undo) {
   rt::Runtime& rt = s.server().rt;
@@ -38,13 +38,6 @@ std::optional<Body> retained_or_undone(Session& s, const std::string& what,
                what + " could not be retained (alarm 183: the retain file '" + rt.retain()->path() +
                    "' could not be written); " + what + " is unchanged");
 }
-
-Json electrode_json(rt::Runtime& rt) {
-  const double l = rt.electrode().length_mm();
-  return Json{{"length_mm", l}, {"known", l > 0.0}, {"retained", rt.retain() != nullptr}};
-}
-
-}  // namespace
 
 Body op_offset_get(Session& s, const Json& /*msg*/) {
   rt::Runtime& rt = s.server().rt;
@@ -106,28 +99,6 @@ Body op_offset_set(Session& s, const Json& msg) {
   out["generation"] = rt.work_offsets().generation();
   out["retained"] = rt.retain() != nullptr;  // false: this run retains nothing (no retain file)
   return out;
-}
-
-Body op_electrode_get(Session& s, const Json& /*msg*/) { return electrode_json(s.server().rt); }
-
-Body op_electrode_set(Session& s, const Json& msg) {
-  rt::Runtime& rt = s.server().rt;
-  const Json* l = field(msg, "length_mm", [](const Json& j) {
-    return j.is_number() && std::isfinite(j.get<double>()) && j.get<double>() > 0.0 &&
-           j.get<double>() <= 1e4;
-  });
-  if (l == nullptr) {
-    return error(ErrorCode::kBadRequest,
-                 "'length_mm' must be the electrode's length, a number of mm in (0, 10000]");
-  }
-  const double before = rt.electrode().length_mm();
-  rt.electrode().set_length_mm(l->get<double>());
-  if (auto refused = retained_or_undone(s, "the electrode length",
-                                        [&] { rt.electrode().set_length_mm(before); })) {
-    return *refused;
-  }
-  s.log(spdlog::level::info, "electrode length set to {} mm (was {} mm)", l->get<double>(), before);
-  return electrode_json(rt);
 }
 
 }  // namespace edm::bridge::ops

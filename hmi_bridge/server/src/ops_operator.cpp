@@ -31,7 +31,7 @@ std::optional<Body> electrode_too_short(rt::Runtime& rt,
                   "the electrode would run out in the hole of line %d: the program wears an "
                   "estimated %.3f mm by its end, %.3f mm through that hole; %.3f mm of the "
                   "%.3f mm electrode is usable (margin %.3f mm): change the electrode "
-                  "(edmhmi electrode set) first",
+                  "(edmhmi electrode change) first",
                   h.line, holes.back().cumulative_mm, h.cumulative_mm, usable > 0 ? usable : 0.0,
                   length, margin);
     return error(ErrorCode::kInvalidState, text,
@@ -268,6 +268,13 @@ std::optional<Body> prepare_start(Session& s, const Json& msg) {
                        std::to_string(*gen) + ", now " +
                        std::to_string(rt.work_offsets().generation()) +
                        "): interpret and commit it again");
+    }
+    if (const ElectrodeEntry* e = srv.electrodes->current();
+        !o.dry_run && e != nullptr && e->unmeasured) {
+      return error(ErrorCode::kInvalidState,
+                   "the electrode " + e->id +
+                       " was put in the spindle and not measured: measure it first (edmhmi "
+                       "electrode measure setter)");
     }
     if (!o.dry_run) {
       if (auto refused =

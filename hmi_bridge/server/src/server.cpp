@@ -138,6 +138,8 @@ void Server::Impl::start() {
   board = std::make_unique<StatusBoard>(rt.machine(), rt.job(), pins);
   job_log = std::make_unique<JobLog>(rt.retain_path().empty() ? "" : rt.retain_path() + ".jobs.csv",
                                      kJobLogCap);
+  electrodes = std::make_unique<ElectrodeTable>(
+      rt.retain_path().empty() ? "" : rt.retain_path() + ".electrodes.json");
   job_watch.started = rt.job().progress().jobs_started;
   rt::Task* io_task = nullptr;
   for (const auto& t : rt.tasks()) {
@@ -374,6 +376,7 @@ void Server::Impl::on_alarm(const rt::Alarm& a) {
 void Server::Impl::progress_tick() {
   const rt::JobProgress p = rt.job().progress();
   watch_jobs(p);
+  watch_measure();
   if (!same_progress(p, last_progress)) {
     last_progress = p;
     const Json body = progress_json(p);

@@ -34,6 +34,7 @@
 #include "edm/runtime/log_escape.hpp"
 #include "edm/runtime/log_limiter.hpp"
 #include "edm/runtime/runtime.hpp"
+#include "electrode_table.hpp"
 #include "job_log.hpp"
 
 namespace boost::asio::ssl {
@@ -148,6 +149,18 @@ struct Server::Impl {
     rt::JobProgress end;       // the progress when it ended
     std::string recent;        // alarms since the last tick (a job that began within it has them)
   } job_watch;
+  /// The electrode table (ops_electrode.cpp), beside the retain file.
+  std::unique_ptr<ElectrodeTable> electrodes;
+  /// electrode.measure's touch, until its result is in: the length is the Z at contact − datum.
+  struct PendingMeasure {
+    std::uint64_t seq{0};
+    std::string reference;  // setter, work
+    double datum_mm{0.0};
+  };
+  std::optional<PendingMeasure> measuring;
+  Json last_measure;  // null until a measurement ended
+  /// Once per progress tick: applies a measurement whose touch ended (ops_electrode.cpp).
+  void watch_measure();
   /// Once per progress tick: notes a job's start and end and logs it (server_jobs.cpp).
   void watch_jobs(const rt::JobProgress& p);
   void log_job();

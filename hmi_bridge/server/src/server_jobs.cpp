@@ -71,6 +71,19 @@ void Server::Impl::log_job() {
     if (name == "cnc.job.job_depth_mm") e.depth_mm = value;
     if (name == "cnc.job.job_wear_mm") e.wear_mm = value;
   }
+  if (const ElectrodeEntry* used = electrodes->current()) e.electrode = used->id;
+  double drilled = 0.0;
+  for (const std::string& v : status_var_names) {  // the job's own block, whatever its name
+    if (v.size() > 11 && v.ends_with(".job_time_s")) {
+      const std::string job = v.substr(0, v.size() - 11);
+      e.holes = static_cast<std::int64_t>(rt.variables().read(job + ".job_holes").value_or(0.0));
+      drilled = rt.variables().read(job + ".job_drilled_mm").value_or(0.0);
+    }
+  }
+  if (!e.dry_run) {
+    electrodes->add_job(e.holes, drilled, e.electrode_end_mm);
+    electrodes->save();
+  }
   job_log->add(std::move(e));
   w.active = false;
   w.settle_ticks = -1;
@@ -114,7 +127,9 @@ Body op_jobs_get(Session& s, const Json& msg) {
                     {"electrode_start_mm", e.electrode_start_mm},
                     {"electrode_end_mm", e.electrode_end_mm},
                     {"cause", e.cause},
-                    {"alarms", e.alarms}});
+                    {"alarms", e.alarms},
+                    {"electrode", e.electrode},
+                    {"holes", e.holes}});
   }
   Json out = {
       {"jobs", std::move(jobs)}, {"total", all.size()}, {"retained", srv.job_log->retained()}};

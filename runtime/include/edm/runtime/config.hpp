@@ -164,8 +164,18 @@ struct RealtimeSpec {
 
 /// `machine.electrode`: the electrode the machine starts with when nothing is retained (the
 /// length estimate of electrode.hpp; 0: unknown, no length compensation).
+/// The tool setter (issue 33, electrode change): a reference surface the electrode touches to
+/// be measured, at machine (x_mm, y_mm); z_mm is the machine Z at which an electrode of length 0
+/// would touch it, so a measured length is the Z at contact − z_mm (calibrate it by touching a
+/// master electrode of known length: z_mm = Z at contact − that length).
+struct ToolSetterSpec {
+  double x_mm{0.0}, y_mm{0.0}, z_mm{0.0};
+  SourceLoc loc;
+};
+
 struct ElectrodeSpec {
   double length_mm{0.0};
+  std::optional<ToolSetterSpec> tool_setter;
   SourceLoc loc;
 };
 
