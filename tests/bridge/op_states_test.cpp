@@ -142,7 +142,7 @@ class OpStates : public ::testing::Test {
     if (op == "offset.set") return {{"frame", "G54"}, {"x", 1.0}};
     if (op == "electrode.set") return {{"length_mm", 300.0}};
     if (op == "electrode.change") {
-      return {{"id", "E1"},
+      return {{"electrode", "E1"},
               {"kind", "tube"},
               {"size_mm", 1.0},
               {"material", "copper"},

@@ -336,5 +336,139 @@ TEST_F(OperatorOps, ACycleStartIsRefusedWhenTheElectrodeCannotFinishTheProgram) 
   ASSERT_TRUE(op_.request("cycle.stop"));
 }
 
+// An electrode change (issue 33): the table takes a new electrode only with all its fields,
+// refuses malformed ones precisely, puts it in the spindle with its new length, and a job (but a
+// dry run) waits until it is measured.
+TEST_F(OperatorOps, AnElectrodeChangeIsValidatedAndAJobWaitsForItsMeasurement) {
+  start();
+  const Json e2{{"electrode", "E2"},
+                {"kind", "tube"},
+                {"size_mm", 1.0},
+                {"material", "copper"},
+                {"new_length_mm", 250.0}};
+  const auto with = [&](const char* key, Json v) {
+    Json j = e2;
+    if (v.is_null()) {
+      j.erase(key);
+    } else {
+      j[key] = std::move(v);
+    }
+    return j;
+  };
+  for (const Json& bad :
+       {with("electrode", nullptr), with("electrode", ""), with("electrode", "E 2"),
+        with("electrode", std::string(33, 'a')), with("electrode", 7), with("kind", nullptr),
+        with("kind", "square"), with("material", nullptr), with("material", std::string(33, 'c')),
+        with("material", "cu\nw"), with("size_mm", nullptr), with("size_mm", 0.0),
+        with("size_mm", "1"), with("new_length_mm", nullptr), with("new_length_mm", 2e4),
+        with("new_length_mm", -1.0)}) {
+    const Reply r = op_.request("electrode.change", bad);
+    EXPECT_EQ(r.code, ErrorCode::kBadRequest) << bad << " → " << r.body;
+  }
+  expect_error(viewer_.request("electrode.change", e2), ErrorCode::kForbidden);
+  EXPECT_EQ(rt_->electrode().length_mm(), 300.0) << "nothing changed";
+  EXPECT_TRUE(op_.request("electrode.get").body["current"].is_null());
+
+  const Reply c = op_.request("electrode.change", e2);
+  ASSERT_TRUE(c) << c.body;
+  EXPECT_EQ(c.body["current"], "E2");
+  EXPECT_EQ(c.body["length_mm"], 250.0) << "the job compensates with its new length";
+  EXPECT_FALSE(c.body["table"][0]["measured"].get<bool>());
+  EXPECT_EQ(rt_->electrode().length_mm(), 250.0);
+  // A known id may come back with none of its fields.
+  ASSERT_TRUE(op_.request("electrode.change", {{"electrode", "E2"}}));
+
+  MotionBlock e1;
+  e1.kind = MotionKind::kCondition;
+  e1.condition = 1;
+  e1.line = 1;
+  MotionBlock hole;
+  hole.kind = MotionKind::kDrill;
+  hole.line = 2;
+  hole.condition = 1;
+  hole.target = {var("io.x_mm"), var("io.y_mm"), var("io.z_mm") - 2.0};
+  hole.depth_mm = 2.0;
+  hole.z_travel_mm = 3.2;
+  hole.feed_mm_s = 1.0;
+  ASSERT_TRUE(op_.upload_program(std::vector<MotionBlock>{e1, hole, end_block(3)}));
+  const Reply refused = op_.request("cycle.start");
+  expect_error(refused, ErrorCode::kInvalidState);
+  EXPECT_NE(refused.message.find("E2 was put in the spindle and not measured"), std::string::npos)
+      << refused.message;
+  EXPECT_EQ(rt_->machine().state(), rt::MachineState::kReady) << "nothing started";
+  // A length measured off the machine counts as its measurement.
+  ASSERT_TRUE(op_.request("electrode.set", {{"length_mm", 249.0}}));
+  EXPECT_TRUE(op_.request("electrode.get").body["table"][0]["measured"].get<bool>());
+  EXPECT_TRUE(op_.request("cycle.start"));
+  // No change while a job runs.
+  expect_error(op_.request("electrode.change", {{"electrode", "E2"}}), ErrorCode::kInvalidState);
+  ASSERT_TRUE(op_.request("cycle.stop"));
+}
+
+// The tool setter (drill-sim: at X-45 Y-45, z_mm −300) measures the electrode's true length,
+// whatever the control believed: the simulator's electrode is set to a length the control does
+// not know, and the measurement finds it. A touch off the setter measures nothing.
+TEST_F(OperatorOps, MeasuringOnTheToolSetterFindsTheElectrodesTrueLength) {
+  start();
+  const double z = var("io.z_mm") + 5.0;  // 5 mm above the work: within the touch's 20 mm
+  const auto run_to = [&](double x, double y) {
+    MotionBlock up;
+    up.kind = MotionKind::kRapid;
+    up.line = 1;
+    up.target = {var("io.x_mm"), var("io.y_mm"), z};
+    MotionBlock across = up;
+    across.line = 2;
+    across.target = {x, y, z};
+    const std::uint64_t before = rt_->job().progress().jobs_started;
+    ASSERT_TRUE(op_.upload_program(std::vector<MotionBlock>{up, across, end_block(3)}));
+    ASSERT_TRUE(op_.request("cycle.start"));
+    const auto deadline = std::chrono::steady_clock::now() + 60s;
+    while (rt_->job().progress().jobs_started == before || rt_->job().active()) {
+      ASSERT_LT(std::chrono::steady_clock::now(), deadline);
+      std::this_thread::sleep_for(10ms);  // polling an observable state, as edmhmi does
+    }
+  };
+  const auto measure = [&](const char* reference) {
+    const Reply m = op_.request("electrode.measure", {{"reference", reference}});
+    EXPECT_TRUE(m) << m.body;
+    const std::uint64_t seq = m.body.value("seq", std::uint64_t{0});
+    const auto deadline = std::chrono::steady_clock::now() + 60s;
+    Json got;
+    while (std::chrono::steady_clock::now() < deadline) {
+      got = op_.request("electrode.get").body;
+      if (got["last_measure"].is_object() && got["last_measure"]["seq"] == seq) break;
+      std::this_thread::sleep_for(20ms);
+    }
+    return got;
+  };
+  expect_error(op_.request("electrode.measure", {{"reference", "moon"}}), ErrorCode::kBadRequest);
+  expect_error(op_.request("electrode.measure"), ErrorCode::kBadRequest);
+  ASSERT_TRUE(op_.request("electrode.change", {{"electrode", "E7"},
+                                               {"kind", "tube"},
+                                               {"size_mm", 1.0},
+                                               {"material", "brass"},
+                                               {"new_length_mm", 300.0}}));
+  // The electrode put in is 12.345 mm shorter than its new length says.
+  ASSERT_TRUE(rt_->variables().write("io.electrode_length_mm", 287.655, true));
+
+  run_to(-20.0, -20.0);  // not over the setter
+  const Json off = measure("setter");
+  EXPECT_FALSE(off["last_measure"]["ok"].get<bool>()) << off;
+  EXPECT_NE(off["last_measure"]["error"].get<std::string>().find("not on the tool setter"),
+            std::string::npos)
+      << off;
+  EXPECT_EQ(rt_->electrode().length_mm(), 300.0) << "a failed measurement changes nothing";
+
+  run_to(-45.0, -45.0);
+  const Json on = measure("setter");
+  ASSERT_TRUE(on["last_measure"]["ok"].get<bool>()) << on;
+  EXPECT_NEAR(on["last_measure"]["length_mm"].get<double>(), 287.655, 0.005) << on;
+  EXPECT_NEAR(rt_->electrode().length_mm(), 287.655, 0.005);
+  EXPECT_TRUE(on["table"][0]["measured"].get<bool>());
+  EXPECT_NEAR(on["table"][0]["new_length_mm"].get<double>(), 287.655, 0.005)
+      << "a new electrode's first measurement is its new length";
+  EXPECT_TRUE(on["measuring"].is_null());
+}
+
 }  // namespace
 }  // namespace edm::bridge::test

@@ -49,7 +49,7 @@ std::string ElectrodeTable::invalid_id(const std::string& id) {
   const bool ok = !id.empty() && id.size() <= 32 && std::all_of(id.begin(), id.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == '_' || c == '-';
   });
-  return ok ? "" : "'id' must be 1 to 32 of A-Z a-z 0-9 . _ -";
+  return ok ? "" : "'electrode' (its id) must be 1 to 32 of A-Z a-z 0-9 . _ -";
 }
 
 std::string ElectrodeTable::invalid_kind(const std::string& kind) {
@@ -174,7 +174,9 @@ void ElectrodeTable::load() {
       e.kind = j.at("kind").get<std::string>();
       e.material = j.at("material").get<std::string>();
       if (!invalid_id(e.id).empty() || !invalid_kind(e.kind).empty() ||
-          !invalid_material(e.material).empty() || entries.size() >= kCap) {
+          !invalid_material(e.material).empty() || entries.size() >= kCap ||
+          std::any_of(entries.begin(), entries.end(),
+                      [&](const ElectrodeEntry& x) { return x.id == e.id; })) {
         throw std::runtime_error("an invalid entry");
       }
       e.size_mm = positive(j, "size_mm", 1e4);

@@ -27,8 +27,8 @@ struct JobLogEntry {
   double depth_mm{0.0};  // deepest depth reached (cnc.job.job_depth_mm)
   double wear_mm{0.0};   // estimated electrode wear (cnc.job.job_wear_mm)
   double electrode_start_mm{0.0}, electrode_end_mm{0.0};  // the estimate (0: unknown)
-  int cause{0};        // the machine's fault cause when it ended aborted in a safe state
-  std::string alarms;  // "110 block_fault cnc.job.finish: no spark …; …"
+  int cause{0};           // the machine's fault cause when it ended aborted in a safe state
+  std::string alarms;     // "110 block_fault cnc.job.finish: no spark …; …"
   std::string electrode;  // the electrode table's id of the one used ("" when none named)
   std::int64_t holes{0};  // drilling blocks begun (cnc.job.job_holes)
 };

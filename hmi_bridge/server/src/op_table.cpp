@@ -99,7 +99,8 @@ std::string audit_detail(const std::string& op, const Json& msg) {
     d += '=';
     d += text;
   };
-  for (const char* key : {"name", "frame", "axis", "axes", "target", "slot", "id", "reference"}) {
+  for (const char* key :
+       {"name", "frame", "axis", "axes", "target", "slot", "electrode", "reference"}) {
     if (auto it = msg.find(key); it != msg.end() && it->is_string()) {
       add(key, ops::brief_name(it->get_ref<const std::string&>()));
     }

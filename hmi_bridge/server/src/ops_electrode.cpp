@@ -152,9 +152,9 @@ Body op_electrode_set(Session& s, const Json& msg) {
 Body op_electrode_change(Session& s, const Json& msg) {
   Server::Impl& srv = s.server();
   rt::Runtime& rt = srv.rt;
-  const Json* id = field(msg, "id", [](const Json& j) { return j.is_string(); });
-  const std::string why_id =
-      id != nullptr ? ElectrodeTable::invalid_id(id->get<std::string>()) : "'id' is required";
+  const Json* id = field(msg, "electrode", [](const Json& j) { return j.is_string(); });
+  const std::string why_id = id != nullptr ? ElectrodeTable::invalid_id(id->get<std::string>())
+                                           : "'electrode' (its id) is required";
   if (!why_id.empty()) return error(ErrorCode::kBadRequest, why_id);
   const ElectrodeEntry* known = srv.electrodes->find(id->get<std::string>());
   ElectrodeEntry e = known != nullptr ? *known : ElectrodeEntry{};

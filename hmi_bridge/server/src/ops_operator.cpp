@@ -269,8 +269,10 @@ std::optional<Body> prepare_start(Session& s, const Json& msg) {
                        std::to_string(rt.work_offsets().generation()) +
                        "): interpret and commit it again");
     }
+    // A program that drills waits for the measurement; moves (to the tool setter) do not.
     if (const ElectrodeEntry* e = srv.electrodes->current();
-        !o.dry_run && e != nullptr && e->unmeasured) {
+        !o.dry_run && e != nullptr && e->unmeasured &&
+        !srv.committed_wear[static_cast<std::size_t>(o.slot)].empty()) {
       return error(ErrorCode::kInvalidState,
                    "the electrode " + e->id +
                        " was put in the spindle and not measured: measure it first (edmhmi "
