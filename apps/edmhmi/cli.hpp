@@ -118,15 +118,24 @@ int cmd_home(const HomeArgs& args, const edm::hmi::ConnectionSettings& settings)
 int cmd_jog(const JogArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_touch(const TouchArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_offset(const OffsetArgs& args, const edm::hmi::ConnectionSettings& settings);
-/// `edmhmi electrode` prints the length estimate; `edmhmi electrode set MM` sets it (after an
-/// electrode change or a measurement). `length_mm` < 0: print only.
-int cmd_electrode(double length_mm, const edm::hmi::ConnectionSettings& settings);
+struct ElectrodeArgs {
+  std::string action;  // "" (print), set, change, measure
+  double length_mm{0.0};
+  std::string id, kind, material;
+  double size_mm{0.0}, new_length_mm{0.0};
+  std::string reference;  // measure: setter, work
+  std::string frame;      // measure work: G54 … G59 ("" = G54)
+};
+/// `edmhmi electrode [set MM | change ID … | measure setter|work]` (cmd_electrode.cpp).
+int cmd_electrode(const ElectrodeArgs& args, const edm::hmi::ConnectionSettings& settings);
 /// `edmhmi alarms [--all]`: the active alarms with cause and remedy; --all adds the history.
 int cmd_alarms(bool all, const edm::hmi::ConnectionSettings& settings);
 /// `edmhmi jobs [--csv] [--limit N]`: the job log, newest last.
 int cmd_jobs(bool csv, int limit, const edm::hmi::ConnectionSettings& settings);
 /// Prints the active alarms as `alarms` does (status); false, and why, when they cannot be read.
 bool print_active_alarms(edm::bridge::Client& client);
+/// `edmhmi queue PART.nc[*N] …` (cmd_queue.cpp).
+int cmd_queue(const std::vector<std::string>& words, const edm::hmi::ConnectionSettings& settings);
 int cmd_mdi(const std::string& line, const edm::hmi::ConnectionSettings& settings);
 int cmd_watch(const WatchArgs& args, const edm::hmi::ConnectionSettings& settings);
 int cmd_trace(const TraceArgs& args, const edm::hmi::ConnectionSettings& settings);

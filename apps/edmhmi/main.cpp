@@ -149,10 +149,24 @@ int run(int argc, char** argv) {
   of->add_flag("--json", offset.json, "print the frames as JSON (for check --offsets)");
 
   std::vector<std::string> electrode_words;
+  ElectrodeArgs electrode;
   CLI::App* el = app.add_subcommand(
       "electrode",
-      "print the electrode length the job compensates with, or set it: electrode set 300");
-  el->add_option("WORDS", electrode_words, "[set <mm>]");
+      "the electrode and the electrode table: electrode | electrode set 300 | electrode change "
+      "E2 --kind tube --size 1 --material copper --new-length 300 | electrode measure setter");
+  el->add_option("WORDS", electrode_words, "[set <mm> | change <id> | measure setter|work]");
+  el->add_option("--kind", electrode.kind, "change: round, tube or rect");
+  el->add_option("--size", electrode.size_mm, "change: diameter or width [mm]");
+  el->add_option("--material", electrode.material, "change: copper, graphite, CuW, …");
+  el->add_option("--new-length", electrode.new_length_mm, "change: its length when new [mm]");
+  el->add_option("--frame", electrode.frame, "measure work: the frame whose Z is the surface");
+
+  std::vector<std::string> queue_words;
+  app.add_subcommand("queue",
+                     "run part programs one after the other, PART.nc*N N times; stop before a "
+                     "hole the electrode cannot finish, go on once it is changed and measured")
+      ->add_option("PARTS", queue_words, "PART.nc or PART.nc*N, in order")
+      ->required();
 
   std::string mdi_line;
   CLI::App* md = app.add_subcommand("mdi", "run one G-code line from where the electrode is");
@@ -226,15 +240,30 @@ int run(int argc, char** argv) {
   if (command == "touch") return cmd_touch(touch, settings);
   if (command == "offset") return cmd_offset(offset, settings);
   if (command == "electrode") {
-    if (electrode_words.empty()) return cmd_electrode(-1.0, settings);
-    const std::optional<double> mm = electrode_words.size() == 2 && electrode_words[0] == "set"
-                                         ? edm::apps::finite_number(electrode_words[1])
-                                         : std::nullopt;
-    if (!mm || *mm <= 0.0)
-      return usage("electrode: expected `electrode` or `electrode set <mm>` (mm > 0)");
-    return cmd_electrode(*mm, settings);
+    const auto& ew = electrode_words;
+    if (!ew.empty()) electrode.action = ew[0];
+    if (ew.empty()) return cmd_electrode(electrode, settings);
+    if (ew[0] == "set") {
+      const std::optional<double> mm =
+          ew.size() == 2 ? edm::apps::finite_number(ew[1]) : std::nullopt;
+      if (!mm || *mm <= 0.0) return usage("electrode set: expected `electrode set <mm>` (mm > 0)");
+      electrode.length_mm = *mm;
+      return cmd_electrode(electrode, settings);
+    }
+    if (ew[0] == "change" && ew.size() == 2) {
+      electrode.id = ew[1];
+      return cmd_electrode(electrode, settings);
+    }
+    if (ew[0] == "measure" && ew.size() == 2 && (ew[1] == "setter" || ew[1] == "work")) {
+      electrode.reference = ew[1];
+      return cmd_electrode(electrode, settings);
+    }
+    return usage(
+        "electrode: expected `electrode`, `electrode set <mm>`, `electrode change <id> [--kind "
+        "K --size MM --material M --new-length MM]` or `electrode measure setter|work`");
   }
   if (command == "mdi") return cmd_mdi(mdi_line, settings);
+  if (command == "queue") return cmd_queue(queue_words, settings);
   return cmd_machine(command, settings);
 }
 
