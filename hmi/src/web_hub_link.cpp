@@ -24,7 +24,7 @@ struct SeriesWish {
   std::string_view key;
   std::array<std::string_view, 2> candidates;
 };
-constexpr std::array<SeriesWish, 11> kSeriesWishes{{
+constexpr std::array<SeriesWish, 12> kSeriesWishes{{
     {"z", {"io.z_mm", ""}},
     {"depth", {"io.depth_mm", ""}},
     {"depth_est", {"*.drill.depth_reached_mm", "*.depth_reached_mm"}},
@@ -36,6 +36,9 @@ constexpr std::array<SeriesWish, 11> kSeriesWishes{{
     {"arc_s", {"io.ratio_stable_arc", ""}},
     {"x", {"io.x_mm", ""}},
     {"y", {"io.y_mm", ""}},
+    // Not drawn: the feed override as the machine runs it (EdmJob drives it into the drill every
+    // cycle from the operator's value), the page's readback beside its control.
+    {"override", {"*.drill.feed_override", "*.feed_override"}},
 }};
 
 bool matches(std::string_view name, std::string_view wish) {

@@ -75,6 +75,18 @@ Json frame_runs(const std::vector<BlockFrame>& frames) {
   return runs;
 }
 
+/// Each drilling block as [block index, source line, depth_mm]: what the page's depth bar and ETA
+/// measure a running job against.
+Json drill_list(const std::vector<machining::MotionBlock>& blocks) {
+  Json out = Json::array();
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    if (blocks[i].kind == MotionKind::kDrill) {
+      out.push_back(Json::array({i, blocks[i].line, blocks[i].depth_mm}));
+    }
+  }
+  return out;
+}
+
 Json errors_json(const std::vector<GcodeError>& errors) {
   Json out = Json::array();
   for (const GcodeError& e : errors) {
@@ -235,11 +247,13 @@ void WebJob::load_locked(std::string part, std::string text,
   text_ = std::move(text);
   generation_ = generation;
   toolpath_ = toolpath_points(blocks, start, kMaxToolpathPoints);
+  drills_ = drill_list(blocks);
   blocks_ = std::move(blocks);
   frames_ = frames;
   frame_runs_ = frame_runs(frames_);
   resumed_from_.reset();
   started_ = false;
+  dry_run_ = false;
   report_done_ = false;
   report_ = JobReport{};
 }
@@ -294,8 +308,10 @@ bridge::Reply WebJob::start(bool dry_run) {
   if (r) {
     std::lock_guard lock(mutex_);
     started_ = true;
+    dry_run_ = dry_run;
     report_done_ = false;
     report_ = JobReport{};
+    report_.dry_run = dry_run;  // nothing drilled: the report gives no depth error
     report_.part = part_;
     report_.machine = machine_name_;
     report_.targets = frames_.size() == blocks_.size() ? program_targets(blocks_, frames_)
@@ -440,6 +456,8 @@ Json WebJob::snapshot() const {
           {"toolpath", toolpath_},
           {"frames", frame_runs_},
           {"resumed_from", resumed_from_ ? Json(*resumed_from_) : Json(nullptr)},
+          {"drills", drills_},
+          {"dry_run", dry_run_},
           {"report", report}};
 }
 

@@ -377,17 +377,22 @@ test('run from a line, as a dry run: re-approach, then the rest of the program',
 // A stop ends the drill's cycle (it retracts, keeping its depth count: EdmJob's abort of its
 // children); job.last then carries the depth, touch Z and wear the resumed drill counts on from.
 test('stop mid-drill, then run from the drilling line: the hole is finished from its depth', async () => {
-  // A second hole: G54 moved 10 mm in X, the electrode over the new place (MDI), and Z touched
-  // off again there — the first hole wore the electrode ~10 mm shorter.
+  // A second hole: G54 moved 10 mm in X, the electrode jogged 10 mm over the new place, and Z
+  // touched off again there — the first hole wore the electrode ~10 mm shorter. (Jogged, not
+  // moved by MDI: an MDI line after the wear is interpreted from the spindle's Z, not the tip's,
+  // and the electrode compensation then takes the worn length off twice — the electrode ends
+  // ~10 mm low, in the work. Only X is sent to the table: the page sends the axes edited.)
   await page.locator('#off-G54-X').fill('10');
   await page.locator('#off-set-G54').click();
   await page.locator('#offsets-result').filter({ hasText: 'G54 set' }).waitFor({ timeout: T });
-  await page.locator('#mdi-line').fill('G00 X5 Y5');
-  await page.locator('#mdi-go').click();
-  await confirm();
-  await page.locator('#mdi-result').filter({ hasText: /started|refused/ }).waitFor({ timeout: T });
-  await page.waitForFunction(() => Math.abs(window.edm.status.vars['io.x_mm'] - 15) < 0.002
-    && window.edm.status.state === 'READY', null, { timeout: T, polling: 50 });
+  const x0 = (await position()).x;
+  const seq0 = await lastSeq();
+  await page.locator('#opfun .jog-step[data-step="10"]').click();
+  await page.locator('#jog-X-plus').click();
+  const jogged = await nextResult(seq0);
+  assert.ok(jogged.ok, `jog failed: ${jogged.error}`);
+  await page.waitForFunction((x) => Math.abs(window.edm.status.vars['io.x_mm'] - x) < 0.002
+    && window.edm.status.state === 'READY', x0 + 10, { timeout: T, polling: 50 });
   const seq = await lastSeq();
   await page.locator('#touch-target').selectOption('z');
   await page.locator('#touch-set').selectOption('G54');

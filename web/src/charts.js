@@ -1,6 +1,8 @@
 // Live charts with uPlot (bundled from node_modules by Vite). Each chart keeps a fixed window of
 // WINDOW rows in preallocated columns that are shifted in place, so memory stays flat however
-// long the page runs; charts are redrawn at most every REDRAW_MS, not per frame.
+// long the page runs; charts are redrawn at most every REDRAW_MS, not per frame. Each chart
+// follows its container's width (a ResizeObserver: a rotated tablet, a column that narrows), and
+// takes its axis colours from the theme (restyle()).
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
 
@@ -30,24 +32,49 @@ export class Charts {
     this.dirty = false;
     this.last = 0;
     this.count = 0;
+    this.series = [];
+    this.latest = {}; // series key → its value in the last row (also the ones not drawn)
+    // A chart is as wide as its container, whatever made the container change.
+    this.observer = new ResizeObserver((entries) => {
+      for (const e of entries) {
+        const c = this.charts.find((x) => x.el === e.target);
+        if (c) this.fit(c);
+      }
+    });
   }
 
   /** series: [{key, var}] as the server chose them for this machine. */
   setup(series) {
-    for (const c of this.charts) c.plot.destroy();
-    this.charts = [];
+    this.series = series;
     this.columns = {};
     series.forEach((s, i) => { this.columns[s.key] = i + 1; });
     this.count = 0;
-    for (const def of DEFS) {
+    this.latest = {};
+    this.build(null);
+  }
+
+  /** The theme changed: the plots again with the new colours, the data kept. */
+  restyle() {
+    if (this.charts.length) this.build(this.charts.map((c) => c.data));
+  }
+
+  build(keep) {
+    for (const c of this.charts) { this.observer.unobserve(c.el); c.plot.destroy(); }
+    this.charts = [];
+    const css = getComputedStyle(document.documentElement);
+    const axisStroke = css.getPropertyValue('--chart-axis').trim() || '#334155';
+    const gridStroke = css.getPropertyValue('--chart-grid').trim() || '#e2e8f0';
+    const axis = { stroke: axisStroke, grid: { stroke: gridStroke }, ticks: { stroke: gridStroke } };
+    DEFS.forEach((def, k) => {
       const el = document.getElementById(def.el);
       el.replaceChildren();
       const present = def.series.filter((s) => this.columns[s.key] !== undefined);
-      const data = [new Float64Array(WINDOW), ...present.map(() => new Float64Array(WINDOW))];
+      const data = keep?.[k] ?? [new Float64Array(WINDOW), ...present.map(() => new Float64Array(WINDOW))];
       const opts = {
         title: def.title,
-        width: Math.max(200, el.clientWidth || 400),
+        width: this.widthOf(el),
         height: 118,
+        axes: [axis, axis],
         scales: { x: { time: false } },
         legend: { live: false },
         cursor: { drag: { x: false, y: false } },
@@ -56,16 +83,26 @@ export class Charts {
       };
       const plot = new uPlot(opts, [[], ...present.map(() => [])], el);
       el.dataset.points = '0';
-      this.charts.push({ def, present, data, plot, el });
-    }
-    this.resize();
+      const c = { def, present, data, plot, el };
+      this.charts.push(c);
+      this.observer.observe(el);
+    });
+    if (keep) this.draw();
   }
 
-  resize() {
-    for (const c of this.charts) {
-      c.plot.setSize({ width: Math.max(200, c.el.clientWidth), height: 118 });
-    }
+  /** The container's content width (never the plot's: it must not hold its column open). */
+  widthOf(el) {
+    const cs = getComputedStyle(el);
+    const w = el.clientWidth - parseFloat(cs.paddingLeft) - parseFloat(cs.paddingRight);
+    return Math.max(120, Math.floor(w || 400));
   }
+
+  fit(c) {
+    const width = this.widthOf(c.el);
+    if (Math.abs(c.plot.width - width) >= 1) c.plot.setSize({ width, height: 118 });
+  }
+
+  resize() { for (const c of this.charts) this.fit(c); }
 
   /** rows: [[t, v0, v1, …], …] from one frame. */
   push(rows, redraw = false) {
@@ -82,6 +119,10 @@ export class Charts {
         });
       }
       if (this.count < WINDOW) this.count++;
+    }
+    if (rows.length) {
+      const last = rows[rows.length - 1];
+      for (const [key, col] of Object.entries(this.columns)) this.latest[key] = last[col];
     }
     this.dirty = rows.length > 0 || this.dirty;
     const now = performance.now();

@@ -1,5 +1,6 @@
 // A small G-code editor: a textarea over a highlighted copy of its text (comments, G/M codes,
-// axis words, E/F/S/P/R words), a line-number gutter, and `check` errors marked at their lines.
+// axis words, E/F/S/P/R words), a line-number gutter, `check` errors marked at their lines, and
+// the line the running job is on (setCurrent).
 const esc = (s) => s.replace(/[&<>]/g, (c) => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;' }[c]));
 
 function highlightLine(line) {
@@ -48,7 +49,8 @@ export class Editor {
     wrap.append(this.hl, this.ta);
     root.append(this.gutter, wrap);
     this.errors = new Map();
-    this.ta.addEventListener('input', () => { this.errors.clear(); this.render(); });
+    this.current = 0; // the running job's line (0: none)
+    this.ta.addEventListener('input', () => { this.errors.clear(); this.render(); this.onEdit?.(); });
     this.ta.addEventListener('scroll', () => {
       this.hl.scrollTop = this.ta.scrollTop;
       this.hl.scrollLeft = this.ta.scrollLeft;
@@ -58,7 +60,7 @@ export class Editor {
   }
 
   get text() { return this.ta.value; }
-  set text(v) { this.ta.value = v; this.errors.clear(); this.render(); }
+  set text(v) { this.ta.value = v; this.errors.clear(); this.render(); this.onEdit?.(); }
   set readOnly(v) { this.ta.readOnly = v; }
 
   /** errors: [{line, col, message}] */
@@ -81,16 +83,34 @@ export class Editor {
     this.ta.scrollTop = Math.max(0, (line - 4) * lh);
   }
 
+  /** Marks the running job's line (0: none) and scrolls it into view unless the operator types. */
+  setCurrent(line) {
+    if (line === this.current) return;
+    this.current = line;
+    this.render();
+    if (line > 0 && document.activeElement !== this.ta) {
+      const lh = parseFloat(getComputedStyle(this.ta).lineHeight) || 18;
+      const top = (line - 1) * lh;
+      const h = this.ta.clientHeight;
+      if (top < this.ta.scrollTop || top + lh > this.ta.scrollTop + h) {
+        this.ta.scrollTop = Math.max(0, top - h / 3);
+      }
+    }
+  }
+
   render() {
     const lines = this.ta.value.split('\n');
     this.hl.innerHTML = lines.map((l, i) => {
       const errs = this.errors.get(i + 1);
       const body = highlightLine(l) || ' ';
-      return errs
-        ? `<span class="err-line" data-line="${i + 1}" title="${esc(errs.map((e) => `${e.col}: ${e.message}`).join('\n'))}">${body}</span>`
-        : body;
+      if (errs) {
+        return `<span class="err-line" data-line="${i + 1}" title="${esc(errs.map((e) => `${e.col}: ${e.message}`).join('\n'))}">${body}</span>`;
+      }
+      return i + 1 === this.current ? `<span class="cur-line" data-line="${i + 1}">${body}</span>` : body;
     }).join('\n') + '\n';
-    this.gutter.innerHTML = lines.map((_, i) => (this.errors.has(i + 1)
-      ? `<span class="err-mark" data-line="${i + 1}">${i + 1}</span>` : String(i + 1))).join('\n') + '\n';
+    this.gutter.innerHTML = lines.map((_, i) => {
+      if (this.errors.has(i + 1)) return `<span class="err-mark" data-line="${i + 1}">${i + 1}</span>`;
+      return i + 1 === this.current ? `<span class="cur-mark" data-line="${i + 1}">${i + 1}</span>` : String(i + 1);
+    }).join('\n') + '\n';
   }
 }

@@ -5,8 +5,12 @@ import { Connection } from './connection.js';
 import { Charts } from './charts.js';
 import { Editor } from './editor.js';
 import { Toolpath } from './toolpath.js';
-import { renderAlarms, renderStats, VarPanel } from './panels.js';
+import { renderAlarms, renderStats, renderConditions } from './panels.js';
+import { VarPanel } from './vars.js';
 import { OperatorPanel, activeFrame } from './manual.js';
+import { KeyJog } from './keyjog.js';
+import { JobPanel } from './job.js';
+import { setupPrefs, units } from './prefs.js';
 
 const $ = (id) => document.getElementById(id);
 const STALE_MS = 1000;
@@ -25,6 +29,7 @@ window.edm = ui; // read by the end-to-end tests (first render time, state, manu
 const charts = new Charts();
 const editor = new Editor($('editor'));
 const toolpath = new Toolpath($('tp-xy'), $('tp-xz'));
+const jobPanel = new JobPanel(editor, toolpath);
 
 function confirmDialog(text) {
   const d = $('confirm');
@@ -60,6 +65,7 @@ const conn = new Connection({
     editor.readOnly = m.role !== 'operator';
     charts.setup(m.series || []);
     if (m.history) charts.push(m.history, true);
+    renderConditions(m.machine?.conditions);
     ui.caps = m.caps || {};
     ops.render(ui.caps, m.role === 'operator');
     ui.offsets = m.offsets; ui.manual = m.manual;
@@ -81,7 +87,7 @@ const conn = new Connection({
     if (f.manual) { ui.manual = f.manual; ops.showManual(f.manual); }
     if (f.status) showStatus(f.status, true);
     else if (f.offsets) showPosition(ui.status);
-    if (f.rows) charts.push(f.rows);
+    if (f.rows) { charts.push(f.rows); showOverride(); }
     if (f.alarms) {
       ui.alarms = ui.alarms.concat(f.alarms).slice(-200);
       renderAlarms(ui.alarms, ui.role === 'operator');
@@ -96,6 +102,19 @@ const conn = new Connection({
 const vars = new VarPanel(conn, confirmDialog);
 const ops = new OperatorPanel(conn, confirmDialog);
 ops.onFrame = () => showPosition(ui.status);
+ui.keyJog = new KeyJog(ops);
+setupPrefs({
+  themeButton: $('btn-theme'),
+  unitsButton: $('btn-units'),
+  onTheme: () => { charts.restyle(); toolpath.request(); },
+  onUnits: () => { ops.showOffsets(); if (ui.status) showStatus(ui.status, false); },
+});
+
+/** The feed override as the machine runs it (the series "override": the drill's input). */
+function showOverride() {
+  const t = ops.showOverride(charts.latest.override);
+  $('job-override').textContent = t;
+}
 
 function statusVar(s, suffix) {
   const v = s.vars || {};
@@ -111,8 +130,8 @@ function showStatus(s, fresh) {
   $('state').dataset.state = s.state;
   ops.setState(s.state);
   const [x, y, z] = showPosition(s);
-  $('val-depth').textContent = `${fmt(statusVar(s, 'io.depth_mm'))} mm`;
-  $('val-electrode').textContent = `${fmt(statusVar(s, 'io.electrode_mm'), 2)} mm`;
+  $('val-depth').textContent = `${units.fmt(statusVar(s, 'io.depth_mm'))} ${units.mode}`;
+  $('val-electrode').textContent = `${units.fmt(statusVar(s, 'io.electrode_mm'), 2)} ${units.mode}`;
   const job = s.job || {};
   $('job-outcome').textContent = job.outcome ?? '—';
   $('job-block').textContent = job.blocks ? `${Math.min(job.block + 1, job.blocks)} / ${job.blocks}` : '—';
@@ -120,6 +139,7 @@ function showStatus(s, fresh) {
   const t = statusVar(s, 'job_time_s');
   $('job-time').textContent = typeof t === 'number' ? `${t.toFixed(1)} s` : '—';
   $('job-progress').value = job.blocks ? (job.outcome === 'finished' ? 1 : job.block / job.blocks) : 0;
+  jobPanel.update(s, ui.job, charts.latest);
   if (x !== undefined) toolpath.setPosition([x ?? 0, y ?? 0, z ?? 0]);
   updateButtons();
   if (job.outcome === 'finished' || job.outcome === 'aborted') {
@@ -137,30 +157,38 @@ function showPosition(s) {
   const m = [statusVar(s, 'io.x_mm'), statusVar(s, 'io.y_mm'), statusVar(s, 'io.z_mm')];
   const f = ui.caps?.work_coordinates ? activeFrame(s, ui.job, ops.offsets, ops.frame) : null;
   ['x', 'y', 'z'].forEach((a, i) => {
-    $(`dro-${a}`).textContent = fmt(m[i]);
+    $(`dro-${a}`).textContent = units.fmt(m[i]);
+    $(`dro-${a}`).dataset.mm = typeof m[i] === 'number' ? String(m[i]) : '';
     const w = $(`wrk-${a}`);
-    w.textContent = f && typeof m[i] === 'number' ? fmt(m[i] - f.offset[i]) : '—';
+    w.textContent = f && typeof m[i] === 'number' ? units.fmt(m[i] - f.offset[i]) : '—';
     w.classList.toggle('na', !f);
   });
   $('wrk-head').textContent = f ? `work ${f.name}` : 'work';
   $('coord-note').textContent = ui.caps?.work_coordinates ? '' : 'work coordinates: not supported by this edmplc';
+  $('units-note').textContent = units.mode === 'in' ? 'inch' : 'mm';
   return m;
 }
 
 function showJob(j, initial) {
   ui.job = j;
   if (!j) return;
-  $('job-part').textContent = j.part || 'none';
+  jobPanel.pathShown = true;
   toolpath.setPath(j.toolpath || []);
   if (initial && j.text && !editor.text) { editor.text = j.text; $('part-name').value = j.part; }
   $('job-report').hidden = !j.report;
-  $('job-report').textContent = j.report ? j.report.text : '';
+  // A dry run says so above its report (the report's own rows say it too).
+  $('job-report').textContent = j.report
+    ? `${j.dry_run ? 'DRY RUN: the motion only, the generator off; nothing was drilled.\n' : ''}${j.report.text}` : '';
+  jobPanel.update(ui.status, j, charts.latest);
 }
 
 function updateButtons() {
   const st = ui.status?.state;
   const loaded = ui.job && ui.job.blocks > 0;
-  $('btn-start').disabled = !(st === 'READY' && loaded);
+  // The machine's loaded program is not the page's (edmhmi run loaded another): upload first.
+  const elsewhere = jobPanel.owner === 'elsewhere';
+  $('btn-start').disabled = !(st === 'READY' && loaded) || elsewhere;
+  $('btn-start').title = elsewhere ? 'the machine holds a program loaded elsewhere: upload this one first' : '';
   $('btn-hold').disabled = st !== 'RUNNING';
   $('btn-resume').disabled = st !== 'HOLD';
   $('btn-stop').disabled = !(st === 'RUNNING' || st === 'HOLD');
@@ -240,7 +268,8 @@ for (const b of document.querySelectorAll('.tabs button')) {
   };
 }
 
-window.addEventListener('resize', () => { charts.resize(); toolpath.request(); });
+// The charts follow their containers by themselves (ResizeObserver); the canvases here.
+window.addEventListener('resize', () => toolpath.request());
 $('login-form').onsubmit = (e) => {
   e.preventDefault();
   $('login-error').textContent = '';

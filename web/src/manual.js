@@ -2,6 +2,9 @@
 // touch-off, the work-offset table, and the work-coordinate readout. Everything acts through
 // `edmhmi serve`, which owns the machine's side: a held jog is refreshed by the server while this
 // page keeps saying "held" — a page that sleeps, closes or loses its network stops the axis.
+// The keyboard's held jog (keyjog.js) goes through the same startHold().
+import { units } from './prefs.js';
+
 const $ = (id) => document.getElementById(id);
 const fmt = (v, d = 3) => (typeof v === 'number' && Number.isFinite(v) ? v.toFixed(d) : '—');
 const el = (tag, props = {}, ...children) => {
@@ -60,6 +63,8 @@ export class OperatorPanel {
     this.manual = null;
     this.state = null;
     this.release = null; // stops the held jog, if any
+    this.keysEnabled = true; // the keyboard's held jog (keyjog.js)
+    this.isOperator = false;
     // A page that is hidden or loses focus lets go of a held jog at once (the server would stop
     // it anyway when "held" stops coming).
     document.addEventListener('visibilitychange', () => { if (document.hidden) this.letGo(); });
@@ -72,6 +77,7 @@ export class OperatorPanel {
   /** Builds the panel for this machine; each function says why when it is not there. */
   render(caps, isOperator) {
     this.caps = caps || {};
+    this.isOperator = isOperator;
     const body = $('opfun-body');
     body.replaceChildren();
     if (!isOperator) return;
@@ -110,7 +116,7 @@ export class OperatorPanel {
     all.onclick = () => this.home('');
     row.append(all);
     for (const a of AXES) {
-      const b = el('button', { id: `home-${a}`, textContent: a, className: 'small' });
+      const b = el('button', { id: `home-${a}`, textContent: a });
       b.onclick = () => this.home(a);
       row.append(b);
     }
@@ -127,7 +133,7 @@ export class OperatorPanel {
   buildJog(div) {
     const steps = el('div', { className: 'btns steps' });
     for (const s of STEPS) {
-      const b = el('button', { className: 'small jog-step', textContent: s === 'cont' ? 'hold' : s });
+      const b = el('button', { className: 'jog-step', textContent: s === 'cont' ? 'hold' : s });
       b.dataset.step = s;
       b.title = s === 'cont' ? 'continuous: moves while the button is held' : `one step of ${s} mm per click`;
       b.onclick = () => { this.step = s; this.markStep(); };
@@ -152,7 +158,11 @@ export class OperatorPanel {
         grid.append(b);
       }
     }
-    div.append(steps, grid);
+    const keys = el('label', { className: 'keys-hint', title: 'jog while a key is held: ← → X, ↑ ↓ Y, PgUp PgDn Z (not while typing in a field); released on key-up or when the page loses focus' });
+    const box = el('input', { type: 'checkbox', id: 'jog-keys', checked: this.keysEnabled });
+    box.onchange = () => { this.keysEnabled = box.checked; if (!box.checked) this.letGo(); };
+    keys.append(box, ' keys: ← → X · ↑ ↓ Y · PgUp PgDn Z (held, at the speed above)');
+    div.append(steps, grid, keys);
   }
 
   markStep() {
@@ -171,7 +181,21 @@ export class OperatorPanel {
     });
   }
 
+  /** A pointer held on a jog button: the jog runs until the pointer lets go. */
   async hold(button, pointerId, axis, dir) {
+    const stop = this.startHold(axis, dir, button);
+    try { button.setPointerCapture(pointerId); } catch { /* a synthetic event */ }
+    for (const ev of ['pointerup', 'pointercancel', 'lostpointercapture']) {
+      button.addEventListener(ev, stop, { once: true });
+    }
+  }
+
+  /**
+   * Starts a continuous jog of `axis` in `dir` at the chosen speed (jog.hold, then "held" every
+   * held_ms while it lasts) and returns the function that lets go (jog.release). One jog at a
+   * time: a new one lets the last go first. blur, hidden and pagehide let go too (constructor).
+   */
+  startHold(axis, dir, button = null) {
     this.letGo();
     let timer = null;
     let held = true;
@@ -179,25 +203,29 @@ export class OperatorPanel {
       if (!held) return;
       held = false;
       if (timer) clearInterval(timer);
-      button.classList.remove('held');
+      button?.classList.remove('held');
       if (this.release === stop) this.release = null;
       this.conn.cmd('jog.release');
     };
     this.release = stop;
-    try { button.setPointerCapture(pointerId); } catch { /* a synthetic event */ }
-    for (const ev of ['pointerup', 'pointercancel', 'lostpointercapture']) {
-      button.addEventListener(ev, stop, { once: true });
-    }
-    button.classList.add('held');
-    const velocity = dir * Number($('jog-speed').value);
-    const r = await this.conn.cmd('jog.hold', { axis, velocity });
-    if (!r.ok) {
-      this.note(`jog refused: ${r.message || r.code}`);
-      stop();
-      return;
-    }
-    if (!held) return; // let go before the server answered: it has stopped the jog
-    timer = setInterval(() => this.conn.send({ t: 'held' }), Math.max(20, r.body.held_ms || 100));
+    button?.classList.add('held');
+    const velocity = dir * Number($('jog-speed')?.value ?? 1);
+    this.conn.cmd('jog.hold', { axis, velocity }).then((r) => {
+      if (!r.ok) {
+        this.note(`jog refused: ${r.message || r.code}`);
+        stop();
+        return;
+      }
+      if (!held) return; // let go before the server answered: it has stopped the jog
+      timer = setInterval(() => this.conn.send({ t: 'held' }), Math.max(20, r.body.held_ms || 100));
+    });
+    return stop;
+  }
+
+  /** Whether a continuous jog may start now (an operator, the function there, READY). */
+  canJog() {
+    return !!this.caps.jog && this.isOperator && this.state === 'READY'
+      && !(this.manual?.busy && this.manual?.mode !== 'jog');
   }
 
   buildTouch(div) {
@@ -222,11 +250,20 @@ export class OperatorPanel {
     const input = el('input', { id: 'override-pct', type: 'number', min: '0', max: '150', step: '5', value: '100' });
     const set = el('button', { id: 'override-set', textContent: 'Set %' });
     const out = el('span', { id: 'override-result' });
+    const back = el('span', { id: 'override-readback', className: 'readback', title: 'the feed override the machine runs with (its variable)' });
     set.onclick = async () => {
       const r = await this.conn.cmd('feed.override', { percent: Number(input.value) });
       out.textContent = r.ok ? ` ${r.body.percent} %` : ` refused: ${r.message || r.code}`;
     };
-    div.append(el('span', { className: 'btns' }, input, set, out));
+    div.append(el('span', { className: 'btns' }, input, set, out, back));
+  }
+
+  /** The override as the machine has it (a ratio, 0 … 1.5), from the status stream. */
+  showOverride(ratio) {
+    const text = typeof ratio === 'number' && Number.isFinite(ratio) ? `${Math.round(ratio * 100)} %` : '—';
+    const b = $('override-readback');
+    if (b) { b.textContent = ` machine: ${text}`; b.dataset.percent = text === '—' ? '' : String(Math.round(ratio * 100)); }
+    return text;
   }
 
   buildOffsets(isOperator) {
@@ -247,7 +284,7 @@ export class OperatorPanel {
       tr.insertCell().append(radio);
       tr.insertCell().textContent = f;
       const inputs = AXES.map((a) => {
-        const i = el('input', { type: 'number', step: '0.0001', className: 'off' });
+        const i = el('input', { type: 'number', step: 'any', className: 'off' });
         i.dataset.axis = a.toLowerCase();
         i.id = `off-${f}-${a}`;
         tr.insertCell().append(i);
@@ -264,14 +301,17 @@ export class OperatorPanel {
   async setOffset(frame, inputs) {
     const params = { frame };
     for (const i of inputs) {
-      const cur = this.offsets?.frames?.[frame]?.[i.dataset.axis];
+      const cur = this.offsets?.frames?.[frame]?.[i.dataset.axis] ?? 0;
       const v = Number(i.value);
-      if (i.value !== '' && Number.isFinite(v) && v !== cur) params[i.dataset.axis] = v;
+      // Unchanged: the text shown for the current value (inches are converted back to mm).
+      if (i.value !== '' && Number.isFinite(v) && i.value !== units.fmt(cur, 4)) {
+        params[i.dataset.axis] = Math.round(units.toMm(v) * 1e6) / 1e6;
+      }
     }
     if (Object.keys(params).length === 1) { $('offsets-result').textContent = `${frame}: nothing changed`; return; }
     const r = await this.conn.cmd('offset.set', params);
     $('offsets-result').textContent = r.ok
-      ? `${frame} set: X ${fmt(r.body.x, 4)} Y ${fmt(r.body.y, 4)} Z ${fmt(r.body.z, 4)} (generation ${r.body.generation})`
+      ? `${frame} set: X ${units.fmt(r.body.x, 4)} Y ${units.fmt(r.body.y, 4)} Z ${units.fmt(r.body.z, 4)} ${units.mode} (generation ${r.body.generation})`
       : `${frame} refused: ${r.message || r.code}`;
   }
 
@@ -283,9 +323,10 @@ export class OperatorPanel {
       const v = this.offsets.frames?.[f] || {};
       for (const a of AXES) {
         const i = $(`off-${f}-${a}`);
-        if (i && document.activeElement !== i) i.value = fmt(v[a.toLowerCase()] ?? 0, 4);
+        if (i && document.activeElement !== i) i.value = units.fmt(v[a.toLowerCase()] ?? 0, 4);
       }
     }
+    $('offsets-unit').textContent = units.mode;
     const t = $('offsets');
     if (t) t.dataset.generation = String(this.offsets.generation ?? '');
   }

@@ -1,5 +1,5 @@
-// The side panels: alarms with acknowledge, task statistics, variable watch and force. The
-// operator functions of issue 21 are in manual.js.
+// The side panels: alarms with acknowledge, task statistics, the conditions (E) table. The
+// variable watch is in vars.js, the operator functions of issue 21 in manual.js.
 const $ = (id) => document.getElementById(id);
 const fmt = (v, d = 3) => (typeof v === 'number' && Number.isFinite(v) ? v.toFixed(d) : '—');
 
@@ -23,6 +23,7 @@ export function renderAlarms(alarms, isOperator) {
     if (a.remedy) li.append(line('alarm-remedy', `Remedy: ${a.remedy}`));
     return li;
   }));
+  $('alarms-none').hidden = alarms.length > 0;
   const open = alarms.filter((a) => !a.acked).length;
   $('alarm-count').hidden = open === 0;
   $('alarm-count').textContent = String(open);
@@ -46,74 +47,34 @@ export function renderStats(reply) {
     + `${w.slow_disconnects ?? '?'} slow disconnects`;
 }
 
-/** The watch list: names read every 500 ms; operators can write parameters and force pins. */
-export class VarPanel {
-  constructor(conn, confirm) {
-    this.conn = conn;
-    this.confirm = confirm;
-    this.watched = new Map(); // name → {kind, forced}
-    this.isOperator = false;
-    $('btn-var-list').onclick = () => this.list();
-    setInterval(() => this.poll(), 500);
+/** machine.info's conditions (the E table the programs select), read-only: edmplc has no op that
+ *  changes one — they are the machine config's `conditions:` (docs/config.md). */
+const CONDITION_COLUMNS = [
+  ['E', 'E', 0], ['name', 'name', null], ['polarity', 'polarity', null],
+  ['open_voltage_v', 'U₀ V', 1], ['peak_current_a', 'Î A', 1], ['on_time_us', 'on µs', 1],
+  ['off_time_us', 'off µs', 1], ['tdr_us', 'Tdr µs', 1], ['servo_ref_v', 'servo V', 1],
+  ['wear_ratio', 'wear', 4], ['area_ratio', 'A ratio', 4],
+];
+export function renderConditions(conditions) {
+  const t = $('conditions');
+  t.replaceChildren();
+  const list = Array.isArray(conditions) ? conditions : [];
+  $('conditions-note').textContent = list.length
+    ? 'read-only: set in the machine config (edmplc has no op to edit them)'
+    : 'this edmplc sends none';
+  if (!list.length) return;
+  const head = t.insertRow();
+  for (const [, label] of CONDITION_COLUMNS) {
+    const th = document.createElement('th');
+    th.textContent = label;
+    head.append(th);
   }
-
-  async list() {
-    const r = await this.conn.cmd('var.list', { prefix: $('var-prefix').value });
-    const ul = $('var-list');
-    if (!r.ok) { ul.innerHTML = `<li>${r.code}: ${r.message}</li>`; return; }
-    ul.replaceChildren(...r.body.vars.slice(0, 500).map((v) => {
-      const li = document.createElement('li');
-      li.textContent = `${v.name} ${v.unit ? `[${v.unit}]` : ''} ${v.kind}`;
-      li.onclick = () => { this.watched.set(v.name, v); this.renderWatch(); };
-      return li;
-    }));
-  }
-
-  renderWatch() {
-    const t = $('watch');
-    t.replaceChildren();
-    for (const [name, v] of this.watched) {
-      const tr = t.insertRow();
-      tr.dataset.var = name;
-      tr.insertCell().textContent = name;
-      const val = tr.insertCell();
-      val.className = 'val';
-      val.textContent = '…';
-      const act = tr.insertCell();
-      if (this.isOperator) {
-        const input = document.createElement('input');
-        input.size = 8;
-        const param = v.kind === 'parameter';
-        const set = document.createElement('button');
-        set.textContent = param ? 'Write' : 'Force';
-        set.onclick = async () => {
-          const value = Number.isNaN(Number(input.value)) ? input.value : Number(input.value);
-          if (!(await this.confirm(`${param ? 'Write' : 'Force'} ${name} = ${value}?`))) return;
-          const r = await this.conn.cmd(param ? 'var.write' : 'var.force', { name, value });
-          if (!r.ok) alert(`${r.code}: ${r.message}`);
-        };
-        act.append(input, set);
-        if (!param) {
-          const un = document.createElement('button');
-          un.textContent = 'Unforce';
-          un.onclick = () => this.conn.cmd('var.unforce', { name });
-          act.append(un);
-        }
-      }
-      const rm = document.createElement('button');
-      rm.textContent = '×';
-      rm.onclick = () => { this.watched.delete(name); this.renderWatch(); };
-      act.append(rm);
-    }
-  }
-
-  async poll() {
-    if (this.watched.size === 0 || $('tab-vars').hidden) return;
-    const r = await this.conn.cmd('var.read', { names: [...this.watched.keys()] });
-    if (!r.ok) return;
-    for (const [name, value] of Object.entries(r.body.values || {})) {
-      const row = document.querySelector(`#watch tr[data-var="${CSS.escape(name)}"] .val`);
-      if (row) row.textContent = typeof value === 'number' ? String(+value.toPrecision(7)) : String(value);
+  for (const c of list) {
+    const tr = t.insertRow();
+    tr.dataset.e = String(c.E);
+    for (const [key, , d] of CONDITION_COLUMNS) {
+      const v = c[key];
+      tr.insertCell().textContent = d === null ? String(v ?? '') : (typeof v === 'number' ? (d ? fmt(v, d) : String(v)) : '—');
     }
   }
 }

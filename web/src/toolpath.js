@@ -18,6 +18,8 @@ export class Toolpath {
   }
 
   draw() {
+    const css = getComputedStyle(document.documentElement);
+    const path = css.getPropertyValue('--muted').trim() || '#94a3b8';
     for (const v of this.views) {
       const c = v.el;
       const w = c.clientWidth || 240;
@@ -35,7 +37,7 @@ export class Toolpath {
       const cx = (x0 + x1) / 2; const cy = (y0 + y1) / 2;
       const X = (x) => w / 2 + (x - cx) * s;
       const Y = (y) => h / 2 - (y - cy) * s;
-      g.strokeStyle = '#94a3b8';
+      g.strokeStyle = path;
       g.lineWidth = 1;
       g.beginPath();
       this.points.forEach((p, i) => (i ? g.lineTo(X(p[v.a]), Y(p[v.b])) : g.moveTo(X(p[v.a]), Y(p[v.b]))));
@@ -46,7 +48,7 @@ export class Toolpath {
         g.arc(X(this.pos[v.a]), Y(this.pos[v.b]), 4, 0, 2 * Math.PI);
         g.fill();
       }
-      g.fillStyle = '#64748b';
+      g.fillStyle = path;
       g.font = '11px sans-serif';
       g.fillText(v.name, 4, 12);
     }

@@ -81,7 +81,9 @@ class WebJob {
   /// What a browser needs to show the job: {"part", "text", "generation", "blocks",
   /// "toolpath": [[x,y,z],…], "frames": [[first block, frame 0..5, ox, oy, oz], …] (the work
   /// frame from each block on, G92 included: the page's work coordinates during the job),
-  /// "resumed_from": line | null, "report": null | {"text", "outcome", …}}.
+  /// "resumed_from": line | null, "drills": [[block, line, depth_mm], …] (each drilling block:
+  /// the page's depth bar and ETA), "dry_run" (the job started as one), "report": null |
+  /// {"text", "outcome", …}}.
   [[nodiscard]] bridge::Json snapshot() const;
 
  private:
@@ -120,8 +122,10 @@ class WebJob {
   std::optional<std::int32_t> resumed_from_;
   bridge::Json toolpath_ = bridge::Json::array();
   bridge::Json frame_runs_ = bridge::Json::array();
+  bridge::Json drills_ = bridge::Json::array();
   // The job being followed and its report.
   bool started_{false};
+  bool dry_run_{false};
   JobReport report_;
   bool report_done_{false};
   // Alarms that come with the end (after the last status) still belong to the report.
