@@ -1,6 +1,7 @@
 // The job queue (job_queue.hpp, docs/hmi.md "A job queue").
 #include "edm/hmi/job_queue.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <thread>
@@ -15,6 +16,10 @@ namespace {
 using bridge::Json;
 using machining::HoleWear;
 using machining::MotionBlock;
+
+/// How far below its soft limit the queue parks Z for a change (a rapid that ends on the limit
+/// would trip it in its settling).
+constexpr double kBelowTopMm = 1.0;
 
 /// What identifies the electrode in the spindle: a change, or a new measurement, alters it.
 struct ElectrodeState {
@@ -152,11 +157,23 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
           }
           // The holes before it run now; the machine stops before it.
           note(why + ": the holes before it run, then the machine stops for a change");
+          // ... and ends with the electrode raised to the top of Z (machine coordinates, no
+          // length compensation): a new electrode, longer than the worn one, must fit in.
+          req.blocks.resize(short_hole->block);
+          MotionBlock up = req.blocks.back();
+          up.kind = machining::MotionKind::kRapid;
+          up.line = short_hole->line;
+          up.electrode_ref_mm = 0.0;
+          for (const MotionBlock& b : req.blocks) up.target.z = std::max(up.target.z, b.target.z);
+          up.target.z = std::max(up.target.z, machine.position.z);
+          if (const machining::AxisLimits* z = machine.tables.axis('Z')) {
+            up.target.z = std::max(up.target.z, z->max_mm - kBelowTopMm);
+          }
           MotionBlock end;
           end.kind = machining::MotionKind::kEnd;
           end.line = short_hole->line;
-          end.target = req.blocks[short_hole->block - 1].target;
-          req.blocks.resize(short_hole->block);
+          end.target = up.target;
+          req.blocks.push_back(up);
           req.blocks.push_back(end);
           if (!req.frames.empty()) req.frames.resize(req.blocks.size(), req.frames.back());
           job.before_line = short_hole->line;
@@ -172,9 +189,10 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
           return out;
         }
         if (!change_after) break;
+        // What is in the spindle now, before the operator is asked to change it.
+        const std::optional<ElectrodeState> before = electrode_state(client);
         note(item.part + ": stopped before the hole of line " + std::to_string(job.before_line) +
              ": change the electrode and measure it; the queue goes on from that line then");
-        const std::optional<ElectrodeState> before = electrode_state(client);
         if (!before || !wait_for_change(client, *before, cb, interrupt)) {
           out.message = "interrupted while waiting for an electrode change";
           return out;

@@ -35,8 +35,8 @@ TEST(ElectrodeTableFile, AnElectrodesHistoryAndWearRatioSurviveARestart) {
     t.measured(299.0);  // its first measurement is its new length
     EXPECT_DOUBLE_EQ(t.current()->new_length_mm, 299.0);
     EXPECT_FALSE(t.current()->measured_wear_ratio()) << "nothing drilled yet";
-    t.add_job(3, 36.0, 270.0);  // three 12 mm holes, the estimate says 29 mm worn
-    t.add_job(1, 12.0, 260.0);
+    t.add_job("E1", 3, 36.0, 270.0);  // three 12 mm holes, the estimate says 29 mm worn
+    t.add_job("E1", 1, 12.0, 260.0);
     EXPECT_NEAR(*t.current()->estimated_wear_ratio(), 39.0 / 48.0, 1e-12);
     EXPECT_FALSE(t.current()->measured_wear_ratio()) << "not measured since it drilled";
     t.measured(263.0);  // the setter says 3 mm less worn than estimated
@@ -73,7 +73,7 @@ TEST(ElectrodeTableFile, TheTableIsBoundedAndItsFieldsAreChecked) {
   EXPECT_EQ(t.entries().size(), ElectrodeTable::kCap);
   EXPECT_TRUE(ElectrodeTable::invalid_id("Cu-1.5_a").empty());
   for (const std::string& id : {std::string(), std::string("E 1"), std::string("E/1"),
-                               std::string(33, 'x'), std::string("É")}) {
+                                std::string(33, 'x'), std::string("É")}) {
     EXPECT_FALSE(ElectrodeTable::invalid_id(id).empty()) << id;
   }
   EXPECT_FALSE(ElectrodeTable::invalid_kind("hex").empty());

@@ -105,12 +105,14 @@ bool ElectrodeTable::change(const ElectrodeEntry& e, double previous_length_mm,
   return true;
 }
 
-void ElectrodeTable::add_job(std::int64_t holes, double drilled_mm, double length_mm) {
-  ElectrodeEntry* c = mutable_current();
-  if (c == nullptr) return;
-  if (holes > 0) c->holes += holes;
-  if (std::isfinite(drilled_mm) && drilled_mm > 0.0) c->drilled_mm += drilled_mm;
-  if (length_mm > 0.0) c->length_mm = length_mm;
+void ElectrodeTable::add_job(const std::string& id, std::int64_t holes, double drilled_mm,
+                             double length_mm) {
+  auto it = std::find_if(entries_.begin(), entries_.end(),
+                         [&](const ElectrodeEntry& x) { return x.id == id; });
+  if (it == entries_.end()) return;
+  if (holes > 0) it->holes += holes;
+  if (std::isfinite(drilled_mm) && drilled_mm > 0.0) it->drilled_mm += drilled_mm;
+  if (length_mm > 0.0 && id == current_) it->length_mm = length_mm;
 }
 
 void ElectrodeTable::measured(double length_mm) {

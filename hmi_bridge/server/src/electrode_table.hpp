@@ -52,9 +52,9 @@ class ElectrodeTable {
   /// Puts `e` in the spindle: a new id is added (false when the table is full), a known one
   /// keeps its history and takes the fields given. The previous one keeps `previous_length_mm`.
   bool change(const ElectrodeEntry& e, double previous_length_mm, const std::string& when);
-  /// A job ended: the current one drilled `holes` holes, `drilled_mm` deep in all, and is now
-  /// `length_mm` long (the runtime's estimate).
-  void add_job(std::int64_t holes, double drilled_mm, double length_mm);
+  /// A job ended: electrode `id` drilled `holes` holes, `drilled_mm` deep in all, and is now
+  /// `length_mm` long (the runtime's estimate; taken only when it is still the current one).
+  void add_job(const std::string& id, std::int64_t holes, double drilled_mm, double length_mm);
   /// The current one was measured `length_mm` long.
   void measured(double length_mm);
   /// The current one's length now (electrode.set, a measurement).

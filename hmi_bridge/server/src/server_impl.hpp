@@ -148,7 +148,10 @@ struct Server::Impl {
     JobLogEntry entry;         // filled as the job runs
     rt::JobProgress end;       // the progress when it ended
     std::string recent;        // alarms since the last tick (a job that began within it has them)
+    double drilled_mm{0.0};    // job_drilled_mm when it ended
   } job_watch;
+  /// The job's figures when its end is seen (server_jobs.cpp).
+  void take_figures();
   /// The electrode table (ops_electrode.cpp), beside the retain file.
   std::unique_ptr<ElectrodeTable> electrodes;
   /// electrode.measure's touch, until its result is in: the length is the Z at contact − datum.

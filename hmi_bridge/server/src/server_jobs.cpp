@@ -37,13 +37,36 @@ void Server::Impl::watch_jobs(const rt::JobProgress& p) {
     w.entry = JobLogEntry{};
     w.entry.start = wall_now();
     w.entry.electrode_start_mm = rt.electrode().length_mm();
+    // The electrode used is the one in the spindle at the start (a change waits for READY).
+    if (const ElectrodeEntry* used = electrodes->current()) w.entry.electrode = used->id;
     if (!taken) take_recent();  // it began within the last tick: so did its alarms
   }
   w.recent.clear();
-  if (w.active && w.settle_ticks < 0 && p.outcome != rt::JobOutcome::kRunning) {
+  // Ended: not running and not active. (Progress fields are read one by one: just after a start
+  // the count may be new and the outcome still the last job's; the job is active then.)
+  if (w.active && w.settle_ticks < 0 && p.outcome != rt::JobOutcome::kRunning &&
+      !rt.job().active()) {
     w.end = p;
     w.entry.end = wall_now();
     w.settle_ticks = 1;
+    take_figures();  // now: the next job resets them as it begins
+  }
+}
+
+void Server::Impl::take_figures() {
+  JobWatch& w = job_watch;
+  for (const auto& [name, value] : status_message().vars) {
+    if (name == "cnc.job.job_time_s") w.entry.time_s = value;
+    if (name == "cnc.job.job_depth_mm") w.entry.depth_mm = value;
+    if (name == "cnc.job.job_wear_mm") w.entry.wear_mm = value;
+  }
+  for (const std::string& v : status_var_names) {  // the job's own block, whatever its name
+    if (v.size() > 11 && v.ends_with(".job_time_s")) {
+      const std::string job = v.substr(0, v.size() - 11);
+      w.entry.holes =
+          static_cast<std::int64_t>(rt.variables().read(job + ".job_holes").value_or(0.0));
+      w.drilled_mm = rt.variables().read(job + ".job_drilled_mm").value_or(0.0);
+    }
   }
 }
 
@@ -66,22 +89,8 @@ void Server::Impl::log_job() {
   e.cause = st == rt::MachineState::kFault || st == rt::MachineState::kEstop
                 ? static_cast<int>(rt.machine().last_cause())
                 : 0;
-  for (const auto& [name, value] : status_message().vars) {
-    if (name == "cnc.job.job_time_s") e.time_s = value;
-    if (name == "cnc.job.job_depth_mm") e.depth_mm = value;
-    if (name == "cnc.job.job_wear_mm") e.wear_mm = value;
-  }
-  if (const ElectrodeEntry* used = electrodes->current()) e.electrode = used->id;
-  double drilled = 0.0;
-  for (const std::string& v : status_var_names) {  // the job's own block, whatever its name
-    if (v.size() > 11 && v.ends_with(".job_time_s")) {
-      const std::string job = v.substr(0, v.size() - 11);
-      e.holes = static_cast<std::int64_t>(rt.variables().read(job + ".job_holes").value_or(0.0));
-      drilled = rt.variables().read(job + ".job_drilled_mm").value_or(0.0);
-    }
-  }
-  if (!e.dry_run) {
-    electrodes->add_job(e.holes, drilled, e.electrode_end_mm);
+  if (!e.dry_run && !e.electrode.empty()) {
+    electrodes->add_job(e.electrode, e.holes, w.drilled_mm, e.electrode_end_mm);
     electrodes->save();
   }
   job_log->add(std::move(e));
