@@ -8,7 +8,8 @@
 // machining::planned_wear) against the electrode left (electrode.get: usable_mm, the length less
 // the supervisor's margin). When a hole would not be finished:
 //   - the holes before it run (the program up to that hole's block, then a rapid straight up to
-//     1 mm below the top of Z, its soft limit, so that a longer new electrode fits in, then an end);
+//     1 mm below the top of Z, its soft limit, so that a longer new electrode fits in, then an
+//     end);
 //   - the machine stops there and the queue asks for an electrode change (callbacks.note) and
 //     waits — for as long as it takes, or the interrupt — until the electrode in the spindle is
 //     another one or another length, and measured (electrode.change, electrode.measure);
