@@ -27,13 +27,17 @@ export function clock(s) {
 
 /**
  * Whose program the status' job is: 'none' (no job since edmplc started), 'mdi' (an MDI line),
- * 'page' (the program this server uploaded: the snapshot's generation) or 'elsewhere'.
+ * 'page' (the program this server uploaded: the snapshot's generation), 'earlier' (a program
+ * committed before the page's last upload: the machine now holds the page's), or 'elsewhere'
+ * (committed after it, by someone else: generations only grow).
  */
 export function jobOwner(status, job) {
   const j = status?.job;
   if (!j || j.outcome === 'none') return 'none';
   if (j.slot === 'mdi') return 'mdi';
-  if (job && job.blocks > 0 && j.generation === job.generation) return 'page';
+  const mine = job && job.blocks > 0 ? job.generation : null;
+  if (mine !== null && j.generation === mine) return 'page';
+  if (mine !== null && j.generation < mine) return 'earlier';
   return 'elsewhere';
 }
 

@@ -180,6 +180,7 @@ function showJob(j, initial) {
   $('job-report').textContent = j.report
     ? `${j.dry_run ? 'DRY RUN: the motion only, the generator off; nothing was drilled.\n' : ''}${j.report.text}` : '';
   jobPanel.update(ui.status, j, charts.latest);
+  updateButtons();
 }
 
 function updateButtons() {
