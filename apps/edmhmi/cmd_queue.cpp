@@ -1,6 +1,7 @@
-// edmhmi queue PART.nc[xN] … — run part programs one after the other, each N times, without an
-// operator between them; stop before a hole the electrode cannot finish and go on once it is
-// changed and measured (job_queue.hpp, docs/hmi.md "A job queue").
+// edmhmi queue PART.nc[*N[@DX,DY]] … — run part programs one after the other, each N times (each
+// run DX,DY further), without an operator between them; stop before a hole the electrode cannot
+// finish and go on once it is changed and measured (job_queue.hpp, docs/hmi.md "A job queue").
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -11,19 +12,35 @@
 namespace edmhmi {
 namespace {
 
-/// "part.nc" → 1 run, "part.nc*3" → 3 (a name that itself ends in *N is given as "part*N*1").
+/// "part.nc" → 1 run, "part.nc*3" → 3, "part.nc*3@10,0" → 3 runs, each 10 mm further in X (a
+/// name that itself ends in *N is given as "part*N*1").
 bool parse_item(const std::string& word, edm::hmi::QueueItem& item) {
   item.part = word;
   item.repeat = 1;
-  if (const auto star = word.rfind('*'); star != std::string::npos && star + 1 < word.size()) {
+  std::string spec = word;
+  if (const auto at = spec.rfind('@'); at != std::string::npos && spec.rfind('*') < at) {
+    const std::string step = spec.substr(at + 1);
     char* end = nullptr;
-    const long n = std::strtol(word.c_str() + star + 1, &end, 10);
+    item.step_x_mm = std::strtod(step.c_str(), &end);
+    const bool comma = *end == ',';
+    if (comma) item.step_y_mm = std::strtod(end + 1, &end);
+    if (!comma || *end != '\0' || step.empty() || !std::isfinite(item.step_x_mm) ||
+        !std::isfinite(item.step_y_mm)) {
+      std::fprintf(stderr, "edmhmi: queue: '%s': the step after '@' is DX,DY in mm\n",
+                   word.c_str());
+      return false;
+    }
+    spec = spec.substr(0, at);
+  }
+  if (const auto star = spec.rfind('*'); star != std::string::npos && star + 1 < spec.size()) {
+    char* end = nullptr;
+    const long n = std::strtol(spec.c_str() + star + 1, &end, 10);
     if (*end != '\0' || n < 1 || n > 10000) {
       std::fprintf(stderr, "edmhmi: queue: '%s': the count after '*' must be 1..10000\n",
                    word.c_str());
       return false;
     }
-    item.part = word.substr(0, star);
+    item.part = spec.substr(0, star);
     item.repeat = static_cast<int>(n);
   }
   return read_text_file(item.part, item.text);

@@ -165,7 +165,8 @@ int run(int argc, char** argv) {
   app.add_subcommand("queue",
                      "run part programs one after the other, PART.nc*N N times; stop before a "
                      "hole the electrode cannot finish, go on once it is changed and measured")
-      ->add_option("PARTS", queue_words, "PART.nc or PART.nc*N, in order")
+      ->add_option("PARTS", queue_words,
+                   "PART.nc, PART.nc*N or PART.nc*N@DX,DY (each run DX,DY mm further), in order")
       ->required();
 
   std::string mdi_line;

@@ -48,14 +48,20 @@ std::optional<ElectrodeState> electrode_state(bridge::Client& client) {
   return s;
 }
 
-/// The first hole of `blocks` the electrode left would not finish, or nullopt (a machine whose
-/// electrode length is unknown checks nothing: 0).
-std::optional<HoleWear> first_short_hole(const std::vector<MotionBlock>& blocks,
-                                         const machining::MachineTables& tables,
-                                         const ElectrodeState& e) {
+/// The first hole of `blocks` the electrode left would not finish, and whether it is the
+/// program's first; nullopt when every hole is covered (a machine whose electrode length is
+/// unknown checks nothing: 0).
+struct ShortHole {
+  HoleWear hole;
+  bool first{false};
+};
+std::optional<ShortHole> first_short_hole(const std::vector<MotionBlock>& blocks,
+                                          const machining::MachineTables& tables,
+                                          const ElectrodeState& e) {
   if (!(e.length_mm > 0.0)) return std::nullopt;
-  for (const HoleWear& h : machining::planned_wear(blocks, tables)) {
-    if (h.cumulative_mm > e.usable_mm) return h;
+  const std::vector<HoleWear> plan = machining::planned_wear(blocks, tables);
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    if (plan[i].cumulative_mm > e.usable_mm) return ShortHole{plan[i], i == 0};
   }
   return std::nullopt;
 }
@@ -64,6 +70,13 @@ std::optional<HoleWear> first_short_hole(const std::vector<MotionBlock>& blocks,
 /// False on the interrupt.
 bool wait_for_change(bridge::Client& client, const ElectrodeState& before, const QueueCallbacks& cb,
                      const std::atomic<bool>& interrupt) {
+  if (cb.waiting) cb.waiting(true);
+  struct Done {
+    const QueueCallbacks& cb;
+    ~Done() {
+      if (cb.waiting) cb.waiting(false);
+    }
+  } done{cb};
   while (!interrupt.load()) {
     std::this_thread::sleep_for(cb.electrode_poll);  // polling the machine, as edmhmi does
     const std::optional<ElectrodeState> now = electrode_state(client);
@@ -102,6 +115,10 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
         GcodeOptions options;
         options.start_mm = machine.position;
         options.offsets = machine.offsets;
+        for (machining::Vec3& origin : options.offsets.frame) {  // the run's place in the row
+          origin.x += (run - 1) * item.step_x_mm;
+          origin.y += (run - 1) * item.step_y_mm;
+        }
         const GcodeResult g = interpret_gcode(item.text, item.part, machine.tables, options);
         if (!g.ok()) {
           out.message = item.part + ": " + (g.messages().empty() ? "" : g.messages().front());
@@ -128,8 +145,9 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
           out.message = "electrode.get failed: the electrode left is not known";
           return out;
         }
-        const std::optional<HoleWear> short_hole =
+        const std::optional<ShortHole> shortage =
             first_short_hole(req.blocks, machine.tables, *electrode);
+        const HoleWear* short_hole = shortage ? &shortage->hole : nullptr;
         QueueJob job;
         job.part = item.part;
         job.run = run;
@@ -142,10 +160,7 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
                                   std::to_string(short_hole->line) + " (" +
                                   mm(short_hole->cumulative_mm) + " mm planned, " +
                                   mm(electrode->usable_mm) + " mm usable)";
-          const bool first_hole =
-              machining::planned_wear(req.blocks, machine.tables).front().block ==
-              short_hole->block;
-          if (first_hole) {
+          if (shortage->first) {
             note(why +
                  ": change the electrode and measure it (edmhmi electrode change …, "
                  "edmhmi electrode measure setter); the queue goes on then");
@@ -179,6 +194,7 @@ QueueResult run_queue(bridge::Client& client, const std::vector<QueueItem>& item
           job.before_line = short_hole->line;
           change_after = true;
         }
+        if (cb.job_start) cb.job_start(job);
         job.result = run_job(client, req, cb.run, interrupt);
         out.jobs.push_back(job);
         if (cb.job_done) cb.job_done(out.jobs.back());

@@ -33,6 +33,20 @@ Json run(PageBackend& b, const PageCommand& c, std::uint64_t owner) {
     }
     case PageOp::kJob: return {{"ok", true}, {"body", b.job_snapshot()}};
     case PageOp::kStats: return b.stats();
+    case PageOp::kQueue: return {{"ok", true}, {"body", b.queue_snapshot()}};
+    case PageOp::kQueueAdd: {
+      QueueItem item;
+      item.part = c.name;
+      item.text = c.text;
+      item.repeat = c.repeat;
+      item.step_x_mm = c.step_x_mm;
+      item.step_y_mm = c.step_y_mm;
+      return b.queue_add(item);
+    }
+    case PageOp::kQueueClear: return b.queue_control("clear");
+    case PageOp::kQueueStart: return b.queue_control("start");
+    case PageOp::kQueueStop: return b.queue_control("stop");
+    case PageOp::kElectrodeMeasure: return b.electrode_measure(c.target, c.set_frame);
     case PageOp::kCycleHold:
     case PageOp::kCycleResume:
     case PageOp::kCycleStop:
@@ -45,7 +59,10 @@ Json run(PageBackend& b, const PageCommand& c, std::uint64_t owner) {
     case PageOp::kVarRead:
     case PageOp::kVarWrite:
     case PageOp::kVarForce:
-    case PageOp::kVarUnforce: return b.relay(page_op_info(c.op).name, c.params);
+    case PageOp::kVarUnforce:
+    case PageOp::kElectrodeGet:
+    case PageOp::kElectrodeChange:
+    case PageOp::kJobsGet: return b.relay(page_op_info(c.op).name, c.params);
   }
   return bad_request("unknown command");
 }

@@ -22,6 +22,7 @@ WebHub::WebHub(boost::asio::io_context& ioc, bridge::Client& client, ConnectionS
       settings_(std::move(settings)),
       job_(client),
       manual_(client),
+      shift_(settings_),
       timer_(ioc) {
   bridge_text_ = Json{{"t", "bridge"},
                       {"up", false},
@@ -42,7 +43,8 @@ void WebHub::stop() {
   }
   link_cv_.notify_all();
   if (link_thread_.joinable()) link_thread_.join();
-  manual_.stop();  // a held jog is stopped
+  manual_.stop();     // a held jog is stopped
+  shift_.stop_all();  // the queue's job is stopped (the operator's stop), a measurement too
   for (Worker& w : workers_) {
     {
       std::lock_guard lock(w.mutex);
@@ -158,6 +160,7 @@ std::string WebHub::welcome(bridge::Role role) const {
                   {"status", last_status_},
                   {"manual", manual_.manual_json()},
                   {"offsets", manual_.offsets_json()},
+                  {"queue", shift_.snapshot()},
                   {"bridge", bridge_up_}};
   return w.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
@@ -329,6 +332,10 @@ void WebHub::on_timer() {
     }
     if (!changes.offsets.is_null()) {
       frame["offsets"] = std::move(changes.offsets);
+      any = true;
+    }
+    if (Json q = shift_.take_changes(); !q.is_null()) {
+      frame["queue"] = std::move(q);
       any = true;
     }
     frame["bridge"] = bridge_up_;

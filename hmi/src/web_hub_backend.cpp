@@ -48,6 +48,29 @@ Json WebHub::offsets() { return manual_.offsets_json(); }
 
 Json WebHub::job_snapshot() { return job_.snapshot(); }
 
+Json WebHub::queue_add(const QueueItem& item) {
+  Json c =
+      job_.check(item.text, item.part);  // against the machine's tables, with its errors located
+  if (!c.value("ok", false)) {
+    if (!c.contains("code")) {
+      c["code"] = "bad_program";
+      c["message"] =
+          std::to_string(c.value("errors", Json::array()).size()) + " error(s) in the program";
+    }
+    c["ok"] = false;
+    return c;
+  }
+  return shift_.add(item);
+}
+
+Json WebHub::queue_control(std::string_view action) { return shift_.control(action); }
+
+Json WebHub::queue_snapshot() { return shift_.snapshot(); }
+
+Json WebHub::electrode_measure(const std::string& reference, const std::string& frame) {
+  return shift_.measure(reference, frame);
+}
+
 Json WebHub::stats() {
   Json r = page_reply(client_.request("tasks.stats"));
   const Counters c = counters();

@@ -67,10 +67,24 @@ constexpr Field kVarReadFields[] = {{"names", Kind::kStringArray, true, kName, t
 constexpr Field kVarWriteFields[] = {{"name", Kind::kString, true, kName, true},
                                      {"value", Kind::kScalar, true, kName, true}};
 constexpr Field kVarNameFields[] = {{"name", Kind::kString, true, kName, true}};
+constexpr Field kElectrodeChangeFields[] = {{"electrode", Kind::kString, true, kName, true},
+                                            {"kind", Kind::kString, false, kWord, true},
+                                            {"size_mm", Kind::kNumber, false, 0, true},
+                                            {"material", Kind::kString, false, kName, true},
+                                            {"new_length_mm", Kind::kNumber, false, 0, true}};
+constexpr Field kElectrodeMeasureFields[] = {{"reference", Kind::kString, true, kWord, false},
+                                             {"frame", Kind::kString, false, kWord, false}};
+constexpr Field kJobsGetFields[] = {{"limit", Kind::kUint, false, 0, true},
+                                    {"csv", Kind::kBool, false, 0, true}};
+constexpr Field kQueueAddFields[] = {{"text", Kind::kString, true, kMaxWebProgramBytes, false},
+                                     {"name", Kind::kString, false, kName, false},
+                                     {"repeat", Kind::kInt32, false, 0, false},
+                                     {"step_x", Kind::kNumber, false, 0, false},
+                                     {"step_y", Kind::kNumber, false, 0, false}};
 constexpr std::span<const Field> kNone{};
 
 using L = PageLane;
-constexpr std::array<OpSpec, 28> kOps{{
+constexpr std::array<OpSpec, 37> kOps{{
     {{"check", PageOp::kCheck, true, L::kProgram}, kProgramFields},
     {{"upload", PageOp::kUpload, false, L::kProgram}, kProgramFields},
     {{"start", PageOp::kStart, false, L::kMachine}, kStartFields},
@@ -99,6 +113,15 @@ constexpr std::array<OpSpec, 28> kOps{{
     {{"var.write", PageOp::kVarWrite, false, L::kProgram}, kVarWriteFields},
     {{"var.force", PageOp::kVarForce, false, L::kProgram}, kVarWriteFields},
     {{"var.unforce", PageOp::kVarUnforce, false, L::kProgram}, kVarNameFields},
+    {{"electrode.get", PageOp::kElectrodeGet, true, L::kProgram}, kNone},
+    {{"electrode.change", PageOp::kElectrodeChange, false, L::kMachine}, kElectrodeChangeFields},
+    {{"electrode.measure", PageOp::kElectrodeMeasure, false, L::kMachine}, kElectrodeMeasureFields},
+    {{"jobs.get", PageOp::kJobsGet, true, L::kProgram}, kJobsGetFields},
+    {{"queue", PageOp::kQueue, true, L::kInline}, kNone},
+    {{"queue.add", PageOp::kQueueAdd, false, L::kProgram}, kQueueAddFields},
+    {{"queue.clear", PageOp::kQueueClear, false, L::kInline}, kNone},
+    {{"queue.start", PageOp::kQueueStart, false, L::kInline}, kNone},
+    {{"queue.stop", PageOp::kQueueStop, false, L::kInline}, kNone},
 }};
 
 constexpr bool ops_in_enum_order() {
@@ -190,8 +213,16 @@ void fill(PageCommand& c, const Json& m) {
   switch (c.op) {
     case PageOp::kCheck:
     case PageOp::kUpload:
+    case PageOp::kQueueAdd:
       str("text", c.text);
       str("name", c.name);
+      if (const auto it = m.find("repeat"); it != m.end()) c.repeat = it->get<std::int32_t>();
+      if (const auto it = m.find("step_x"); it != m.end()) c.step_x_mm = it->get<double>();
+      if (const auto it = m.find("step_y"); it != m.end()) c.step_y_mm = it->get<double>();
+      break;
+    case PageOp::kElectrodeMeasure:
+      str("reference", c.target);
+      str("frame", c.set_frame);
       break;
     case PageOp::kStart: c.dry_run = flag("dry_run"); break;
     case PageOp::kStartFrom:

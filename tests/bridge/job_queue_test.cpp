@@ -151,13 +151,23 @@ TEST(JobQueue, StopsBeforeTheHoleTheElectrodeCannotFinishAndGoesOnAfterAMeasured
   const Json e = op.request("electrode.get").body;
   EXPECT_EQ(e["current"], "E2");
   EXPECT_NEAR(e["length_mm"].get<double>(), 300.0 - 2 * 3.3, 1.0) << e;
-  // Not asserted yet: the table's holes and the log's figures of a job followed at once by an
-  // electrode change read 0 here (known, under investigation: issue 33's note).
   std::vector<std::string> used;
+  std::vector<std::int64_t> holes;
   for (const Json& j : jobs) {
-    if (j["slot"] == "main") used.push_back(j["electrode"].get<std::string>());
+    if (j["slot"] != "main") continue;
+    used.push_back(j["electrode"].get<std::string>());
+    holes.push_back(j["holes"].get<std::int64_t>());
+    // The figures of each job, also of one whose successor started within a progress tick of
+    // its end (taken at that cycle.start, before the new job resets them).
+    EXPECT_GT(j["time_s"].get<double>(), 1.0) << j;
+    EXPECT_NEAR(j["depth_mm"].get<double>(), 4.0, 0.05) << j;
+    EXPECT_GT(j["wear_mm"].get<double>(), 0.5) << j;
   }
   EXPECT_EQ(used, (std::vector<std::string>{"E1", "E2", "E2"})) << jobs;
+  EXPECT_EQ(holes, (std::vector<std::int64_t>{2, 1, 1})) << jobs;
+  for (const Json& t : e["table"]) {
+    EXPECT_EQ(t["holes"], 2) << "E1 drilled two holes, E2 two: " << t;
+  }
   runner.stop();
   server->stop();
 }

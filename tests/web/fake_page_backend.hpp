@@ -82,6 +82,22 @@ class FakePageBackend : public PageBackend {
     hit("stats");
     return {{"ok", true}, {"body", Json::object()}};
   }
+  Json queue_add(const QueueItem& item) override {
+    hit("queue_add " + item.part + " x" + std::to_string(item.repeat));
+    return {{"ok", true}};
+  }
+  Json queue_control(std::string_view action) override {
+    hit("queue " + std::string(action));
+    return {{"ok", true}};
+  }
+  Json queue_snapshot() override {
+    hit("queue");
+    return Json::object();
+  }
+  Json electrode_measure(const std::string& reference, const std::string& frame) override {
+    hit("electrode_measure " + reference + " " + frame);
+    return {{"ok", true}};
+  }
 
  private:
   void hit(std::string what) {

@@ -50,8 +50,9 @@ export function waitForOutput(child, re, what, timeoutMs = 20000) {
   });
 }
 
-/** A private directory with an operator and a viewer token and drill-sim's config using them. */
-export function makeMachine() {
+/** A private directory with an operator and a viewer token and drill-sim's config using them;
+ *  `edit` may change the config's text first (each edit must change it). */
+export function makeMachine({ edit = null } = {}) {
   const dir = mkdtempSync(join(tmpdir(), 'edm-web-'));
   const op = join(dir, 'operator.token');
   const vw = join(dir, 'viewer.token');
@@ -67,7 +68,9 @@ export function makeMachine() {
   if (withTokens === base) throw new Error('drill-sim.yaml has no bridge: section');
   const withDeadman = withTokens.replace('manual: {}', `manual: {deadman: ${DEADMAN_MS}ms}`);
   if (withDeadman === withTokens) throw new Error('drill-sim.yaml has no EdmJob manual: {}');
-  writeFileSync(config, withDeadman);
+  const edited = edit ? edit(withDeadman) : withDeadman;
+  if (edit && edited === withDeadman) throw new Error('the config edit changed nothing');
+  writeFileSync(config, edited);
   // The copy includes the machines' fragments (docs/config.md "Fragments"): link them beside it.
   symlinkSync(join(ROOT, 'config/machines/fragments'), join(dir, 'fragments'));
   return { dir, tokens, op, vw, config, procs: [] };
@@ -102,8 +105,8 @@ export async function startServe(stack, { args = [], nofile = 0, env = {} } = {}
   return { child, url, port: Number(new URL(url).port), stderr: () => err };
 }
 
-export async function startStack({ speed = String(SPEED) } = {}) {
-  const stack = makeMachine();
+export async function startStack({ speed = String(SPEED), edit = null } = {}) {
+  const stack = makeMachine({ edit });
   stack.bridgePort = await freePort();
   try {
     await startPlc(stack, { speed });

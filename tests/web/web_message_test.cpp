@@ -43,21 +43,30 @@ TEST(WebMessage, wrong_json_types_are_errors_naming_the_field) {
   EXPECT_EQ(dry.code, "bad_request");
   EXPECT_EQ(dry.id, "a");
   EXPECT_NE(dry.message.find("'dry_run' must be true or false"), std::string::npos) << dry.message;
-  for (const char* text :
-       {R"({"t":"cmd","op":"start_from","line":"5"})",
-        R"({"t":"cmd","op":"start_from","line":5.5})",
-        R"({"t":"cmd","op":"start_from","line":4294967296})",
-        R"({"t":"cmd","op":"jog.hold","axis":"X","velocity":"1"})",
-        R"({"t":"cmd","op":"jog.hold","axis":1,"velocity":1})",
-        R"({"t":"cmd","op":"touch","target":{"a":1}})", R"({"t":"cmd","op":"ack","seq":-1})",
-        R"({"t":"cmd","op":"ack","seq":"1"})", R"({"t":"cmd","op":"mdi","line":"G0 X1\nG0 X2"})",
-        R"({"t":"cmd","op":"var.read","names":["a",2]})",
-        R"({"t":"cmd","op":"var.read","names":[]})",
-        R"({"t":"cmd","op":"var.write","name":"x","value":[1]})",
-        R"({"t":"cmd","op":"var.write","name":"x","value":null})",
-        R"({"t":"cmd","op":"feed.override","percent":true})",
-        R"({"t":"cmd","op":"offset.set","frame":"G54","z":"1"})",
-        R"({"t":"cmd","op":"upload","text":7})"}) {
+  for (const char* text : {R"({"t":"cmd","op":"start_from","line":"5"})",
+                           R"({"t":"cmd","op":"start_from","line":5.5})",
+                           R"({"t":"cmd","op":"start_from","line":4294967296})",
+                           R"({"t":"cmd","op":"jog.hold","axis":"X","velocity":"1"})",
+                           R"({"t":"cmd","op":"jog.hold","axis":1,"velocity":1})",
+                           R"({"t":"cmd","op":"touch","target":{"a":1}})",
+                           R"({"t":"cmd","op":"ack","seq":-1})",
+                           R"({"t":"cmd","op":"ack","seq":"1"})",
+                           R"({"t":"cmd","op":"mdi","line":"G0 X1\nG0 X2"})",
+                           R"({"t":"cmd","op":"var.read","names":["a",2]})",
+                           R"({"t":"cmd","op":"var.read","names":[]})",
+                           R"({"t":"cmd","op":"var.write","name":"x","value":[1]})",
+                           R"({"t":"cmd","op":"var.write","name":"x","value":null})",
+                           R"({"t":"cmd","op":"feed.override","percent":true})",
+                           R"({"t":"cmd","op":"offset.set","frame":"G54","z":"1"})",
+                           R"({"t":"cmd","op":"upload","text":7})",
+                           R"({"t":"cmd","op":"queue.add","text":"M30","repeat":2.5})",
+                           R"({"t":"cmd","op":"queue.add","text":"M30","step_x":"10"})",
+                           R"({"t":"cmd","op":"queue.add","repeat":2})",
+                           R"({"t":"cmd","op":"electrode.change","kind":"tube"})",
+                           R"({"t":"cmd","op":"electrode.change","electrode":"E2","size_mm":"1"})",
+                           R"({"t":"cmd","op":"electrode.measure","reference":"setter","frame":5})",
+                           R"({"t":"cmd","op":"electrode.measure"})",
+                           R"({"t":"cmd","op":"jobs.get","limit":-1})"}) {
     const PageError e = error_of(text);
     EXPECT_EQ(e.code, "bad_request") << text;
     EXPECT_FALSE(e.message.empty()) << text;
@@ -169,25 +178,69 @@ TEST(WebMessage, the_pages_own_commands_decode) {
             (Json{{"name", "a.b"}, {"value", "2ms"}}));
   EXPECT_EQ(command_of(R"({"t":"cmd","op":"var.force","name":"a.b","value":false})").params,
             (Json{{"name", "a.b"}, {"value", false}}));
+  // The shift (shift.js): electrode.change relayed as typed, measure and queue.add typed.
+  EXPECT_EQ(command_of(R"({"t":"cmd","op":"electrode.change","electrode":"E2","kind":"tube",
+                           "size_mm":1,"material":"copper","new_length_mm":300})")
+                .params,
+            (Json{{"electrode", "E2"},
+                  {"kind", "tube"},
+                  {"size_mm", 1},
+                  {"material", "copper"},
+                  {"new_length_mm", 300}}));
+  const PageCommand measure =
+      command_of(R"({"t":"cmd","op":"electrode.measure","reference":"setter"})");
+  EXPECT_EQ(measure.target, "setter");
+  EXPECT_EQ(measure.set_frame, "");
+  const PageCommand add = command_of(
+      R"({"t":"cmd","op":"queue.add","name":"r.nc","text":"M30","repeat":3,"step_x":10,"step_y":-2.5})");
+  EXPECT_EQ(add.name, "r.nc");
+  EXPECT_EQ(add.repeat, 3);
+  EXPECT_EQ(add.step_x_mm, 10.0);
+  EXPECT_EQ(add.step_y_mm, -2.5);
+  EXPECT_EQ(command_of(R"({"t":"cmd","op":"jobs.get","limit":200,"csv":true})").params,
+            (Json{{"limit", 200}, {"csv", true}}));
   for (const char* op :
        {"cycle.hold", "cycle.resume", "cycle.stop", "estop", "reset", "jog.release", "jog.stop",
-        "offset.get", "manual.status", "job", "stats", "var.list"}) {
+        "offset.get", "manual.status", "job", "stats", "var.list", "electrode.get", "queue",
+        "queue.clear", "queue.start", "queue.stop"}) {
     const PageCommand c = command_of(std::string(R"({"t":"cmd","op":")") + op + R"("})");
     EXPECT_EQ(page_op_info(c.op).name, op);
   }
 }
 
 TEST(WebMessage, viewer_commands_are_exactly_those_that_cannot_act) {
-  for (const char* op :
-       {"check", "stats", "var.list", "var.read", "job", "offset.get", "manual.status"}) {
+  for (const char* op : {"check", "stats", "var.list", "var.read", "job", "offset.get",
+                         "manual.status", "electrode.get", "jobs.get", "queue"}) {
     ASSERT_NE(find_page_op(op), nullptr) << op;
     EXPECT_TRUE(find_page_op(op)->viewer) << op;
   }
-  for (const char* op :
-       {"upload",     "start",         "start_from", "mdi",       "estop",       "reset",
-        "home",       "jog",           "jog.hold",   "jog.stop",  "jog.release", "touch",
-        "offset.set", "feed.override", "ack",        "var.write", "var.force",   "var.unforce",
-        "cycle.hold", "cycle.resume",  "cycle.stop"}) {
+  for (const char* op : {"upload",
+                         "start",
+                         "start_from",
+                         "mdi",
+                         "estop",
+                         "reset",
+                         "home",
+                         "jog",
+                         "jog.hold",
+                         "jog.stop",
+                         "jog.release",
+                         "touch",
+                         "offset.set",
+                         "feed.override",
+                         "ack",
+                         "var.write",
+                         "var.force",
+                         "var.unforce",
+                         "cycle.hold",
+                         "cycle.resume",
+                         "cycle.stop",
+                         "electrode.change",
+                         "electrode.measure",
+                         "queue.add",
+                         "queue.clear",
+                         "queue.start",
+                         "queue.stop"}) {
     ASSERT_NE(find_page_op(op), nullptr) << op;
     EXPECT_FALSE(find_page_op(op)->viewer) << op;
   }

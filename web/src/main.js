@@ -11,6 +11,7 @@ import { OperatorPanel, activeFrame } from './manual.js';
 import { KeyJog } from './keyjog.js';
 import { JobPanel } from './job.js';
 import { setupPrefs, units } from './prefs.js';
+import { ShiftPanel } from './shift.js';
 
 const $ = (id) => document.getElementById(id);
 const STALE_MS = 1000;
@@ -76,6 +77,9 @@ const conn = new Connection({
     vars.isOperator = m.role === 'operator';
     vars.renderWatch();
     showJob(m.job, true);
+    shift.active = true;
+    shift.showQueue(m.queue);
+    shift.refreshElectrode();
     if (m.status && Object.keys(m.status).length) showStatus(m.status, false);
     refreshStats();
     if (ui.firstRender === null) {
@@ -94,6 +98,7 @@ const conn = new Connection({
       // An alarm that came with the end of the job belongs to its report: fetch it again.
       if (ui.job && ui.job.report) conn.cmd('job').then((r) => { if (r.ok) showJob(r.body, false); });
     }
+    if (f.queue) shift.showQueue(f.queue);
     if (f.bridge === false) $('conn').textContent = 'edmhmi online, edmplc unreachable';
   },
   alarms: (a) => { ui.alarms = a; renderAlarms(a, ui.role === 'operator'); },
@@ -101,6 +106,8 @@ const conn = new Connection({
 });
 const vars = new VarPanel(conn, confirmDialog);
 const ops = new OperatorPanel(conn, confirmDialog);
+const shift = new ShiftPanel(conn, confirmDialog, editor);
+ui.shift = shift;
 ops.onFrame = () => showPosition(ui.status);
 ui.keyJog = new KeyJog(ops);
 setupPrefs({
@@ -265,6 +272,8 @@ for (const b of document.querySelectorAll('.tabs button')) {
     for (const o of document.querySelectorAll('.tabs button')) o.classList.toggle('active', o === b);
     $('tab-stats').hidden = b.dataset.tab !== 'stats';
     $('tab-vars').hidden = b.dataset.tab !== 'vars';
+    $('tab-log').hidden = b.dataset.tab !== 'log';
+    if (b.dataset.tab === 'log') shift.refreshLog();
     refreshStats();
   };
 }

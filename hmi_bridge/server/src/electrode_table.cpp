@@ -130,23 +130,25 @@ void ElectrodeTable::set_length(double length_mm) {
   if (ElectrodeEntry* c = mutable_current()) c->length_mm = length_mm;
 }
 
+Json to_json(const ElectrodeEntry& e) {
+  return {{"id", e.id},
+          {"kind", e.kind},
+          {"size_mm", e.size_mm},
+          {"material", e.material},
+          {"new_length_mm", e.new_length_mm},
+          {"length_mm", e.length_mm},
+          {"holes", e.holes},
+          {"drilled_mm", e.drilled_mm},
+          {"measured_length_mm", e.measured_length_mm},
+          {"drilled_at_measure_mm", e.drilled_at_measure_mm},
+          {"changed", e.changed},
+          {"unmeasured", e.unmeasured}};
+}
+
 bool ElectrodeTable::save() const {
   if (path_.empty()) return true;
   Json list = Json::array();
-  for (const ElectrodeEntry& e : entries_) {
-    list.push_back({{"id", e.id},
-                    {"kind", e.kind},
-                    {"size_mm", e.size_mm},
-                    {"material", e.material},
-                    {"new_length_mm", e.new_length_mm},
-                    {"length_mm", e.length_mm},
-                    {"holes", e.holes},
-                    {"drilled_mm", e.drilled_mm},
-                    {"measured_length_mm", e.measured_length_mm},
-                    {"drilled_at_measure_mm", e.drilled_at_measure_mm},
-                    {"changed", e.changed},
-                    {"unmeasured", e.unmeasured}});
-  }
+  for (const ElectrodeEntry& e : entries_) list.push_back(to_json(e));
   const Json doc{{"format", kFormat}, {"current", current_}, {"electrodes", std::move(list)}};
   try {
     rt::write_file_atomic(path_, doc.dump(1) + "\n");

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "edm/bridge/codec.hpp"
+
 namespace edm::bridge {
 
 struct ElectrodeEntry {
@@ -35,6 +37,9 @@ struct ElectrodeEntry {
   /// The same from the length now (the runtime's estimate between measurements).
   [[nodiscard]] std::optional<double> estimated_wear_ratio() const noexcept;
 };
+
+/// Every stored field of `e`, as the file keeps it (electrode.get adds the derived ones).
+bridge::Json to_json(const ElectrodeEntry& e);
 
 class ElectrodeTable {
  public:

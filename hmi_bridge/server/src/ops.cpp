@@ -220,6 +220,8 @@ Body op_program_commit(Session& s, const Json& msg) {
   if (it == msg.end() || !parse_checksum(*it, want)) {
     return error(ErrorCode::kBadRequest, "'checksum' must be 8 hex digits (CRC-32, see protocol)");
   }
+  // The last job's end and figures, first: a load resets its progress (outcome, program).
+  srv.note_job_end(srv.rt.job().progress());
   Upload& u = *s.upload();
   if (u.blocks.size() != u.expected) {
     return error(ErrorCode::kBadRequest, "incomplete program: " + std::to_string(u.blocks.size()) +
@@ -346,6 +348,7 @@ Body op_program_abort(Session& s, const Json& /*msg*/) {
 
 Body op_cycle_start(Session& s, const Json& msg) {
   if (auto e = prepare_start(s, msg)) return *e;
+  s.server().note_job_end(s.server().rt.job().progress());  // the last job's figures, first
   return op_machine(s, rt::MachineCommand::kStart, "cycle.start");
 }
 Body op_cycle_hold(Session& s, const Json& /*msg*/) {

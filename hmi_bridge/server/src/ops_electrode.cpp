@@ -24,19 +24,11 @@ constexpr double kSetterToleranceMm = 0.05;
 
 Json entry_json(const ElectrodeEntry& e) {
   const auto ratio = [](std::optional<double> r) { return r ? Json(*r) : Json(nullptr); };
-  return Json{{"id", e.id},
-              {"kind", e.kind},
-              {"size_mm", e.size_mm},
-              {"material", e.material},
-              {"new_length_mm", e.new_length_mm},
-              {"length_mm", e.length_mm},
-              {"holes", e.holes},
-              {"drilled_mm", e.drilled_mm},
-              {"measured", !e.unmeasured},
-              {"measured_length_mm", e.measured_length_mm},
-              {"wear_ratio", ratio(e.measured_wear_ratio())},
-              {"wear_ratio_estimated", ratio(e.estimated_wear_ratio())},
-              {"changed", e.changed}};
+  Json j = to_json(e);
+  j["measured"] = !e.unmeasured;
+  j["wear_ratio"] = ratio(e.measured_wear_ratio());
+  j["wear_ratio_estimated"] = ratio(e.estimated_wear_ratio());
+  return j;
 }
 
 std::string wall_now() { return ops::wall_time(std::chrono::system_clock::now()); }

@@ -136,6 +136,13 @@ void Server::Impl::start() {
     status_var_names.push_back(name);
   }
   board = std::make_unique<StatusBoard>(rt.machine(), rt.job(), pins);
+  for (const rt::Variable& v : rt.variables().all()) {
+    constexpr std::string_view kFigure = ".job_time_s";
+    if (v.is_pin() && v.name.size() > kFigure.size() && v.name.ends_with(kFigure)) {
+      job_block = v.name.substr(0, v.name.size() - kFigure.size());
+      break;
+    }
+  }
   job_log = std::make_unique<JobLog>(rt.retain_path().empty() ? "" : rt.retain_path() + ".jobs.csv",
                                      kJobLogCap);
   electrodes = std::make_unique<ElectrodeTable>(

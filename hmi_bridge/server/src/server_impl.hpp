@@ -124,6 +124,10 @@ struct Server::Impl {
   rt::LogRateLimiter log_limiter;
   AuditLog audit;
   std::vector<std::string> status_var_names;
+  /// The job block's name ("cnc.job"): the one output pin `<block>.job_time_s` of the config
+  /// (the first, if several); empty when the config has none (its jobs are logged without
+  /// figures).
+  std::string job_block;
   std::unique_ptr<StatusBoard> board;
   std::vector<std::unique_ptr<TraceTap>> taps;      // one per task, same order as rt.tasks()
   std::vector<std::vector<std::string>> tap_names;  // the variables each tap samples, in order
@@ -150,7 +154,7 @@ struct Server::Impl {
     std::string recent;        // alarms since the last tick (a job that began within it has them)
     double drilled_mm{0.0};    // job_drilled_mm when it ended
   } job_watch;
-  /// The job's figures when its end is seen (server_jobs.cpp).
+  /// The job's figures when its end is seen, from job_block's outputs (server_jobs.cpp).
   void take_figures();
   /// The electrode table (ops_electrode.cpp), beside the retain file.
   std::unique_ptr<ElectrodeTable> electrodes;
@@ -166,6 +170,10 @@ struct Server::Impl {
   void watch_measure();
   /// Once per progress tick: notes a job's start and end and logs it (server_jobs.cpp).
   void watch_jobs(const rt::JobProgress& p);
+  /// The end of the job watched, if it ended since the last tick: its figures taken now. Also
+  /// just before a program.commit and a cycle.start (a queue loads and starts the next job
+  /// within a tick of the last one's end; the load resets the progress, the start the figures).
+  void note_job_end(const rt::JobProgress& p);
   void log_job();
   std::uint16_t bound_port{0};
   std::uint64_t next_session_id{1};

@@ -42,6 +42,11 @@ void Server::Impl::watch_jobs(const rt::JobProgress& p) {
     if (!taken) take_recent();  // it began within the last tick: so did its alarms
   }
   w.recent.clear();
+  note_job_end(p);
+}
+
+void Server::Impl::note_job_end(const rt::JobProgress& p) {
+  JobWatch& w = job_watch;
   // Ended: not running and not active. (Progress fields are read one by one: just after a start
   // the count may be new and the outcome still the last job's; the job is active then.)
   if (w.active && w.settle_ticks < 0 && p.outcome != rt::JobOutcome::kRunning &&
@@ -55,19 +60,16 @@ void Server::Impl::watch_jobs(const rt::JobProgress& p) {
 
 void Server::Impl::take_figures() {
   JobWatch& w = job_watch;
-  for (const auto& [name, value] : status_message().vars) {
-    if (name == "cnc.job.job_time_s") w.entry.time_s = value;
-    if (name == "cnc.job.job_depth_mm") w.entry.depth_mm = value;
-    if (name == "cnc.job.job_wear_mm") w.entry.wear_mm = value;
-  }
-  for (const std::string& v : status_var_names) {  // the job's own block, whatever its name
-    if (v.size() > 11 && v.ends_with(".job_time_s")) {
-      const std::string job = v.substr(0, v.size() - 11);
-      w.entry.holes =
-          static_cast<std::int64_t>(rt.variables().read(job + ".job_holes").value_or(0.0));
-      w.drilled_mm = rt.variables().read(job + ".job_drilled_mm").value_or(0.0);
-    }
-  }
+  if (job_block.empty()) return;
+  // From the process image now (the status snapshot may be a period old).
+  const auto read = [&](const char* figure) {
+    return rt.variables().read(job_block + figure).value_or(0.0);
+  };
+  w.entry.time_s = read(".job_time_s");
+  w.entry.depth_mm = read(".job_depth_mm");
+  w.entry.wear_mm = read(".job_wear_mm");
+  w.entry.holes = static_cast<std::int64_t>(read(".job_holes"));
+  w.drilled_mm = read(".job_drilled_mm");
 }
 
 void Server::Impl::log_job() {

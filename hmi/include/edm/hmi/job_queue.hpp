@@ -34,6 +34,10 @@ struct QueueItem {
   std::string part;  // its name in messages and reports
   std::string text;  // the G-code
   int repeat{1};     // runs of it, >= 1
+  /// Run k (from 1) is interpreted with every work frame moved by (k − 1) × this in X and Y: a
+  /// row of holes or of parts, each run on fresh material (mm; 0: every run at the same place).
+  double step_x_mm{0.0};
+  double step_y_mm{0.0};
 };
 
 /// One job the queue ran (a program split by an electrode change is two jobs).
@@ -46,10 +50,12 @@ struct QueueJob {
 };
 
 struct QueueCallbacks {
-  RunCallbacks run;                               // passed to each job
-  std::function<void(const QueueJob&)> job_done;  // after each job
-  std::function<void(const std::string&)> note;   // an electrode change is needed, …
-  std::chrono::milliseconds electrode_poll{500};  // electrode.get while waiting for a change
+  RunCallbacks run;                                // passed to each job
+  std::function<void(const QueueJob&)> job_start;  // before each job (result not yet set)
+  std::function<void(const QueueJob&)> job_done;   // after each job
+  std::function<void(const std::string&)> note;    // an electrode change is needed, …
+  std::function<void(bool)> waiting;               // true: waiting for a change; false: it came
+  std::chrono::milliseconds electrode_poll{500};   // electrode.get while waiting for a change
 };
 
 struct QueueResult {

@@ -19,6 +19,7 @@
 #include <string_view>
 
 #include "edm/bridge/protocol.hpp"
+#include "edm/hmi/job_queue.hpp"
 #include "edm/hmi/web_message.hpp"
 
 namespace edm::hmi {
@@ -52,6 +53,14 @@ class PageBackend {
   virtual bridge::Json job_snapshot() = 0;
   /// tasks.stats and the web server's own counters.
   virtual bridge::Json stats() = 0;
+  /// The queue (web_shift.hpp): a program checked, then added; "clear", "start", "stop"; the
+  /// electrode measurement. Never block (the procedures run on threads of their own), except
+  /// queue_add's check.
+  virtual bridge::Json queue_add(const QueueItem& item) = 0;
+  virtual bridge::Json queue_control(std::string_view action) = 0;
+  virtual bridge::Json queue_snapshot() = 0;
+  virtual bridge::Json electrode_measure(const std::string& reference,
+                                         const std::string& frame) = 0;
 };
 
 /// Runs one command and returns its reply: {"t":"reply","id","op","ok",…}. Never throws.

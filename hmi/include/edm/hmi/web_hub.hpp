@@ -44,6 +44,7 @@
 #include "edm/hmi/web_job.hpp"
 #include "edm/hmi/web_login.hpp"
 #include "edm/hmi/web_manual.hpp"
+#include "edm/hmi/web_shift.hpp"
 
 namespace edm::hmi {
 
@@ -151,6 +152,10 @@ class WebHub : public PageBackend {
   bridge::Json offsets() override;
   bridge::Json job_snapshot() override;
   bridge::Json stats() override;
+  bridge::Json queue_add(const QueueItem& item) override;
+  bridge::Json queue_control(std::string_view action) override;
+  bridge::Json queue_snapshot() override;
+  bridge::Json electrode_measure(const std::string& reference, const std::string& frame) override;
 
   /// Expires when the hub is destroyed: a session outliving it (destroyed with the io_context's
   /// pending handlers after the hub, at shutdown) must not call back into it.
@@ -185,6 +190,7 @@ class WebHub : public PageBackend {
   ConnectionSettings settings_;
   WebJob job_;
   WebManual manual_;
+  WebShift shift_;  // the queue and the electrode measurement, on sessions of their own
   boost::asio::steady_timer timer_;
   std::vector<std::weak_ptr<WebSink>> sinks_;    // logged in; I/O thread only
   std::vector<std::weak_ptr<WebSink>> watched_;  // every socket; I/O thread only

@@ -61,6 +61,15 @@ enum class PageOp : std::uint8_t {
   kVarWrite,
   kVarForce,
   kVarUnforce,
+  kElectrodeGet,
+  kElectrodeChange,
+  kElectrodeMeasure,
+  kJobsGet,
+  kQueue,
+  kQueueAdd,
+  kQueueClear,
+  kQueueStart,
+  kQueueStop,
 };
 
 /// Where a command runs: at once on the I/O thread (it never blocks), or on one of the hub's
@@ -78,21 +87,24 @@ struct PageOpInfo {
 [[nodiscard]] const PageOpInfo& page_op_info(PageOp op) noexcept;
 
 /// A decoded command. Only the fields of its op are set; `params` holds what is relayed to
-/// edmplc as it is (home, jog, offset.set, feed.override, var.*), already type-checked — edmplc
+/// edmplc as it is (home, jog, offset.set, feed.override, var.*, electrode.change, jobs.get),
+/// already type-checked — edmplc
 /// checks values, ranges and the machine's state.
 struct PageCommand {
   bridge::Json id;  // null, an integer or a string of ≤ kMaxPageIdBytes: echoed in the reply
   PageOp op{PageOp::kJob};
-  std::string text;                     // check, upload: the G-code
-  std::string name{"program.nc"};       // check, upload: the part's name
-  bool dry_run{false};                  // start, start_from
-  std::int32_t from_line{0};            // start_from: the G-code line
-  std::optional<double> depth_done_mm;  // start_from
-  std::string mdi_line;                 // mdi
-  std::string axis;                     // jog.hold
-  double velocity_mm_s{0.0};            // jog.hold
-  std::string target, set_frame;        // touch
-  std::uint64_t seq{0};                 // ack: alarms up to this one
+  std::string text;                       // check, upload, queue.add: the G-code
+  std::string name{"program.nc"};         // check, upload, queue.add: the part's name
+  std::int32_t repeat{1};                 // queue.add
+  double step_x_mm{0.0}, step_y_mm{0.0};  // queue.add
+  bool dry_run{false};                    // start, start_from
+  std::int32_t from_line{0};              // start_from: the G-code line
+  std::optional<double> depth_done_mm;    // start_from
+  std::string mdi_line;                   // mdi
+  std::string axis;                       // jog.hold
+  double velocity_mm_s{0.0};              // jog.hold
+  std::string target, set_frame;          // touch; electrode.measure: reference, frame
+  std::uint64_t seq{0};                   // ack: alarms up to this one
   bridge::Json params = bridge::Json::object();
 };
 
