@@ -60,6 +60,7 @@ Interpreter::Interpreter(std::string_view text, std::string_view file, const Mac
     : text_(text), tables_(tables), opt_(options) {
   result_.file = std::string(file);
   result_.start_mm = opt_.start_mm;
+  result_.electrode_mm = opt_.offsets.electrode_mm;
   pos_ = opt_.start_mm;
   const double f = opt_.default_feed_mm_min;
   feed_mm_min_ = f > 0.0 && std::isfinite(f) ? f : 0.0;

@@ -120,12 +120,19 @@ ResumePlan plan_resume(const GcodeResult& program, const machining::MachineTable
   }
 
   const std::vector<Vec3> starts = block_starts(program);
-  const Vec3 now = program.start_mm;
-  const Vec3 target = starts[first];
+  // The prologue is in the frame of the resumed block, with its electrode length reference, so
+  // the job compensates it as it compensates that block (a new electrode of another length: the
+  // approach ends where the block begins). Where the electrode is now, in those coordinates:
+  // the spindle's Z less the compensation the job will add.
+  const double ref = blocks[first].electrode_ref_mm;
+  const double comp = program.electrode_mm > 0.0 && ref > 0.0 ? program.electrode_mm - ref : 0.0;
+  const Vec3 now{program.start_mm.x, program.start_mm.y, program.start_mm.z - comp};
+  const Vec3 target = first == 0 ? now : starts[first];
   // The highest point of the program so far is clear of the work (it got there by rapids and
-  // feeds the operator wrote); so is where the electrode is now, above it.
+  // feeds the operator wrote); so is where the electrode is now, above it. (starts[0] is the
+  // spindle's start, uncompensated: `now` stands for it.)
   double clearance = std::max(now.z, target.z);
-  for (std::size_t i = 0; i < first; ++i) clearance = std::max(clearance, starts[i].z);
+  for (std::size_t i = 1; i < first; ++i) clearance = std::max(clearance, starts[i].z);
 
   ResumePlan p;
   p.first = first;
@@ -134,9 +141,10 @@ ResumePlan plan_resume(const GcodeResult& program, const machining::MachineTable
   const BlockFrame frame =
       program.frames.size() == blocks.size() ? program.frames[first] : BlockFrame{};
   const Modal modal = modal_before(blocks, first);
-  auto add = [&p, &frame](MotionKind kind, const Vec3& point) -> MotionBlock& {
+  auto add = [&p, &frame, ref](MotionKind kind, const Vec3& point) -> MotionBlock& {
     MotionBlock b{};
     b.kind = kind;
+    b.electrode_ref_mm = ref;
     b.line = 0;  // not a line of the program: a record of an interruption here names line 0
     b.col = 0;
     b.target = point;

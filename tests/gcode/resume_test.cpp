@@ -165,6 +165,36 @@ TEST(Resume, WorkFramesCarryOver) {
   EXPECT_NEAR(p.blocks[*p.drill].z_travel_mm, 6.5 + 0.6 * 1.25 * 4.0, 1e-9);
 }
 
+// A queue that goes on after an electrode change (issue 33): the frame's Z was set with a 300 mm
+// electrode, the one in the spindle now is longer or shorter. The prologue is in the resumed
+// block's compensation, so the approach ends where that block begins wherever the job puts it:
+// the program passes the runtime's check with the new length (a drill from an uncompensated
+// approach did not: "a drilling block must move Z down"), and the first rapid, compensated, goes
+// from where the spindle is straight up or stays (never down, never to the limit needlessly).
+TEST(Resume, AfterAnElectrodeChangeTheApproachIsCompensatedLikeTheResumedBlock) {
+  for (const double now_mm : {308.0, 292.0}) {
+    GcodeOptions o;
+    o.offsets.frame[0] = {0.0, 0.0, -0.2};
+    o.offsets.z_electrode_mm[0] = 300.0;
+    o.offsets.electrode_mm = now_mm;
+    o.start_mm = {-45.0, -45.0, 19.0};  // parked high over the tool setter
+    const GcodeResult g = interpret(kDrillThenFinish, o);
+    ASSERT_TRUE(g.ok()) << joined(g);
+    const ResumePlan p = plan_resume(g, test_tables(), 8);
+    ASSERT_TRUE(p.ok()) << p.error;
+    const double comp = now_mm - 300.0;
+    for (std::size_t i = 0; i < p.prologue; ++i) {
+      EXPECT_EQ(p.blocks[i].electrode_ref_mm, 300.0) << now_mm << " block " << i;
+    }
+    EXPECT_DOUBLE_EQ(p.blocks[0].target.z + comp, 19.0) << now_mm << ": straight up or stay";
+    EXPECT_EQ(p.blocks[2].target, g.blocks[p.first - 1].target) << "ends where line 8 begins";
+    machining::ProgramCheckOptions check;
+    check.electrode_mm = now_mm;
+    const auto issues = machining::check_program(p.blocks, test_tables(), o.start_mm, check);
+    EXPECT_TRUE(issues.empty()) << now_mm << ": " << (issues.empty() ? "" : issues[0].message);
+  }
+}
+
 TEST(Resume, RefusesWhatCannotBeResumed) {
   const GcodeResult g = program();
   EXPECT_EQ(plan_resume(g, test_tables(), 11).error,
