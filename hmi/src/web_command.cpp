@@ -47,6 +47,7 @@ Json run(PageBackend& b, const PageCommand& c, std::uint64_t owner) {
     case PageOp::kQueueStart: return b.queue_control("start");
     case PageOp::kQueueStop: return b.queue_control("stop");
     case PageOp::kElectrodeMeasure: return b.electrode_measure(c.target, c.set_frame);
+    case PageOp::kConditionSet: return b.condition_set(c.params);
     case PageOp::kCycleHold:
     case PageOp::kCycleResume:
     case PageOp::kCycleStop:

@@ -71,6 +71,15 @@ Json WebHub::electrode_measure(const std::string& reference, const std::string& 
   return shift_.measure(reference, frame);
 }
 
+Json WebHub::condition_set(const Json& params) {
+  Json r = relay("condition.set", params);
+  if (r.value("ok", false)) {
+    std::string error;
+    if (!job_.refresh_machine(error)) r["warning"] = "machine.info after the edit: " + error;
+  }
+  return r;
+}
+
 Json WebHub::stats() {
   Json r = page_reply(client_.request("tasks.stats"));
   const Counters c = counters();

@@ -206,7 +206,11 @@ Json WebJob::offsets_json() const {
 Json WebJob::machine_info() const {
   std::lock_guard lock(mutex_);
   if (!have_tables_) return nullptr;
-  return bridge::to_json(tables_, machine_name_);
+  Json info = bridge::to_json(tables_, machine_name_);
+  // The condition fields operators may edit (condition.set), as edmplc says; none from an older
+  // one.
+  info["condition_edit"] = machine_raw_.value("condition_edit", Json::array());
+  return info;
 }
 
 std::optional<Vec3> WebJob::position_locked() const {

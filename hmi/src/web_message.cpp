@@ -76,6 +76,9 @@ constexpr Field kElectrodeMeasureFields[] = {{"reference", Kind::kString, true, 
                                              {"frame", Kind::kString, false, kWord, false}};
 constexpr Field kJobsGetFields[] = {{"limit", Kind::kUint, false, 0, true},
                                     {"csv", Kind::kBool, false, 0, true}};
+constexpr Field kConditionSetFields[] = {{"E", Kind::kInt32, true, 0, true},
+                                         {"field", Kind::kString, true, kWord, true},
+                                         {"value", Kind::kNumber, true, 0, true}};
 constexpr Field kQueueAddFields[] = {{"text", Kind::kString, true, kMaxWebProgramBytes, false},
                                      {"name", Kind::kString, false, kName, false},
                                      {"repeat", Kind::kInt32, false, 0, false},
@@ -84,7 +87,7 @@ constexpr Field kQueueAddFields[] = {{"text", Kind::kString, true, kMaxWebProgra
 constexpr std::span<const Field> kNone{};
 
 using L = PageLane;
-constexpr std::array<OpSpec, 37> kOps{{
+constexpr std::array<OpSpec, 38> kOps{{
     {{"check", PageOp::kCheck, true, L::kProgram}, kProgramFields},
     {{"upload", PageOp::kUpload, false, L::kProgram}, kProgramFields},
     {{"start", PageOp::kStart, false, L::kMachine}, kStartFields},
@@ -122,6 +125,7 @@ constexpr std::array<OpSpec, 37> kOps{{
     {{"queue.clear", PageOp::kQueueClear, false, L::kInline}, kNone},
     {{"queue.start", PageOp::kQueueStart, false, L::kInline}, kNone},
     {{"queue.stop", PageOp::kQueueStop, false, L::kInline}, kNone},
+    {{"condition.set", PageOp::kConditionSet, false, L::kProgram}, kConditionSetFields},
 }};
 
 constexpr bool ops_in_enum_order() {

@@ -1,5 +1,7 @@
 #include "edm/machining/machine_tables.hpp"
 
+#include <cmath>
+
 namespace edm::machining {
 
 const Condition* MachineTables::condition(int e) const noexcept {
@@ -12,6 +14,35 @@ const AxisLimits* MachineTables::axis(char name) const noexcept {
   for (const AxisLimits& a : axes)
     if (a.name == name) return &a;
   return nullptr;
+}
+
+double* condition_field(Condition& c, std::string_view field) noexcept {
+  if (field == "open_voltage_v") return &c.open_voltage_v;
+  if (field == "peak_current_a") return &c.peak_current_a;
+  if (field == "on_time_us") return &c.on_time_us;
+  if (field == "off_time_us") return &c.off_time_us;
+  if (field == "tdr_us") return &c.tdr_us;
+  if (field == "servo_ref_v") return &c.servo_ref_v;
+  if (field == "wear_ratio") return &c.wear_ratio;
+  if (field == "area_ratio") return &c.area_ratio;
+  return nullptr;
+}
+
+std::optional<std::string> condition_value_error(std::string_view field, double value) {
+  Condition probe;
+  if (condition_field(probe, field) == nullptr) {
+    return "'" + std::string(field) + "' is no numeric field of a condition";
+  }
+  const std::string got = " (got " + std::to_string(value) + ")";
+  if (!std::isfinite(value)) return std::string(field) + " must be a finite number";
+  if (field == "wear_ratio") {
+    if (value < 0.0 || value > 10.0) return "wear_ratio must be in 0..10" + got;
+  } else if (field == "area_ratio") {
+    if (!(value > 0.0 && value <= 100.0)) return "area_ratio must be in (0, 100]" + got;
+  } else if (!(value > 0.0)) {
+    return std::string(field) + " must be > 0" + got;
+  }
+  return std::nullopt;
 }
 
 MachineTables make_tables(const std::vector<LocatedAxis>& axes,

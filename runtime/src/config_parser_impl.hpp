@@ -85,6 +85,7 @@ class Parser {
   void parse_pin_map(const Value& v, std::vector<PinMapSpec>& out);
   void parse_realtime(const Value& v, RealtimeSpec& out);
   void parse_electrode(const Value& v, ElectrodeSpec& out);
+  void parse_condition_edit(const Value& v, std::vector<std::string>& out);
   void parse_safety(const Value& v, MachineSpec& machine);  // config_safety.cpp
   void parse_safety_axis(const Value& v, const MachineSpec& machine, SafetyAxisSpec& out);
   void parse_short_stop(const Value& v, SafetySpec& out);

@@ -21,7 +21,7 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "io", "electrode", "axes", "safety", "realtime"});
+  auto m = r_.map(v, {"name", "io", "electrode", "condition_edit", "axes", "safety", "realtime"});
   if (!m) {
     return;
   }
@@ -44,6 +44,28 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
   }
   if (const Field* f = m->find("electrode")) {
     parse_electrode(f->value, out.electrode);
+  }
+  if (const Field* f = m->find("condition_edit")) {
+    parse_condition_edit(f->value, out.condition_edit);
+  }
+}
+
+void Parser::parse_condition_edit(const Value& v, std::vector<std::string>& out) {
+  auto items = r_.list(v);
+  if (!items) return;
+  for (const Value& item : *items) {
+    const auto name = r_.string(item);
+    if (!name) continue;
+    machining::Condition probe;
+    if (machining::condition_field(probe, *name) == nullptr) {
+      r_.error(item, yaml_util::quote(*name) +
+                         " is no editable condition field (open_voltage_v, peak_current_a, "
+                         "on_time_us, off_time_us, tdr_us, servo_ref_v, wear_ratio, area_ratio)");
+    } else if (std::find(out.begin(), out.end(), *name) != out.end()) {
+      r_.error(item, yaml_util::quote(*name) + " is listed twice");
+    } else {
+      out.push_back(*name);
+    }
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -15,6 +16,24 @@
 #include "edm/runtime/scheduler.hpp"
 
 namespace edm::rt {
+
+std::optional<std::string> Runtime::set_condition_field(int e, std::string_view field,
+                                                        double value) {
+  const std::vector<std::string>& allowed = config_.machine.condition_edit;
+  if (std::find(allowed.begin(), allowed.end(), field) == allowed.end()) {
+    return "'" + std::string(field) + "' of a condition may not be changed on this machine" +
+           (allowed.empty() ? std::string(" (machine.condition_edit lists none)")
+                            : " (machine.condition_edit)");
+  }
+  machining::Condition* c = nullptr;
+  for (machining::Condition& x : tables_.conditions) {
+    if (x.e == e) c = &x;
+  }
+  if (c == nullptr) return "this machine has no condition E" + std::to_string(e);
+  if (auto why = machining::condition_value_error(field, value)) return why;
+  *machining::condition_field(*c, field) = value;
+  return std::nullopt;
+}
 
 Runtime::~Runtime() {
   // A runtime that never ran (a failed start) has nothing new to keep: it must not write.

@@ -149,6 +149,7 @@ class OpStates : public ::testing::Test {
               {"new_length_mm", 300.0}};
     }
     if (op == "electrode.measure") return {{"reference", "setter"}};
+    if (op == "condition.set") return {{"E", 1}, {"field", "tdr_us"}, {"value", 8.0}};
     return Json::object();
   }
 

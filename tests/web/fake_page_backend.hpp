@@ -94,6 +94,10 @@ class FakePageBackend : public PageBackend {
     hit("queue");
     return Json::object();
   }
+  Json condition_set(const Json& params) override {
+    hit("condition_set " + params.dump());
+    return {{"ok", true}};
+  }
   Json electrode_measure(const std::string& reference, const std::string& frame) override {
     hit("electrode_measure " + reference + " " + frame);
     return {{"ok", true}};

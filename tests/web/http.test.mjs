@@ -293,7 +293,16 @@ test('startup: serve before edmplc waits and says so, logs in when it comes, and
     r.ws.send({ t: 'login', token: m.tokens.operator });
     const waiting = await r.ws.next((x) => x.t === 'bridge' && x.up === false);
     assert.match(waiting.message, new RegExp(`waiting for edmplc at 127\\.0\\.0\\.1:${m.bridgePort}`));
-    assert.match(s.stderr(), /waiting for edmplc at/);
+    // Its log line may reach this process after the socket's message: wait for it on its pipe.
+    await new Promise((res, rej) => {
+      const timer = setTimeout(() => rej(new Error(`no 'waiting for edmplc at' in: ${s.stderr()}`)), 10000);
+      const check = () => {
+        if (!/waiting for edmplc at/.test(s.stderr())) return;
+        clearTimeout(timer); s.child.stderr.off('data', check); res();
+      };
+      s.child.stderr.on('data', check);
+      check();
+    });
     assert.ok(alive(s.child), 'serve exited');
     await startPlc(m);
     const w = await r.ws.next((x) => x.t === 'welcome', 30000);

@@ -35,11 +35,19 @@ after(async () => {
   if (stack) stopStack(stack);
 });
 
-test('the conditions (E) table from machine.info, read-only', async () => {
+test('the conditions (E) table from machine.info: the fields drill-sim lets operators edit', async () => {
   await page.locator('#conditions tr[data-e="1"]').waitFor({ timeout: T });
   assert.match(await page.locator('#conditions tr[data-e="1"]').textContent(), /drill-rough/);
-  assert.match(await page.locator('#conditions-note').textContent(), /read-only/);
-  assert.equal(await page.locator('#conditions input, #conditions button').count(), 0);
+  assert.match(await page.locator('#conditions-note').textContent(), /editable: on_time_us/);
+  // machine.condition_edit: on, off, Tdr and servo reference; nothing else has an input.
+  assert.equal(await page.locator('#conditions tr[data-e="1"] input').count(), 4);
+  const tdr = page.locator('#conditions tr[data-e="1"] input[data-field="tdr_us"]');
+  await tdr.fill('-3');
+  await tdr.dispatchEvent('change');
+  await page.locator('#conditions-note').filter({ hasText: 'must be > 0' }).waitFor({ timeout: T });
+  await tdr.fill('9.5');
+  await tdr.dispatchEvent('change');
+  await page.locator('#conditions-note').filter({ hasText: 'E1 tdr_us set to 9.5' }).waitFor({ timeout: T });
 });
 
 test('the feed override as the machine has it, beside the control', async () => {

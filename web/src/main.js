@@ -66,7 +66,8 @@ const conn = new Connection({
     editor.readOnly = m.role !== 'operator';
     charts.setup(m.series || []);
     if (m.history) charts.push(m.history, true);
-    renderConditions(m.machine?.conditions);
+    renderConditions(m.machine?.conditions,
+      { edit: m.machine?.condition_edit, operator: m.role === 'operator', conn });
     ui.caps = m.caps || {};
     ops.render(ui.caps, m.role === 'operator');
     ui.offsets = m.offsets; ui.manual = m.manual;

@@ -47,21 +47,24 @@ export function renderStats(reply) {
     + `${w.slow_disconnects ?? '?'} slow disconnects`;
 }
 
-/** machine.info's conditions (the E table the programs select), read-only: edmplc has no op that
- *  changes one — they are the machine config's `conditions:` (docs/config.md). */
+/** machine.info's conditions (the E table the programs select). Read-only unless the machine
+ *  config lets operators edit some fields (machine.condition_edit, docs/config.md): an operator
+ *  then edits those cells, each change sent as condition.set and checked by edmplc against the
+ *  config's ranges; the table shown is the one edmplc gives back. */
 const CONDITION_COLUMNS = [
   ['E', 'E', 0], ['name', 'name', null], ['polarity', 'polarity', null],
   ['open_voltage_v', 'U₀ V', 1], ['peak_current_a', 'Î A', 1], ['on_time_us', 'on µs', 1],
   ['off_time_us', 'off µs', 1], ['tdr_us', 'Tdr µs', 1], ['servo_ref_v', 'servo V', 1],
   ['wear_ratio', 'wear', 4], ['area_ratio', 'A ratio', 4],
 ];
-export function renderConditions(conditions) {
+export function renderConditions(conditions, { edit = [], operator = false, conn = null } = {}) {
   const t = $('conditions');
   t.replaceChildren();
   const list = Array.isArray(conditions) ? conditions : [];
-  $('conditions-note').textContent = list.length
-    ? 'read-only: set in the machine config (edmplc has no op to edit them)'
-    : 'this edmplc sends none';
+  const editable = operator && conn ? new Set(Array.isArray(edit) ? edit : []) : new Set();
+  $('conditions-note').textContent = !list.length ? 'this edmplc sends none'
+    : (editable.size ? `editable: ${[...editable].join(', ')} (machine.condition_edit)`
+      : 'read-only: set in the machine config');
   if (!list.length) return;
   const head = t.insertRow();
   for (const [, label] of CONDITION_COLUMNS) {
@@ -74,7 +77,30 @@ export function renderConditions(conditions) {
     tr.dataset.e = String(c.E);
     for (const [key, , d] of CONDITION_COLUMNS) {
       const v = c[key];
-      tr.insertCell().textContent = d === null ? String(v ?? '') : (typeof v === 'number' ? (d ? fmt(v, d) : String(v)) : '—');
+      const cell = tr.insertCell();
+      if (editable.has(key) && typeof v === 'number') {
+        const input = document.createElement('input');
+        input.type = 'number';
+        input.step = 'any';
+        input.value = String(v);
+        input.className = 'cond-edit';
+        input.dataset.field = key;
+        input.setAttribute('aria-label', `E${c.E} ${key}`);
+        input.onchange = async () => {
+          const r = await conn.cmd('condition.set', { E: c.E, field: key, value: Number(input.value) });
+          if (r.ok) {
+            const said = `E${c.E} ${key} set to ${input.value}${r.body.retained ? '' : ' (not retained)'}`;
+            renderConditions(r.body.conditions, { edit, operator, conn });
+            $('conditions-note').textContent = said;
+          } else {
+            $('conditions-note').textContent = `${r.code}: ${r.message}`;
+            input.value = String(v);
+          }
+        };
+        cell.append(input);
+      } else {
+        cell.textContent = d === null ? String(v ?? '') : (typeof v === 'number' ? (d ? fmt(v, d) : String(v)) : '—');
+      }
     }
   }
 }

@@ -74,6 +74,7 @@ constexpr OpSpec kOps[] = {
     {"electrode.measure", kOper, states(mask_of(S::kIdle)), ops::op_electrode_measure},
     {"alarms.get", kView, states(kAll), ops::op_alarms_get},
     {"jobs.get", kView, states(kAll), ops::op_jobs_get},
+    {"condition.set", kOper, states(mask_of(S::kIdle)), ops::op_condition_set},
 };
 
 // A row without a handler, or a name twice, does not compile.

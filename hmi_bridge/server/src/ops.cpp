@@ -374,6 +374,7 @@ Body op_machine_info(Session& s, const Json& /*msg*/) {
   for (const OpSpec& o : op_table()) ops_list.push_back(std::string(o.name));
   info["ops"] = std::move(ops_list);
   info["manual"] = manual_info_json(rt.manual().info());
+  info["condition_edit"] = rt.config().machine.condition_edit;
   return info;
 }
 

@@ -68,6 +68,8 @@ Body op_electrode_measure(Session& s, const Json& msg);
 
 // server_jobs.cpp: the job log.
 Body op_jobs_get(Session& s, const Json& msg);
+/// ops_conditions.cpp: an operator's edit of one field of a machining condition.
+Body op_condition_set(Session& s, const Json& msg);
 
 // ops_alarms.cpp: the active alarms and the history, each with its cause and remedy.
 Body op_alarms_get(Session& s, const Json& msg);

@@ -147,6 +147,9 @@ void Server::Impl::start() {
                                      kJobLogCap);
   electrodes = std::make_unique<ElectrodeTable>(
       rt.retain_path().empty() ? "" : rt.retain_path() + ".electrodes.json");
+  condition_edits = std::make_unique<ConditionEdits>(
+      rt.retain_path().empty() ? "" : rt.retain_path() + ".conditions.json");
+  condition_edits->load_and_apply(rt);
   job_watch.started = rt.job().progress().jobs_started;
   rt::Task* io_task = nullptr;
   for (const auto& t : rt.tasks()) {

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "audit.hpp"
+#include "condition_edits.hpp"
 #include "edm/bridge/codec.hpp"
 #include "edm/bridge/hello_throttle.hpp"
 #include "edm/bridge/server.hpp"
@@ -158,6 +159,8 @@ struct Server::Impl {
   void take_figures();
   /// The electrode table (ops_electrode.cpp), beside the retain file.
   std::unique_ptr<ElectrodeTable> electrodes;
+  /// The operators' condition edits (condition.set), beside the retain file.
+  std::unique_ptr<ConditionEdits> condition_edits;
   /// electrode.measure's touch, until its result is in: the length is the Z at contact − datum.
   struct PendingMeasure {
     std::uint64_t seq{0};

@@ -61,6 +61,9 @@ class PageBackend {
   virtual bridge::Json queue_snapshot() = 0;
   virtual bridge::Json electrode_measure(const std::string& reference,
                                          const std::string& frame) = 0;
+  /// condition.set relayed; once done, the machine's tables are fetched again (every later
+  /// check and upload uses the edit).
+  virtual bridge::Json condition_set(const bridge::Json& params) = 0;
 };
 
 /// Runs one command and returns its reply: {"t":"reply","id","op","ok",…}. Never throws.

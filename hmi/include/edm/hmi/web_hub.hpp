@@ -156,6 +156,7 @@ class WebHub : public PageBackend {
   bridge::Json queue_control(std::string_view action) override;
   bridge::Json queue_snapshot() override;
   bridge::Json electrode_measure(const std::string& reference, const std::string& frame) override;
+  bridge::Json condition_set(const bridge::Json& params) override;
 
   /// Expires when the hub is destroyed: a session outliving it (destroyed with the io_context's
   /// pending handlers after the hub, at shutdown) must not call back into it.

@@ -39,7 +39,8 @@ class WebJob {
 
   /// machine.info: the tables every check and upload uses. Returns false (and why) on failure.
   bool refresh_machine(std::string& error);
-  /// {"name", "axes", "conditions"} as machine.info gave them (null before refresh_machine()).
+  /// {"name", "axes", "conditions", "condition_edit"} as machine.info gave them (null before
+  /// refresh_machine()).
   [[nodiscard]] bridge::Json machine_info() const;
   /// machine.info as edmplc sent it (also "ops" and "manual"; null before refresh_machine()).
   [[nodiscard]] bridge::Json machine_info_raw() const;

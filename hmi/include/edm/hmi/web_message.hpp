@@ -70,6 +70,7 @@ enum class PageOp : std::uint8_t {
   kQueueClear,
   kQueueStart,
   kQueueStop,
+  kConditionSet,
 };
 
 /// Where a command runs: at once on the I/O thread (it never blocks), or on one of the hub's

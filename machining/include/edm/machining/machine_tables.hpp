@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "edm/machining/diagnostics.hpp"
@@ -30,6 +31,15 @@ struct Condition {
   // condition is set for one electrode), > 0 and <= 100; 1 = the paper's single A.
   double area_ratio{1.0};
 };
+
+/// The numeric fields of a condition an operator may be allowed to edit (`machine.condition_edit`),
+/// by their config names: open_voltage_v peak_current_a on_time_us off_time_us tdr_us servo_ref_v
+/// wear_ratio area_ratio. nullptr for another name.
+[[nodiscard]] double* condition_field(Condition& c, std::string_view field) noexcept;
+/// Why `value` is not a valid `field` of a condition (the config's own ranges: > 0, wear_ratio
+/// 0..10, area_ratio (0, 100]), or nullopt when it is.
+[[nodiscard]] std::optional<std::string> condition_value_error(std::string_view field,
+                                                               double value);
 
 /// Soft limits and dynamics of one axis (machine coordinates, mm).
 struct AxisLimits {

@@ -183,6 +183,10 @@ struct MachineSpec {
   std::string name;
   IoSpec io;
   ElectrodeSpec electrode;
+  /// `machine.condition_edit`: the condition fields an operator may change on the running
+  /// machine (condition.set; machining::condition_field names them); empty: the table is
+  /// read-only.
+  std::vector<std::string> condition_edit;
   std::vector<AxisSpec> axes;
   SafetySpec safety;
   RealtimeSpec realtime;

@@ -130,6 +130,12 @@ class Runtime {
   }
   /// The config's conditions and soft limits, in the form part programs are checked against.
   [[nodiscard]] const machining::MachineTables& tables() const noexcept { return tables_; }
+  /// Sets one field of condition E `e` (an operator's edit, condition.set): only a field the
+  /// config lists in machine.condition_edit, within the config's own range. nullopt when set,
+  /// else why not. Non-RT, and only while no job runs (the caller's op state: READY idle): a job
+  /// reads its conditions as its blocks begin, and its start (a command through the machine's
+  /// lock-free queue) orders this write before those reads.
+  std::optional<std::string> set_condition_field(int e, std::string_view field, double value);
 
  private:
   friend class RuntimeBuilder;
