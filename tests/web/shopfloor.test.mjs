@@ -173,7 +173,11 @@ test('a job started from the command line is shown as loaded elsewhere', async (
   assert.match(await page.locator('#job-part').textContent(), /a program loaded elsewhere \(generation \d+, \d+ blocks\)/);
   assert.match(await page.locator('#job-note').textContent(), /not what this page uploaded/);
   assert.equal(await page.locator('#editor .cur-line').count(), 0);
-  await state().filter({ hasText: 'READY' }).waitFor({ timeout: 60000 });
+  await state().filter({ hasText: 'READY' }).waitFor({ timeout: 60000 }).catch(async (e) => {
+    const seen = await page.evaluate(() => JSON.stringify({ state: window.edm.status?.state,
+      job: window.edm.status?.job, alarms: (window.edm.alarms || []).slice(-3).map((a) => `${a.code} ${a.source}: ${a.text}`) }));
+    throw new Error(`not READY again: ${seen}; edmhmi run said: ${said}`, { cause: e });
+  });
   assert.ok(await page.locator('#btn-start').isDisabled(), 'Start offered for the program loaded elsewhere');
   await new Promise((resolve) => { if (cli.exitCode !== null) resolve(); else cli.on('exit', resolve); });
   // Uploading from the page makes it the page's program again.

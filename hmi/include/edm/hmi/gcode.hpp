@@ -55,10 +55,10 @@ struct GcodeResult {
   std::vector<machining::MotionBlock> blocks;  // empty when errors is not
   std::vector<BlockFrame> frames;              // the work frame of each block (blocks' size)
   machining::Vec3 start_mm{};                  // the start point used (machine coordinates)
-  double electrode_mm{0.0};  // the electrode length interpreted with (offsets; 0: unknown)
-  std::vector<GcodeError> errors;              // file order (line, then column)
-  double drill_depth_mm{0.0};                  // Σ nominal lz of the drilling blocks
-  double electrode_wear_mm{0.0};               // Σ δ (eq. 10) of the drilling blocks
+  double electrode_mm{0.0};        // the electrode length interpreted with (offsets; 0: unknown)
+  std::vector<GcodeError> errors;  // file order (line, then column)
+  double drill_depth_mm{0.0};      // Σ nominal lz of the drilling blocks
+  double electrode_wear_mm{0.0};   // Σ δ (eq. 10) of the drilling blocks
   int drill_blocks{0};
 
   [[nodiscard]] bool ok() const noexcept { return errors.empty(); }
