@@ -438,6 +438,10 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
       // Not referenced (or still moving by hand): no job; back to READY (the bridge refuses
       // such a start first, this is the runtime's own guard).
       machine_->command(rt::MachineCommand::kStop, ctx.release);
+    } else if (ms == rt::MachineState::kRunning && (drill_.running() || finish_.running())) {
+      // The last job was stopped and its cycle still retracts (out of the hole, off the wall):
+      // the machine shows READY from the stop on, so a start may come now; the new job begins
+      // once the retract has ended, never with two commanders of one axis.
     } else if (ms == rt::MachineState::kRunning && job_->rt_begin()) {
       dry_run.set(job_->current_options().dry_run);
       state_value_ = State::kRun;

@@ -233,5 +233,36 @@ TEST(StopAndResume, StopMidDrillRetractsThenRunFromTheLineFinishesTheHole) {
   EXPECT_NEAR(err_um, 0.0, 30.0);
 }
 
+// A start that comes as soon as a stop mid-drill shows READY (a queue, a page, edmhmi run right
+// after it): the drill still retracts out of the hole for about two seconds. The new job begins
+// after the retract, and runs; before, its first block fought the retract for Z and faulted
+// (110 cnc.job.pz, following error), found by tests/web/shopfloor.test.mjs.
+TEST(StopAndResume, AJobStartedWhileTheStoppedDrillRetractsBeginsAfterTheRetract) {
+  OperatorRig m("start_gap_um: 5000", "");
+  ASSERT_NO_FATAL_FAILURE(start_part(m, /*dry_run=*/false));
+  auto& job = m.runtime->job();
+  for (int k = 0; k < 120'000 && m.read("cnc.job.drill.depth_reached_mm") < 3.8; ++k) {
+    m.run_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(m.runtime->machine().command(rt::MachineCommand::kStop), rt::CommandResult::kOk);
+  for (int k = 0;
+       k < 1000 && (m.runtime->machine().state() != rt::MachineState::kReady || job.active());
+       ++k) {
+    m.run_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(m.runtime->machine().state(), rt::MachineState::kReady);
+  const double z_ready = m.truth().machine_z_mm;
+  ASSERT_LT(z_ready, -3.0) << "READY while the electrode is still in the hole";
+  const std::uint64_t jobs = job.progress().jobs_started;
+  ASSERT_NO_FATAL_FAILURE(start_part(m, /*dry_run=*/true));
+  m.run_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(job.progress().jobs_started, jobs) << "the new job waits for the retract";
+  EXPECT_GT(m.truth().machine_z_mm, z_ready) << "the retract goes on";
+  m.jobs_before_start = jobs;
+  EXPECT_TRUE(m.run_to_end()) << "state " << static_cast<int>(m.runtime->machine().state());
+  EXPECT_EQ(job.progress().jobs_started, jobs + 1);
+  EXPECT_EQ(m.runtime->machine().state(), rt::MachineState::kReady);
+}
+
 }  // namespace
 }  // namespace edm::test
