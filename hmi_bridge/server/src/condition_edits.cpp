@@ -4,10 +4,9 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "edm/bridge/codec.hpp"
+#include "edm/machining/bounded_read.hpp"
 #include "edm/runtime/retain.hpp"
 #include "edm/runtime/runtime.hpp"
 
@@ -18,13 +17,11 @@ void ConditionEdits::load_and_apply(rt::Runtime& rt) {
   if (path_.empty() || !std::filesystem::exists(path_, ec)) return;
   std::map<std::pair<int, std::string>, double> read;
   try {
-    // Sized before it is read: a huge file put there is refused, never read into memory.
-    const auto bytes = std::filesystem::file_size(path_, ec);
-    if (ec || bytes > kMaxFileBytes) throw std::runtime_error("larger than 1 MiB, or unreadable");
-    std::ifstream in(path_, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    const Json doc = Json::parse(ss.str());
+    // The project's bounded reader: a regular file of at most 1 MiB, never read further.
+    const machining::BoundedRead file =
+        machining::read_bounded_file(path_, kMaxFileBytes, "condition edit file");
+    if (!file.ok()) throw std::runtime_error(file.problem);
+    const Json doc = Json::parse(file.text);
     if (doc.at("format") != kFormat) throw std::runtime_error("not a condition edit file");
     for (const Json& j : doc.at("edits")) {
       read[{j.at("E").get<int>(), j.at("field").get<std::string>()}] = j.at("value").get<double>();
