@@ -7,6 +7,7 @@
 
 #include "edm/bridge/codec.hpp"
 #include "edm/machining/bounded_read.hpp"
+#include "edm/runtime/log_escape.hpp"
 #include "edm/runtime/retain.hpp"
 #include "edm/runtime/runtime.hpp"
 
@@ -37,12 +38,12 @@ void ConditionEdits::load_and_apply(rt::Runtime& rt) {
   for (const auto& [key, value] : read) {
     if (auto why = rt.set_condition_field(key.first, key.second, value)) {
       spdlog::warn("bridge: a retained condition edit is dropped: E{} {} = {}: {}", key.first,
-                   key.second, value, *why);
+                   rt::log_quote(key.second), value, rt::log_quote(*why));
       continue;
     }
     edits_[key] = value;
     spdlog::info("bridge: condition E{} {} = {} (an operator's edit, retained)", key.first,
-                 key.second, value);
+                 key.second, value);  // an allowed field: one of the config's names
   }
   if (edits_.size() != read.size()) save();
 }
