@@ -43,7 +43,10 @@ constexpr CodeGroup kCodeGroups[] = {
     {'G', {170}, 1, &Block::plane_g, "plane codes (modal group 2)"},
     {'G', {200, 210}, 2, &Block::units_g, "unit codes (modal group 6: G20 G21)"},
     {'G', {900, 910}, 2, &Block::distance_g, "distance-mode codes (modal group 3: G90 G91)"},
-    {'M', {20, 300}, 2, &Block::stop_m, "program-end codes (modal group 4: M02 M30)"},
+    {'M', {0, 10, 20, 300}, 4, &Block::stop_m,
+     "stop and end codes (modal group 4: M00 M01 M02 M30)"},
+    {'G', {400, 410, 420}, 3, &Block::comp_g, "wire-offset codes (modal group 7: G40 G41 G42)"},
+    {'M', {980, 990}, 2, &Block::sub_m, "subprogram codes (M98 call, M99 return)"},
     {'M', {30, 50}, 2, &Block::rotation_m, "rotation codes (modal group 7: M03 M05)"},
     {'M', {80, 90}, 2, &Block::flushing_m, "flushing codes (modal group 8: M08 M09)"},
 };
@@ -118,6 +121,9 @@ class Sorter {
         case 'F':
         case 'E':
         case 'P':
+        case 'D':
+        case 'L':
+        case 'O':
         case 'R': {
           const Word*& slot = b.value[static_cast<std::size_t>(w.letter - 'A')];
           if (slot != nullptr) {

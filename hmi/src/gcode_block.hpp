@@ -22,10 +22,12 @@ struct Block {
   const Word* plane_g{nullptr};         // group 2: G17
   const Word* units_g{nullptr};         // group 6: G20 G21
   const Word* distance_g{nullptr};      // group 3: G90 G91
-  const Word* stop_m{nullptr};          // group 4: M02 M30
+  const Word* stop_m{nullptr};          // group 4: M00 M01 M02 M30
+  const Word* comp_g{nullptr};          // group 7: G40 G41 G42 (wire offset)
+  const Word* sub_m{nullptr};           // M98 M99 (subprogram call, return)
   const Word* rotation_m{nullptr};      // group 7: M03 M05
   const Word* flushing_m{nullptr};      // group 8: M08 M09
-  std::array<const Word*, 26> value{};  // X Y Z I J F E P R by letter
+  std::array<const Word*, 26> value{};  // X Y Z I J F E P R D L O by letter
 
   [[nodiscard]] const Word* operator[](char letter) const noexcept {
     return value[static_cast<std::size_t>(letter - 'A')];

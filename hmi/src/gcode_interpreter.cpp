@@ -67,14 +67,11 @@ Interpreter::Interpreter(std::string_view text, std::string_view file, const Mac
 }
 
 GcodeResult Interpreter::run() {
+  scan_subprograms();
   int line_no = 0;
-  std::size_t begin = 0;
-  while (begin < text_.size() && !stop_) {
-    std::size_t end = text_.find('\n', begin);
-    if (end == std::string_view::npos) end = text_.size();
-    ++line_no;
-    process_line(text_.substr(begin, end - begin), line_no);
-    begin = end + 1;
+  for (std::size_t i = 0; i < lines_.size() && !stop_; ++i) {
+    line_no = static_cast<int>(i + 1);
+    if (in_definition_[i] == 0) process_line(lines_[i], line_no);
   }
   if (!stop_ && !ended_) {
     if (opt_.implicit_end) {
@@ -276,7 +273,7 @@ void Interpreter::execute(const Block& b) {
     ok = false;
   }
   const Word* p = b['P'];
-  if (p != nullptr && !dwell && !(arc_move && has_ij)) {
+  if (p != nullptr && !dwell && !(arc_move && has_ij) && !is_code(b.sub_m, 980)) {
     error(b, p, word_text(*p) + " is only used by G04 (dwell) and G02/G03 (extra turns)");
     ok = false;
   }
@@ -297,6 +294,28 @@ void Interpreter::execute(const Block& b) {
     ok = false;
   }
   if (orbit && !check_orbit_words(b, armed_after)) ok = false;
+  const bool call = is_code(b.sub_m, 980);
+  if (is_code(b.sub_m, 990)) {
+    error(b, b.sub_m, "M99 outside a subprogram (O<n> ... M99)");
+    ok = false;
+  }
+  for (char letter : {'L', 'O', 'D'}) {
+    const Word* w = b[letter];
+    if (w == nullptr) continue;
+    if ((letter == 'L' && !call) || letter == 'O' ||
+        (letter == 'D' && !(is_code(b.comp_g, 410) || is_code(b.comp_g, 420)))) {
+      error(b, w,
+            word_text(*w) + (letter == 'L'   ? " is only used by M98 (the repeat count)"
+                             : letter == 'O' ? ": O<n> opens a subprogram alone on its line"
+                                             : " is only used by G41/G42 (the wire offset, mm)"));
+      ok = false;
+    }
+  }
+  if (b.comp_g != nullptr && tables_.kind != machining::MachineKind::kWire) {
+    error(b, b.comp_g,
+          word_text(*b.comp_g) + " (wire offset) is for wire machines (machine.kind: wire)");
+    ok = false;
+  }
   if (!ok) return;
 
   // Phase 2: effects, in RS274/NGC order.
@@ -328,9 +347,18 @@ void Interpreter::execute(const Block& b) {
     g92_active_ = false;
   }
   if (b.motion_g != nullptr) mode_ = mode;
+  if (b.comp_g != nullptr && !set_wire_offset(b)) return;
   if (orbit) do_orbit(b);
   if (has_axis || arc_move) do_motion(b);
-  if (b.stop_m != nullptr) {
+  if (call) call_subprogram(b);
+  if (b.stop_m != nullptr && code10(*b.stop_m) <= 10) {  // M00, M01: the job holds there
+    MotionBlock mb = make(MotionKind::kProgramStop, b, b.stop_m);
+    mb.on = is_code(b.stop_m, 10);
+    push(mb);
+  } else if (b.stop_m != nullptr) {
+    if (auto open = comp_.at_end(b.line, b.stop_m->col)) {
+      error(open->line, open->col, open->message);
+    }
     push(make(MotionKind::kEnd, b, b.stop_m));
     ended_ = true;
     end_line_ = b.line;
@@ -343,6 +371,39 @@ std::string Interpreter::known_conditions() const {
   std::string s = "this machine has";
   for (const Condition& c : tables_.conditions) s += " E" + std::to_string(c.e);
   return s;
+}
+
+bool Interpreter::set_wire_offset(const Block& b) {
+  const int g = code10(*b.comp_g);
+  if (g == 400) {
+    if (comp_.engaged()) comp_.stop();
+    return true;
+  }
+  if (comp_.engaged()) {
+    error(b, b.comp_g,
+          word_text(*b.comp_g) + " while the wire offset is on: switch it off with G40 first");
+    return false;
+  }
+  double d = 0.0;
+  if (const Word* dw = b['D']; dw != nullptr) {
+    if (!(dw->value > 0.0 && dw->value <= 10.0)) {
+      error(b, dw, "wire offset " + word_text(*dw) + " must be > 0 and <= 10 mm");
+      return false;
+    }
+    d = dw->value;
+  } else {
+    const Condition* c = armed_ >= 1 ? tables_.condition(armed_) : nullptr;
+    if (c == nullptr || !(c->offset_mm > 0.0)) {
+      error(b, b.comp_g,
+            word_text(*b.comp_g) + " needs an offset: a D word (mm) or an armed condition " +
+                "whose offset_mm is > 0" +
+                (c != nullptr ? " (E" + std::to_string(c->e) + " has none)" : std::string()));
+      return false;
+    }
+    d = c->offset_mm;
+  }
+  comp_.start(g == 410 ? 1 : -1, d);
+  return true;
 }
 
 bool Interpreter::check_orbit_words(const Block& b, int armed_after) {

@@ -10,8 +10,11 @@
 #include <string_view>
 #include <vector>
 
+#include <map>
+
 #include "edm/hmi/gcode.hpp"
 #include "gcode_block.hpp"
+#include "gcode_comp.hpp"
 
 namespace edm::hmi::detail {
 
@@ -59,6 +62,23 @@ class Interpreter {
                  const machining::Vec3& target);
   void do_arc(const Block& b, const Word* at, const machining::Vec3& start, machining::Vec3 target);
   void remember_axis_words(const Block& b);
+  /// A move of a wire machine: through the wire offset when it is engaged, else pushed.
+  void push_move(const machining::MotionBlock& mb, const machining::Vec3& start);
+  void push_now(const machining::MotionBlock& mb);
+  /// G40/G41/G42 of block b (phase 2); false with an error when the offset cannot be set.
+  bool set_wire_offset(const Block& b);
+
+  // gcode_subprograms.cpp: O<n> … M99 definitions (found before the program runs) and M98 calls.
+  struct SubprogramDef {
+    int o_line{0};
+    int first{0}, last{0};  // body lines (1-based); the M99 line is last + 1
+  };
+  /// Splits the text into lines and finds the definitions; their lines are skipped in the
+  /// program's own flow.
+  void scan_subprograms();
+  /// M98 P<n> [L<k>]: runs the body k times.
+  void call_subprogram(const Block& b);
+  [[nodiscard]] std::string_view line_text(int line_no) const;
 
   std::string_view text_;
   const machining::MachineTables& tables_;
@@ -87,6 +107,13 @@ class Interpreter {
   bool reported_no_feed_{false};
   bool stop_{false};
   bool too_many_{false};
+
+  WireOffset comp_;
+  std::vector<std::string_view> lines_;  // by line - 1
+  std::vector<char> in_definition_;      // by line - 1: part of an O … M99 definition
+  std::map<long, SubprogramDef> subprograms_;
+  int call_depth_{0};
+  std::size_t lines_called_{0};  // lines run through calls (bounded)
 };
 
 }  // namespace edm::hmi::detail

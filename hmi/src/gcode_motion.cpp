@@ -39,6 +39,27 @@ MotionBlock Interpreter::make(MotionKind kind, const Block& b, const Word* at) c
 }
 
 void Interpreter::push(const MotionBlock& mb) {
+  if (comp_.pending()) {  // emitted after the move the wire offset holds back, and its corner
+    comp_.hold(mb);
+    return;
+  }
+  push_now(mb);
+}
+
+void Interpreter::push_move(const MotionBlock& mb, const Vec3& start) {
+  if (!comp_.engaged()) {
+    push(mb);
+    return;
+  }
+  std::vector<MotionBlock> out;
+  if (auto e = comp_.move({mb, start}, out)) {
+    error(e->line, e->col, e->message);
+    return;
+  }
+  for (const MotionBlock& b : out) push_now(b);
+}
+
+void Interpreter::push_now(const MotionBlock& mb) {
   result_.blocks.push_back(mb);
   result_.frames.push_back(
       {.frame = static_cast<std::uint8_t>(frame_), .offset_mm = offset(), .g92 = g92_active_});
@@ -85,6 +106,10 @@ void Interpreter::do_motion(const Block& b) {
   remember_axis_words(b);
   switch (mode_) {
     case Motion::kRapid: {
+      if (comp_.engaged()) {
+        error(b, at, "G00 while the wire offset is on: cut with G01, or switch it off with G40");
+        return;
+      }
       pos_ = target;
       push(make(MotionKind::kRapid, b, at));
       break;
@@ -98,6 +123,18 @@ void Interpreter::do_motion(const Block& b) {
 
 void Interpreter::do_linear(const Block& b, const Word* at, const Vec3& start, const Vec3& target) {
   pos_ = target;
+  if (tables_.kind == machining::MachineKind::kWire) {  // a wire cuts in XY; Z is the guide
+    MotionBlock mb = make(MotionKind::kLinear, b, at);
+    if (need_feed(b, at, "G01")) mb.feed_mm_s = feed_mm_min_ / 60.0;
+    mb.cut = armed_ >= 1;
+    if ((mb.cut || comp_.engaged()) && std::fabs(target.z - start.z) > kEps) {
+      error(b, b['Z'] != nullptr ? b['Z'] : at,
+            "a wire cut moves X and Y only (Z is the upper guide): move Z with E0 or G40 first");
+      return;
+    }
+    push_move(mb, start);
+    return;
+  }
   const bool drill = armed_ >= 1 && target.z < start.z - kEps;
   MotionBlock mb = make(drill ? MotionKind::kDrill : MotionKind::kLinear, b, at);
   if (need_feed(b, at, "G01")) mb.feed_mm_s = feed_mm_min_ / 60.0;
@@ -173,6 +210,15 @@ void Interpreter::do_arc(const Block& b, const Word* at, const Vec3& start, Vec3
   mb.centre = centre;
   mb.turns = b['P'] != nullptr ? static_cast<std::int32_t>(b['P']->value) : 0;
   if (need_feed(b, at, name)) mb.feed_mm_s = feed_mm_min_ / 60.0;
+  if (tables_.kind == machining::MachineKind::kWire) {
+    mb.cut = armed_ >= 1;
+    if (comp_.engaged() && mb.turns > 0) {
+      error(b, b['P'], "extra turns (P) are not compensated by the wire offset");
+      return;
+    }
+    push_move(mb, start);
+    return;
+  }
   push(mb);
 }
 

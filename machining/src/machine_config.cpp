@@ -52,6 +52,7 @@ MachineTables parse_machine_tables(std::string_view yaml_text, const std::string
   // Only these sections are read; the others (tasks, programs, ...) are the runtime loader's.
   std::vector<LocatedAxis> axes;
   std::vector<LocatedCondition> conditions;
+  MachineKind kind = MachineKind::kDrill;
   if (auto m = r.map(top, {})) {
     if (const yaml::Field* v = m->find("version")) {
       if (!(v->value.node.IsScalar() && v->value.node.Scalar() == "1")) {
@@ -63,12 +64,13 @@ MachineTables parse_machine_tables(std::string_view yaml_text, const std::string
       // machine.name and machine.io are the runtime's; only the axes are read here.
       if (auto mm = r.map(machine->value, {})) {
         if (const yaml::Field* f = mm->find("axes")) axes = read_axes(r, f->value);
+        if (const yaml::Field* f = mm->find("kind")) kind = read_machine_kind(r, f->value);
       }
     }
     if (const yaml::Field* f = m->find("conditions")) conditions = read_conditions(r, f->value);
   }
   if (!sink.empty()) throw_all(sink);
-  return make_tables(axes, conditions);
+  return make_tables(axes, conditions, kind);
 }
 
 MachineTables read_machine_tables(const std::string& path) {

@@ -86,7 +86,8 @@ SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out)
   out.loc = v.loc;
   SourceLoc e_loc = v.loc;
   auto m = r.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
-                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio", "area_ratio"});
+                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio", "area_ratio",
+                     "offset_mm"});
   if (!m) {
     return e_loc;
   }
@@ -114,6 +115,15 @@ SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out)
         r.error(f->value, "must be in 0..10 (got " + f->value.node.Scalar() + ")");
       } else {
         out.wear_ratio = *x;
+      }
+    }
+  }
+  if (const Field* f = m->find("offset_mm")) {
+    if (auto x = r.real(f->value)) {
+      if (*x < 0.0 || *x > 10.0) {
+        r.error(f->value, "must be in 0..10 mm (got " + f->value.node.Scalar() + ")");
+      } else {
+        out.offset_mm = *x;
       }
     }
   }
@@ -161,6 +171,12 @@ std::vector<T> read_keyed_list(yaml::Reader& r, const Value& list, ReadOne read_
 }
 
 }  // namespace
+
+MachineKind read_machine_kind(yaml::Reader& r, const Value& v) {
+  MachineKind k = MachineKind::kDrill;
+  if (auto s = r.choice(v, {"drill", "wire", "sink"})) machine_kind_from_string(*s, k);
+  return k;
+}
 
 std::vector<LocatedAxis> read_axes(yaml::Reader& r, const Value& axes) {
   return read_keyed_list<LocatedAxis>(r, axes, [&r](const Value& item, LocatedAxis& a) {

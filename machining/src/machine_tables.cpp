@@ -25,6 +25,7 @@ double* condition_field(Condition& c, std::string_view field) noexcept {
   if (field == "servo_ref_v") return &c.servo_ref_v;
   if (field == "wear_ratio") return &c.wear_ratio;
   if (field == "area_ratio") return &c.area_ratio;
+  if (field == "offset_mm") return &c.offset_mm;
   return nullptr;
 }
 
@@ -39,15 +40,37 @@ std::optional<std::string> condition_value_error(std::string_view field, double 
     if (value < 0.0 || value > 10.0) return "wear_ratio must be in 0..10" + got;
   } else if (field == "area_ratio") {
     if (!(value > 0.0 && value <= 100.0)) return "area_ratio must be in (0, 100]" + got;
+  } else if (field == "offset_mm") {
+    if (value < 0.0 || value > 10.0) return "offset_mm must be in 0..10" + got;
   } else if (!(value > 0.0)) {
     return std::string(field) + " must be > 0" + got;
   }
   return std::nullopt;
 }
 
+std::string_view to_string(MachineKind k) noexcept {
+  switch (k) {
+    case MachineKind::kDrill: return "drill";
+    case MachineKind::kWire: return "wire";
+    case MachineKind::kSink: return "sink";
+  }
+  return "drill";
+}
+
+bool machine_kind_from_string(std::string_view s, MachineKind& out) noexcept {
+  for (MachineKind k : {MachineKind::kDrill, MachineKind::kWire, MachineKind::kSink}) {
+    if (s == to_string(k)) {
+      out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
 MachineTables make_tables(const std::vector<LocatedAxis>& axes,
-                          const std::vector<LocatedCondition>& conditions) {
+                          const std::vector<LocatedCondition>& conditions, MachineKind kind) {
   MachineTables t;
+  t.kind = kind;
   t.axes.assign(axes.begin(), axes.end());
   t.conditions.assign(conditions.begin(), conditions.end());
   return t;

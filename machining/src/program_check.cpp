@@ -240,6 +240,7 @@ std::vector<ProgramIssue> check_program(std::span<const MotionBlock> program,
         break;
       case MotionKind::kRotation:
       case MotionKind::kFlushing: break;
+      case MotionKind::kProgramStop: break;
       case MotionKind::kEnd: ended = true; break;
     }
     if (b.kind != MotionKind::kCondition && b.condition > 0 &&

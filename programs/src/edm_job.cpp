@@ -45,6 +45,7 @@ EdmJob::EdmJob()
       manual_(add_child<ManualMotion>("manual")),
       probe_(add_child<DepthProbe>("probe")),
       axes_(add_child<AxisArbiter>("axes")),
+      wire_(add_child<WireCut>("wire")),
       cycles_{&drill_, &finish_} {}
 
 std::vector<rt::ParamError> EdmJob::configure_self(const rt::BlockSetup& setup) {
@@ -203,6 +204,8 @@ void EdmJob::finish_job(rt::JobOutcome outcome) noexcept {
     manual_.abort_job_touch();
   }
   drill_returning_ = false;
+  cut_continuing_ = false;
+  wire_.reset();
   probe_.stop();
   if (outcome == rt::JobOutcome::kFinished) jobs_finished.set(jobs_finished.get() + 1);
   state_value_ = State::kIdle;
@@ -368,6 +371,10 @@ bool EdmJob::run_finish(const MotionBlock& b, bool hold) noexcept {
 
 bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                        rt::BlockStatus& status) noexcept {
+  if (step_ == Step::kEnter && !b.cut) {  // another kind of block ends a cut's history
+    cut_continuing_ = false;
+    wire_.reset();
+  }
   switch (b.kind) {
     case MotionKind::kCondition: {
       const machining::Condition* next =
@@ -394,9 +401,14 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
       }
       return !hold && ctx.release >= wait_until_;
     case MotionKind::kRapid:
-    case MotionKind::kLinear: return run_linear(b, ctx, hold, status);
+    case MotionKind::kLinear:
+      if (b.cut && !dry_run.get()) return run_cut(b, ctx, hold);  // a dry run moves at F
+      return run_linear(b, ctx, hold, status);
     case MotionKind::kArcCw:
-    case MotionKind::kArcCcw: return run_arc(b, ctx, hold, status);
+    case MotionKind::kArcCcw:
+      if (b.cut && !dry_run.get()) return run_cut(b, ctx, hold);
+      return run_arc(b, ctx, hold, status);
+    case MotionKind::kProgramStop: return run_program_stop(ctx);
     case MotionKind::kDrill:
       return dry_run.get() || run_drill(b, ctx, hold, status);  // a dry run skips it
     case MotionKind::kOrbitFinish: return dry_run.get() || run_finish(b, hold);
@@ -407,6 +419,7 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
 
 rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   rt::BlockStatus status = rt::BlockStatus::kOk;
+  cutting_ = false;
   // The operator's feed override, read once a cycle for every child that moves.
   feed_override_ = machine_ != nullptr ? machine_->feed_override() : 1.0;
   for (rt::Input<double>* in :
@@ -505,6 +518,7 @@ rt::BlockStatus EdmJob::update_self(const rt::CycleContext& ctx) noexcept {
   if (drill_.running()) hold_z_ = z;
   bool generator = false;
   for (const MachiningCycle* c : cycles_) generator = generator || c->generator_on();
+  generator = generator || cutting_;
   gen_on.set(gen_arm.get() && generator);
   polarity_positive.set(finish_.running() ? finish_.polarity_positive.get()
                                           : polarity_positive_value_);

@@ -254,7 +254,7 @@ Config parse_config_file(const std::string& path) {
 }
 
 machining::MachineTables to_machine_tables(const Config& cfg) {
-  return machining::make_tables(cfg.machine.axes, cfg.conditions);
+  return machining::make_tables(cfg.machine.axes, cfg.conditions, cfg.machine.kind);
 }
 
 }  // namespace edm::rt

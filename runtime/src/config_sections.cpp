@@ -21,7 +21,8 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "io", "electrode", "condition_edit", "axes", "safety", "realtime"});
+  auto m = r_.map(v, {"name", "kind", "io", "electrode", "condition_edit", "axes", "safety",
+                        "realtime"});
   if (!m) {
     return;
   }
@@ -32,6 +33,9 @@ void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.io.driver_loc = v.loc;
   if (const Field* f = m->find("io")) {
     parse_io(f->value, out.io);
+  }
+  if (const Field* f = m->find("kind")) {
+    out.kind = machining::read_machine_kind(r_, f->value);
   }
   if (const Field* f = m->find("axes")) {
     out.axes = machining::read_axes(r_, f->value);

@@ -64,6 +64,21 @@ std::vector<rt::ParamError> SimParams::cross_field_errors() const {
     e.push_back({"wire_break_rab_shape",
                  "must be a whole number (got " + std::to_string(wire_break_rab_shape) + ")"});
   }
+  if (wire_plane) {
+    if (tool_kind != "wire") e.push_back({"wire_plane", "needs tool_kind wire"});
+    const double w = wire_plate_x_max_mm - wire_plate_x_min_mm;
+    const double hgt = wire_plate_y_max_mm - wire_plate_y_min_mm;
+    // The field is a float per cell: at most 64 M cells (256 MB) for one plate.
+    if (!(w > 0.0 && hgt > 0.0)) {
+      e.push_back({"wire_plate_x_max_mm", "the plate must have a positive extent in X and Y"});
+    } else if ((w + 1.0) * (hgt + 1.0) / (wire_grid_um * wire_grid_um * 1e-6) > 64e6) {
+      e.push_back({"wire_grid_um", "the plate's field would exceed 64 M cells: a coarser grid "
+                                   "or a smaller plate"});
+    }
+    if (wire_void_d_mm > 0.0 && !(wire_void_height_mm < wire_plate_mm)) {
+      e.push_back({"wire_void_height_mm", "must be < wire_plate_mm"});
+    }
+  }
   if (!(work_x_min_mm < work_x_max_mm)) {
     e.push_back({"work_x_max_mm", "must be > work_x_min_mm (got " + std::to_string(work_x_max_mm) +
                                       " <= " + std::to_string(work_x_min_mm) + ")"});

@@ -283,6 +283,29 @@ void SimParams::visit_wire(rt::ParamVisitor& v) {
            rt::closed(0.0, 1.0)});
   v.param("mean_current_ema_ms", mean_current_ema_ms,
           {"ms", "time constant of mean current", rt::kPositive});
+  v.param("wire_plane", wire_plane, {"", "2-D cut: the wire's XY from the axes, the plate eroded"});
+  v.param("wire_plate_mm", wire_plate_mm, {"mm", "2-D: plate thickness", rt::kPositive});
+  v.param("wire_plate_x_min_mm", wire_plate_x_min_mm, {"mm", "2-D: plate extent, machine X min"});
+  v.param("wire_plate_x_max_mm", wire_plate_x_max_mm, {"mm", "2-D: plate extent, machine X max"});
+  v.param("wire_plate_y_min_mm", wire_plate_y_min_mm, {"mm", "2-D: plate extent, machine Y min"});
+  v.param("wire_plate_y_max_mm", wire_plate_y_max_mm, {"mm", "2-D: plate extent, machine Y max"});
+  v.param("wire_grid_um", wire_grid_um, {"um", "2-D: material field pitch", rt::closed(1.0, 100.0)});
+  v.param("wire_start_hole_x_mm", wire_start_hole_x_mm, {"mm", "2-D: start hole centre X"});
+  v.param("wire_start_hole_y_mm", wire_start_hole_y_mm, {"mm", "2-D: start hole centre Y"});
+  v.param("wire_start_hole_d_mm", wire_start_hole_d_mm,
+          {"mm", "2-D: start hole diameter (0: none)", rt::kNonNegative});
+  v.param("wire_step_x_mm", wire_step_x_mm, {"mm", "2-D: thickness step at this machine X"});
+  v.param("wire_step_mm", wire_step_mm, {"mm", "2-D: thickness added for x >= step_x"});
+  v.param("wire_void_x_mm", wire_void_x_mm, {"mm", "2-D: internal void centre X"});
+  v.param("wire_void_y_mm", wire_void_y_mm, {"mm", "2-D: internal void centre Y"});
+  v.param("wire_void_d_mm", wire_void_d_mm,
+          {"mm", "2-D: internal void diameter (0: none)", rt::kNonNegative});
+  v.param("wire_void_height_mm", wire_void_height_mm,
+          {"mm", "2-D: internal void height, centred in the thickness", rt::kNonNegative});
+  v.param("wire_reach_um", wire_reach_um,
+          {"um", "2-D: discharges reach material this far from the wire", rt::kPositive});
+  v.param("wire_erode_ms", wire_erode_ms,
+          {"ms", "2-D: the field takes the removal this often", rt::closed(0.025, 100.0)});
 }
 
 void SimParams::visit_sensors(rt::ParamVisitor& v) {

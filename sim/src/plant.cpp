@@ -56,6 +56,14 @@ Plant::Plant(const SimParams& params, std::uint64_t seed)
       std::string why;
       profile_ = *ThicknessProfile::make(p.wire_thickness_profile, &why);  // validated above
       area_electrode_mm2_ = 1.0;                                           // no wear
+      if (p.wire_plane) {
+        plane_ = WirePlane(WirePlaneGeometry{
+            p.wire_plate_x_min_mm, p.wire_plate_x_max_mm, p.wire_plate_y_min_mm,
+            p.wire_plate_y_max_mm, p.wire_plate_mm, p.wire_grid_um * 1e-3, p.wire_start_hole_x_mm,
+            p.wire_start_hole_y_mm, p.wire_start_hole_d_mm, p.wire_step_x_mm, p.wire_step_mm,
+            p.wire_void_x_mm, p.wire_void_y_mm, p.wire_void_d_mm, p.wire_void_height_mm});
+        plane_erode_ns_ = std::max<std::int64_t>(1, to_ns(p.wire_erode_ms * 1e3));
+      }
       break;
     }
   }
@@ -129,10 +137,17 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
     axes_[2].reset(hold_gap_um_ * 1e-3 + bottom_mm() - wear_length_mm_);
   } else {
     double vz = cmd_.vz_mm_s;
-    if (cmd_.servo_ref_v > 0.0) {  // the machine's own servo: advance while U_av > reference
+    if (cmd_.servo_ref_v > 0.0 && !plane_.active()) {  // the machine's own servo: advance while U_av > reference
       vz -= params_.servo_gain_mm_s_per_v * (state_.gap_voltage_filtered_v - cmd_.servo_ref_v);
     }
     axes_[2].step(vz, dt);
+  }
+  if (plane_.active() && plane_pending_mm3_ > 0.0 &&
+      t_ns - plane_eroded_at_ns_ >= plane_erode_ns_) {
+    plane_.erode(axes_[0].position_mm(), axes_[1].position_mm(),
+                 params_.wire_d_mm / 2.0 + params_.wire_reach_um * 1e-3, plane_pending_mm3_);
+    plane_pending_mm3_ = 0.0;
+    plane_eroded_at_ns_ = t_ns;
   }
   track_short_events();
   update_ref_switches();

@@ -32,6 +32,11 @@ double Plant::front_gap_um(double z_mm) const noexcept {
     }
   }
   if (hold_) return hold_gap_um_;
+  if (plane_.active()) {
+    return (plane_.clearance_mm(axes_[0].position_mm(), axes_[1].position_mm()) -
+            params_.wire_d_mm / 2.0) *
+           1e3;
+  }
   return (z_mm + wear_length_mm_ - bottom_mm()) * 1e3;
 }
 
@@ -79,6 +84,9 @@ double Plant::cavity_centre_fraction(double cut_mm) const noexcept {
 }
 
 double Plant::cut_thickness_mm() const noexcept {
+  if (plane_.active()) {
+    return plane_.cut_thickness_mm(axes_[0].position_mm(), axes_[1].position_mm());
+  }
   const double s = depth_mm();
   const auto& p = params_;
   const bool in_cavity = s >= p.wire_cavity_from_mm && s < p.wire_cavity_to_mm;
@@ -95,6 +103,12 @@ void Plant::remove(double volume_mm3, double wear_mm3, double gap_um, int site) 
     const double kerf = p.wire_d_mm + 2.0 * std::max(gap_um, 0.0) * 1e-3;  // k = D + 2g
     const double ds = volume_mm3 / (kerf * h);
     state_.kerf_debris = std::min(1.0, state_.kerf_debris + p.wire_kerf_debris_per_mm * ds);
+    if (plane_.active()) {  // the field takes it; depth_mm() counts the cut length it makes
+      plane_pending_mm3_ += volume_mm3;
+      hole_bottom_mm_ -= ds;
+      state_.debris = std::min(1.0, state_.debris + p.debris_kappa * volume_mm3 / v_gap);
+      return;
+    }
     double s = depth_mm() + ds;
     if (s >= p.wire_hole_from_mm && s < p.wire_hole_to_mm) s = p.wire_hole_to_mm;  // no material
     if (p.wire_cavity_to_mm > p.wire_cavity_from_mm && depth_mm() < p.wire_cavity_to_mm &&

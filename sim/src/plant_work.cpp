@@ -98,6 +98,11 @@ double Plant::mean_wall_radius_mm() const noexcept {
 
 double Plant::touch_distance_um() const noexcept {
   const auto& p = params_;
+  if (plane_.active()) {  // the wire spans the plate: its plan-view clearance
+    return std::max(0.0, plane_.clearance_mm(axes_[0].position_mm(), axes_[1].position_mm()) -
+                             p.wire_d_mm / 2.0) *
+           1e3;
+  }
   Section tool = tool_section_;
   tool.x_mm = axes_[0].position_mm();
   tool.y_mm = axes_[1].position_mm();

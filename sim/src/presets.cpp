@@ -1,6 +1,6 @@
 #include "edm/sim/params.hpp"
 
-// The named presets of the simulator (drill, sink, wire): SimParams defaults are DRILL; the others
+// The named presets of the simulator (drill, sink, wire, wire-xy): SimParams defaults are DRILL; the others
 // change what differs. The schema and its validation are params.cpp.
 
 #include <optional>
@@ -95,9 +95,21 @@ std::optional<SimParams> SimParams::preset(std::string_view name) {
     p.short_events = false;  // the wire's abnormal pulses are calibrated to seed 000 without them
     return p;
   }
+  if (name == "wire-xy") {  // the wire machine: the wire preset's gap, cutting a plate in XY
+    p = *preset("wire");
+    p.wire_plane = true;
+    p.wire_thickness_profile = "0:20";  // unused in 2-D (the plate's thickness is)
+    p.wire_hole_from_mm = p.wire_hole_to_mm = 0.0;
+    p.servo_gain_mm_s_per_v = 0.0;  // the job's servo feeds along the path
+    p.wire_start_hole_x_mm = -9.0;  // the shipped punch's start hole (examples/parts/)
+    p.wire_start_hole_d_mm = 1.0;
+    p.start_x_mm = -9.0;  // threaded there
+    p.start_gap_um = 0.0;
+    return p;
+  }
   return std::nullopt;
 }
 
-std::vector<std::string> preset_names() { return {"drill", "sink", "wire"}; }
+std::vector<std::string> preset_names() { return {"drill", "sink", "wire", "wire-xy"}; }
 
 }  // namespace edm::sim

@@ -108,7 +108,7 @@ TEST(FaultInjection, ElectrodeNearItsEndRaises160BeforeTheHolder) {
 // A wire break (the wire-break input of the process image turns true): alarm 170, FAULT, the
 // axis command 0 and the generator off, within 1 cycle of the driver publishing it.
 TEST(FaultInjection, WireBreakRaises170AndTheSafeState) {
-  SafetyRig m(shipped_config("wire-sim"), "wire-sim.yaml");
+  SafetyRig m(shipped_config("wire-process-sim"), "wire-process-sim.yaml");
   m.run_ms(200);
   ASSERT_EQ(m.state(), MachineState::kReady);
   ASSERT_NE(m.read("io.vz_cmd"), 0.0) << "the servo is feeding";

@@ -49,7 +49,7 @@ Outcome run_200_ms(SafetyRig& m) {
 }
 
 TEST(HostStall, TheShippedSimulatedMachinesTolerateHostStallsAndTheDefaultIsFault) {
-  for (const char* name : {"drill-sim", "sink-sim", "wire-sim"}) {
+  for (const char* name : {"drill-sim", "sink-sim", "wire-sim", "wire-process-sim"}) {
     const rt::Config cfg = rt::parse_config_text(shipped_config(name), shipped_path(name));
     for (const rt::TaskSpec& t : cfg.tasks) {
       EXPECT_EQ(t.watchdog.host_stall, rt::HostStallPolicy::kTolerate) << name << " " << t.name;

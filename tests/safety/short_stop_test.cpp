@@ -303,7 +303,7 @@ std::string sink_config(int seed) {
   return edited(shipped_config("sink-sim"), "seed: 1", "seed: " + std::to_string(seed));
 }
 std::string wire_config(int seed) {
-  return edited(shipped_config("wire-sim"), "seed: 1", "seed: " + std::to_string(seed));
+  return edited(shipped_config("wire-process-sim"), "seed: 1", "seed: " + std::to_string(seed));
 }
 
 // The property (issue 31): over seeded random short bursts of 1-10 cycles injected at random
@@ -315,7 +315,7 @@ std::string wire_config(int seed) {
 TEST(ShortStop, RandomShortBurstsOfOneToTenCyclesAreNeverFedInto) {
   const Machine machines[] = {{"drill-sim-program", drill_config, "cycle.drill.vz_cmd_mm_s", 15},
                               {"sink-sim", sink_config, nullptr, 5},
-                              {"wire-sim", wire_config, nullptr, 5}};
+                              {"wire-process-sim", wire_config, nullptr, 5}};
   constexpr int kBursts = 8;
   std::mt19937_64 rng(31);
   int bursts = 0;

@@ -52,7 +52,7 @@ TEST(SimDriver, RealClockLatchAdvancesThePlantFromTheFirstLatchOnly) {
 }
 
 TEST(SimDriver, TheShippedMachinesPassCheck) {
-  for (const char* m : {"drill-sim", "sink-sim", "wire-sim", "sink-str-sim"}) {
+  for (const char* m : {"drill-sim", "sink-sim", "wire-sim", "wire-process-sim", "sink-str-sim"}) {
     Child c({EDM_EDMPLC_PATH, "--check", "--config",
              std::string(EDM_SOURCE_DIR) + "/config/machines/" + m + ".yaml"});
     EXPECT_EQ(c.wait(), 0) << m << ": " << c.output();
@@ -67,7 +67,7 @@ struct BadSim {
 TEST(SimDriver, BadParametersAreLocatedErrors) {
   TempDir dir("edm-sim");
   const BadSim cases[] = {
-      {"{preset: drll}", "unknown preset 'drll' (presets: drill, sink, wire)"},
+      {"{preset: drll}", "unknown preset 'drll' (presets: drill, sink, wire, wire-xy)"},
       {"{preset: drill, peak_current_a: fast}", "parameter 'peak_current_a' is LREAL"},
       {"{preset: drill, peak_curent_a: 10}", "unknown parameter 'peak_curent_a'"},
       {"{preset: drill, peak_current_a: -5}", "peak_current_a"},

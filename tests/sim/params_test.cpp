@@ -30,7 +30,7 @@ bool has_error(const std::vector<edm::rt::ParamError>& errs, std::string_view fi
 }
 
 TEST(SimParams, presets_are_valid_and_distinct) {
-  ASSERT_EQ(preset_names().size(), 3U);
+  ASSERT_EQ(preset_names().size(), 4U);
   for (const auto& n : preset_names()) {
     const auto p = SimParams::preset(n);
     ASSERT_TRUE(p.has_value()) << n;

@@ -95,6 +95,7 @@ Json to_json(const MotionBlock& b) {
   put_unless_default(j, "final_radius_mm", b.final_radius_mm, d.final_radius_mm);
   put_unless_default(j, "dwell_s", b.dwell_s, d.dwell_s);
   put_unless_default(j, "on", b.on, d.on);
+  put_unless_default(j, "cut", b.cut, d.cut);
   put_unless_default(j, "electrode_ref_mm", b.electrode_ref_mm, d.electrode_ref_mm);
   return j;
 }
@@ -148,6 +149,11 @@ bool from_json(const Json& j, MotionBlock& out, std::string& error) {
       if (ok) {
         b.on = v.get<bool>();
       }
+    } else if (key == "cut") {
+      ok = v.is_boolean();
+      if (ok) {
+        b.cut = v.get<bool>();
+      }
     } else {
       error = "unknown field '" + key + "'";
       return false;
@@ -170,7 +176,7 @@ void Crc32::update(std::span<const std::uint8_t> bytes) noexcept {
 }
 
 void Crc32::update(const MotionBlock& b) noexcept {
-  std::array<std::uint8_t, kBlockRecordBytes + sizeof(double)> rec{};
+  std::array<std::uint8_t, kBlockRecordBytes + sizeof(double) + 1> rec{};
   std::uint8_t* p = rec.data();
   *p++ = static_cast<std::uint8_t>(b.kind);
   put_le(p, b.line);
@@ -193,12 +199,10 @@ void Crc32::update(const MotionBlock& b) noexcept {
   *p++ = b.on ? 1 : 0;
   // The electrode length of a block in a work frame follows, when there is one: a client that
   // never sends it (before issue 33) keeps its 130-byte records.
-  if (b.electrode_ref_mm != 0.0) {
-    put_le(p, b.electrode_ref_mm);
-    update(rec);
-  } else {
-    update(std::span<const std::uint8_t>(rec.data(), kBlockRecordBytes));
-  }
+  // So does a wire cut's flag (issue 34), only when set: a drill's records stay as they were.
+  if (b.electrode_ref_mm != 0.0) put_le(p, b.electrode_ref_mm);
+  if (b.cut) *p++ = 1;
+  update(std::span<const std::uint8_t>(rec.data(), static_cast<std::size_t>(p - rec.data())));
 }
 
 std::uint32_t program_checksum(std::span<const MotionBlock> blocks) noexcept {

@@ -45,6 +45,16 @@ bool area_ratio_from_json(const Json& j, Condition& c, std::string& error,
   return true;
 }
 
+bool offset_from_json(const Json& j, Condition& c, std::string& error, const std::string& where) {
+  if (!j.contains("offset_mm")) return true;
+  if (!get_number(j, "offset_mm", c.offset_mm, error, where)) return false;
+  if (!(c.offset_mm >= 0.0 && c.offset_mm <= 10.0)) {
+    error = where + ".offset_mm: must be in 0..10";
+    return false;
+  }
+  return true;
+}
+
 bool axis_from_json(const Json& j, AxisLimits& a, std::string& error, const std::string& where) {
   if (!j.is_object()) {
     error = where + ": an object is required";
@@ -100,7 +110,7 @@ bool condition_from_json(const Json& j, Condition& c, std::string& error,
          get_number(j, "tdr_us", c.tdr_us, error, where) &&
          get_number(j, "servo_ref_v", c.servo_ref_v, error, where) &&
          get_number(j, "wear_ratio", c.wear_ratio, error, where) &&
-         area_ratio_from_json(j, c, error, where);
+         area_ratio_from_json(j, c, error, where) && offset_from_json(j, c, error, where);
 }
 
 }  // namespace
@@ -126,9 +136,13 @@ Json to_json(const machining::MachineTables& tables, const std::string& machine_
                           {"tdr_us", c.tdr_us},
                           {"servo_ref_v", c.servo_ref_v},
                           {"wear_ratio", c.wear_ratio},
-                          {"area_ratio", c.area_ratio}});
+                          {"area_ratio", c.area_ratio},
+                          {"offset_mm", c.offset_mm}});
   }
-  return Json{{"name", machine_name}, {"axes", axes}, {"conditions", conditions}};
+  return Json{{"name", machine_name},
+              {"kind", std::string(machining::to_string(tables.kind))},
+              {"axes", axes},
+              {"conditions", conditions}};
 }
 
 bool from_json(const Json& j, machining::MachineTables& out, std::string& machine_name,
@@ -145,6 +159,13 @@ bool from_json(const Json& j, machining::MachineTables& out, std::string& machin
     return false;
   }
   machining::MachineTables t;
+  if (const auto kind = j.find("kind"); kind != j.end()) {  // absent: an older runtime, a drill
+    if (!kind->is_string() ||
+        !machining::machine_kind_from_string(kind->get<std::string>(), t.kind)) {
+      error = "machine.kind: 'drill', 'wire' or 'sink' expected";
+      return false;
+    }
+  }
   std::set<char> axis_names;
   for (std::size_t i = 0; i < axes->size(); ++i) {
     AxisLimits a;

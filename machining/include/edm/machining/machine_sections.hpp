@@ -16,6 +16,8 @@ namespace edm::machining {
 /// and duplicate axis names, each problem reported to `r`. Returns every entry read (entries
 /// with errors included; the caller throws when `r`'s sink is not empty).
 std::vector<LocatedAxis> read_axes(yaml::Reader& r, const yaml::Value& axes);
+/// `machine.kind`: drill (the default), wire or sink; another name is an error at its place.
+MachineKind read_machine_kind(yaml::Reader& r, const yaml::Value& v);
 
 /// Reads the list under `conditions`: keys, types, ranges and duplicate E numbers, as above.
 std::vector<LocatedCondition> read_conditions(yaml::Reader& r, const yaml::Value& conditions);

@@ -30,11 +30,14 @@ struct Condition {
   // A_hole / A_e: the hole's cross-section over the electrode's (seed 004 eq. 8; a drilling
   // condition is set for one electrode), > 0 and <= 100; 1 = the paper's single A.
   double area_ratio{1.0};
+  // Wire: the wire offset of this pass (wire radius + side gap + what later passes take off),
+  // applied by G41/G42 without a D word; >= 0.
+  double offset_mm{0.0};
 };
 
 /// The numeric fields of a condition an operator may be allowed to edit (`machine.condition_edit`),
 /// by their config names: open_voltage_v peak_current_a on_time_us off_time_us tdr_us servo_ref_v
-/// wear_ratio area_ratio. nullptr for another name.
+/// wear_ratio area_ratio offset_mm. nullptr for another name.
 [[nodiscard]] double* condition_field(Condition& c, std::string_view field) noexcept;
 /// Why `value` is not a valid `field` of a condition (the config's own ranges: > 0, wear_ratio
 /// 0..10, area_ratio (0, 100]), or nullopt when it is.
@@ -50,7 +53,16 @@ struct AxisLimits {
   double a_max_mm_s2{1000.0};
 };
 
+/// What the machine machines (`machine.kind`): the G-code interpreter makes a wire machine's
+/// armed G01/G02/G03 cuts (gap-controlled feed along the path) and allows G41/G42 there.
+enum class MachineKind : std::uint8_t { kDrill, kWire, kSink };
+/// "drill", "wire", "sink".
+std::string_view to_string(MachineKind k) noexcept;
+/// Inverse of to_string(); false for another name.
+bool machine_kind_from_string(std::string_view s, MachineKind& out) noexcept;
+
 struct MachineTables {
+  MachineKind kind{MachineKind::kDrill};
   std::vector<Condition> conditions;
   std::vector<AxisLimits> axes;  // axes not listed are unlimited
 
@@ -72,6 +84,7 @@ struct LocatedCondition : Condition {
 
 /// The tables of what a config's `machine.axes` and `conditions` sections held.
 MachineTables make_tables(const std::vector<LocatedAxis>& axes,
-                          const std::vector<LocatedCondition>& conditions);
+                          const std::vector<LocatedCondition>& conditions,
+                          MachineKind kind = MachineKind::kDrill);
 
 }  // namespace edm::machining

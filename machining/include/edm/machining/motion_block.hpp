@@ -35,9 +35,12 @@ enum class MotionKind : std::uint8_t {
   kRotation = 8,   // M03 (`on` = true) / M05 (false): electrode rotation
   kFlushing = 9,   // M08 (`on` = true) / M09 (false)
   kEnd = 10,       // M02 / M30: end of program
+  kProgramStop = 11,  // M00 (`on` = false) / M01 optional stop (`on` = true): the job holds
+                      // with the generator off until the operator resumes (M01: only when the
+                      // job was started with optional stops on)
 };
 
-inline constexpr int kMotionKindCount = 11;
+inline constexpr int kMotionKindCount = 12;
 
 /// Stable lower-case names used by the protocol and in messages ("rapid", "drill", …).
 std::string_view to_string(MotionKind k) noexcept;
@@ -66,7 +69,9 @@ struct MotionBlock {
                                   // sparks, plus depth_done_mm)
   double final_radius_mm{0.0};    // kOrbitFinish: final hole radius (mm, absolute, > 0)
   double dwell_s{0.0};            // kDwell
-  bool on{false};                 // kRotation / kFlushing
+  bool on{false};                 // kRotation / kFlushing; kProgramStop: M01
+  bool cut{false};                // kLinear / kArcCw / kArcCcw on a wire machine while armed: a
+                                  // cut, its path speed set by the gap servo (feed_mm_s caps it)
   double electrode_ref_mm{0.0};   // the electrode length the block's Z assumes (its work frame's
                                   // Z was set with it): the job moves Z by the length lost since
                                   // (rt::Electrode); 0 = none (machine coordinates, or unknown)

@@ -21,6 +21,8 @@
 //                           (`job.manual.contact: io.contact`, …).
 //   probe   DepthProbe      cycle: a blind hole's depth measured by touch (depth_probe.hpp),
 //                           on with `probe: {enable: true}` and touch sensing wired
+//   wire    WireCut         cycle: a wire machine's cut blocks, fed along the path by the gap
+//                           servo on gap_voltage_v, back along it on a short (wire_cut.hpp)
 //   axes    AxisArbiter     who commands each axis: the safe state, manual motion, a running
 //                           cycle, the loops (axis_arbiter.hpp). Its vx/vy/vz_cmd_mm_s are the
 //                           job's axis commands (`io.vx_cmd: job.axes.vx_cmd_mm_s`).
@@ -90,6 +92,7 @@
 #include "edm/programs/manual_motion.hpp"
 #include "edm/programs/pulse_inputs.hpp"
 #include "edm/programs/wall_finish.hpp"
+#include "edm/programs/wire_cut.hpp"
 #include "edm/runtime/block.hpp"
 #include "edm/runtime/composite_block.hpp"
 #include "edm/runtime/electrode.hpp"
@@ -119,6 +122,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::Input<std::int64_t> n_transient_arc{pins_, "n_transient_arc"};
   rt::Input<std::int64_t> n_stable_arc{pins_, "n_stable_arc"};
   rt::Xyz<rt::Input<double>> pos{pins_, {"x_mm", "y_mm", "z_mm"}, "mm"};
+  rt::Input<double> gap_voltage_v{pins_, "gap_voltage_v", "V"};  // the cycle's mean (wire cuts)
   rt::Output<bool> gen_arm{pins_, "gen_arm"};
   rt::Output<bool> gen_on{pins_, "gen_on"};
   rt::Output<bool> polarity_positive{pins_, "polarity_positive"};
@@ -160,6 +164,10 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   bool run_drill(const machining::MotionBlock& b, const rt::CycleContext& ctx, bool hold,
                  rt::BlockStatus& status) noexcept;
   bool run_finish(const machining::MotionBlock& b, bool hold) noexcept;
+  /// A wire cut (edm_job_wire.cpp): the wire child feeds along the block's path.
+  bool run_cut(const machining::MotionBlock& b, const rt::CycleContext& ctx, bool hold) noexcept;
+  /// M00 / M01: the machine holds (the generator off) until the operator resumes.
+  bool run_program_stop(const rt::CycleContext& ctx) noexcept;
   /// Starts the drill child to `depth_mm`, its depth counted from `from`.
   void start_drill(double depth_mm, const DrillFrom& from) noexcept;
   void set_hold(bool hold) noexcept;  // the cycles' feed hold
@@ -190,6 +198,7 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   ManualMotion& manual_;
   DepthProbe& probe_;
   AxisArbiter& axes_;
+  WireCut& wire_;
   std::array<MachiningCycle*, 2> cycles_;
   rt::Machine* machine_{nullptr};
   rt::ManualControl* manual_control_{nullptr};
@@ -215,6 +224,8 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::TimePoint wait_until_{};
   const machining::Condition* condition_{nullptr};
   bool polarity_positive_value_{false};
+  bool cut_continuing_{false};  // the previous block was a cut: the wire's history goes on
+  bool cutting_{false};         // a cut runs this cycle (the generator's on)
   bool drill_returning_{false};  // the drill is done; rapid back to the block's start
   machining::MotionBlock drill_return_{};
   machining::MotionBlock probe_move_{};

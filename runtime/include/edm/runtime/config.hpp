@@ -181,6 +181,7 @@ struct ElectrodeSpec {
 
 struct MachineSpec {
   std::string name;
+  machining::MachineKind kind{machining::MachineKind::kDrill};  // `machine.kind`
   IoSpec io;
   ElectrodeSpec electrode;
   /// `machine.condition_edit`: the condition fields an operator may change on the running

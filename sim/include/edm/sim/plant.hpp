@@ -15,6 +15,7 @@
 #include "edm/sim/gap_model.hpp"
 #include "edm/sim/monitors.hpp"
 #include "edm/sim/params.hpp"
+#include "edm/sim/wire_plane.hpp"
 #include "edm/sim/work_geometry.hpp"
 
 namespace edm::sim {
@@ -133,6 +134,10 @@ class Plant {
   /// the electrode erodes first). Tube and block; for the wire, depth_mm is the cut length.
   /// RT-safe.
   void set_hole_mm(double x_mm, double y_mm, double depth_mm) noexcept;
+
+  /// The wire machine's plate in plan view (wire_plane): the truth a test measures a part on.
+  /// Inactive for the other tools and the 1-D wire.
+  [[nodiscard]] const WirePlane& wire_plane() const noexcept { return plane_; }
 
   /// Tube hole wall: radius of bin j (angle 2πj/kWallBins from +x) at the tip, mm.
   static constexpr std::size_t kWallBins = 64;
@@ -255,6 +260,13 @@ class Plant {
   bool touch_contact_{false};
   std::uint64_t touch_events_{0};  // contacts ended so far: keys the next threshold
   double touch_threshold_now_um_{0.0};
+
+  // The 2-D wire cut: the plate, and the removal it has not taken yet (it erodes every
+  // wire_erode_ms, not every pulse).
+  WirePlane plane_{};
+  double plane_pending_mm3_{0.0};
+  std::int64_t plane_erode_ns_{1'000'000};
+  std::int64_t plane_eroded_at_ns_{0};
 
   // Sensors and WEDM.
   RabWindow rab_{};
