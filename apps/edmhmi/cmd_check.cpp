@@ -52,6 +52,12 @@ int cmd_check(const CheckArgs& args) {
     for (const std::string& m : r.messages()) std::fprintf(stderr, "%s\n", m.c_str());
     return kExitBadInput;
   }
+  if (tables.kind == edm::machining::MachineKind::kWire) {
+    std::printf("%s: ok: %zu blocks, %d cut blocks, %.3f mm of cut path (machine %s, work offsets %s)\n",
+                part.c_str(), r.blocks.size(), r.cut_blocks, r.cut_length_mm, machine.c_str(),
+                args.offsets.empty() ? "zero" : args.offsets.c_str());
+    return kExitOk;
+  }
   std::printf(
       "%s: ok: %zu blocks, %d drilling blocks, %.3f mm drilled, estimated electrode wear %.3f mm "
       "(machine %s, work offsets %s)\n",

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "edm/machining/wear_precomp.hpp"
@@ -60,6 +61,21 @@ void Interpreter::push_move(const MotionBlock& mb, const Vec3& start) {
 }
 
 void Interpreter::push_now(const MotionBlock& mb) {
+  const Vec3 from = result_.blocks.empty() ? opt_.start_mm : result_.blocks.back().target;
+  if (mb.cut) {
+    ++result_.cut_blocks;
+    if (mb.kind == MotionKind::kLinear) {
+      result_.cut_length_mm += std::hypot(mb.target.x - from.x, mb.target.y - from.y);
+    } else {
+      const double r = std::hypot(from.x - mb.centre.x, from.y - mb.centre.y);
+      double sweep = std::atan2(mb.target.y - mb.centre.y, mb.target.x - mb.centre.x) -
+                     std::atan2(from.y - mb.centre.y, from.x - mb.centre.x);
+      const double turn = 2.0 * std::numbers::pi;
+      if (mb.kind == MotionKind::kArcCw) sweep = -sweep;
+      while (sweep <= 1e-12) sweep += turn;
+      result_.cut_length_mm += r * (sweep + turn * mb.turns);
+    }
+  }
   result_.blocks.push_back(mb);
   result_.frames.push_back(
       {.frame = static_cast<std::uint8_t>(frame_), .offset_mm = offset(), .g92 = g92_active_});

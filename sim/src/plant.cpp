@@ -393,6 +393,18 @@ void Plant::set_depth_mm(double h) noexcept {
   publish();
 }
 
+void Plant::break_wire() noexcept {
+  if (tool_ != Tool::kWire) return;
+  state_.wire_broken = true;
+  set_idle(state_.now.count());
+  publish();
+}
+
+void Plant::thread_wire() noexcept {
+  state_.wire_broken = false;
+  publish();
+}
+
 void Plant::set_debris(double c) noexcept {
   state_.debris = std::clamp(c, 0.0, 1.0);
   publish();

@@ -264,9 +264,9 @@ void SimDriver::enter_safe_state(const rt::SafeStateRequest& /*request*/) noexce
 }
 
 rt::IoFault SimDriver::fault() const noexcept {
-  if (plant_ && plant_->state().wire_broken) {
-    return {static_cast<int>(rt::AlarmCode::kWireBreak), "sim: wire broken"};
-  }
+  // A broken wire is the process's, not the driver's: io.wire_broken says it, and the
+  // supervisor's safety.wire_break makes it alarm 170 with its cause and remedy (every shipped
+  // wire config wires it). As a driver fault it came first as alarm 120, "I/O fault".
   return {};
 }
 

@@ -228,6 +228,17 @@ INSTANTIATE_TEST_SUITE_P(Shipped, DrillMachines, ::testing::Values("drill-sim", 
                                                                       : "FuzzyServo";
                          });
 
+TEST(Allocations, NoneInsideCyclesOfTheWireMachineCuttingAlongItsPath) {
+  // wire-sim.yaml (issue 34): EdmJob's wire cut (the gap servo along the path, its history ring)
+  // and the simulator's plate field eroded in 2-D. 4 s: the rapid, then the cut into the plate.
+  auto r = build_shipped("wire-sim");
+  ASSERT_EQ(r->job().load(edm::test::wire_job()), rt::LoadResult::kOk);
+  ASSERT_EQ(r->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
+  EXPECT_EQ(allocations_in_cycles(*r, 4000), 0u);
+  EXPECT_GT(r->variables().read("cnc.job.wire.block_done_mm").value(), 0.05) << "it cut";
+  EXPECT_GT(r->variables().read("io.depth_mm").value(), 0.0) << "material was removed";
+}
+
 // The operator's manual motion (issue 21) on drill-sim: a homing of Z (switch, back-off, latch,
 // encoder set), a distance jog, a continuous jog refreshed then stopped, and a touch-off of the
 // surface (touch mode, fast and slow approach) — every cycle of them counted. The requests are

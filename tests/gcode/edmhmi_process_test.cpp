@@ -54,6 +54,24 @@ TEST(EdmhmiCheck, BadProgramPrintsLocatedErrorsAndExitsTwo) {
       << r.output;
 }
 
+// Issue 34: on the wire machine the shipped punch passes and a program whose wire offset cannot be
+// applied (a concave arc smaller than E1's 0.2 mm offset) is refused at the arc's line:col.
+TEST(EdmhmiCheck, AWireOffsetThatCannotBeAppliedIsRefusedAtItsLine) {
+  const std::string wire = std::string(EDM_SOURCE_DIR) + "/config/machines/wire-sim.yaml";
+  const Outcome ok = edmhmi({"check", "--machine", wire, kParts + "wire-punch.nc"});
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  edm::test::TempDir dir;
+  const std::string part = dir.file("pocket.nc");
+  std::ofstream(part) << "G00 X-9 Y0\nE1 F3\nG41 G01 X-5 Y0\n  G03 X-5.2 Y0.2 I0 J0.2\n"
+                         "G40 G01 X-9 Y0\nE0\nM30\n";
+  const Outcome r = edmhmi({"check", "--machine", wire, part});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(part + ":4:3: the wire offset 0.200 mm cannot be applied: this concave "
+                                 "arc's radius 0.200 mm is not larger than the offset"),
+            std::string::npos)
+      << r.output;
+}
+
 TEST(EdmhmiCheck, MachineOptionSelectsTheConditionTable) {
   // sink-sim has no E2: the finishing example is refused there.
   const std::string sink = std::string(EDM_SOURCE_DIR) + "/config/machines/sink-sim.yaml";

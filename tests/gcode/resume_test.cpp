@@ -222,6 +222,9 @@ TEST(Resume, EveryLineOfEveryExampleResumesSafelyOrSaysWhyNot) {
       std::string(EDM_SOURCE_DIR) + "/config/machines/drill-sim.yaml");
   int resumed = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(EDM_SOURCE_DIR) / "examples/parts")) {
+    // The wire machine's parts are not the drill's (their resume after a wire break: issue 34,
+    // not built yet).
+    if (entry.path().filename().string().rfind("wire-", 0) == 0) continue;
     std::ifstream in(entry.path(), std::ios::binary);
     std::ostringstream ss;
     ss << in.rdbuf();

@@ -143,8 +143,8 @@ TEST(GcodeModalGroups, OneWordPerGroupPerBlock) {
             "t.nc:1:5: 'M09' conflicts with 'M08' in the same block: both are flushing codes "
             "(modal group 8: M08 M09)");
   EXPECT_EQ(first_error("M02 M30"),
-            "t.nc:1:5: 'M30' conflicts with 'M02' in the same block: both are program-end codes "
-            "(modal group 4: M02 M30)");
+            "t.nc:1:5: 'M30' conflicts with 'M02' in the same block: both are stop and end codes "
+            "(modal group 4: M00 M01 M02 M30)");
 }
 
 TEST(GcodeModalGroups, DifferentGroupsShareABlock) {

@@ -60,6 +60,8 @@ struct GcodeResult {
   double drill_depth_mm{0.0};      // Σ nominal lz of the drilling blocks
   double electrode_wear_mm{0.0};   // Σ δ (eq. 10) of the drilling blocks
   int drill_blocks{0};
+  int cut_blocks{0};          // wire machines: the cut blocks (compensated) ...
+  double cut_length_mm{0.0};  // ... and their path length
 
   [[nodiscard]] bool ok() const noexcept { return errors.empty(); }
   /// Every error as "file:line:col: message", in file order.

@@ -25,7 +25,7 @@
 namespace edm::programs {
 
 struct WireCutParams {
-  double kv_mm_s_per_v{0.0005};   // [mm/s/V] path speed per volt above the servo reference
+  double kv_mm_s_per_v{0.003};    // [mm/s/V] path speed per volt above the servo reference
   rt::Duration u_tau{std::chrono::milliseconds(5)};  // U_f filter
   double back_speed_mm_s{0.1};    // [mm/s] back along the path on a short
   double back_min_mm{0.02};       // [mm] a short backs up at least this far

@@ -122,6 +122,11 @@ class Plant {
   /// Every pulse that begins within `duration` from the plant's time now is a short (a hard
   /// contact for that long, whatever the gap): the safety tests' short bursts. RT-safe.
   void inject_short(edm::rt::Duration duration) noexcept;
+  /// The wire breaks now (the safety tests' wire break, whatever the rupture model says): the
+  /// generator stops, wire_broken holds until the wire is threaded again. RT-safe.
+  void break_wire() noexcept;
+  /// The wire is threaded again (an operator's rethread): wire_broken clears. RT-safe.
+  void thread_wire() noexcept;
   /// The electrode now measures `mm` (a retained length restored at start, an electrode
   /// change): the wear becomes electrode_length_mm − mm, so the tip sits that much above where a
   /// new electrode's would. RT-safe.
