@@ -53,9 +53,10 @@ int cmd_check(const CheckArgs& args) {
     return kExitBadInput;
   }
   if (tables.kind == edm::machining::MachineKind::kWire) {
-    std::printf("%s: ok: %zu blocks, %d cut blocks, %.3f mm of cut path (machine %s, work offsets %s)\n",
-                part.c_str(), r.blocks.size(), r.cut_blocks, r.cut_length_mm, machine.c_str(),
-                args.offsets.empty() ? "zero" : args.offsets.c_str());
+    std::printf(
+        "%s: ok: %zu blocks, %d cut blocks, %.3f mm of cut path (machine %s, work offsets %s)\n",
+        part.c_str(), r.blocks.size(), r.cut_blocks, r.cut_length_mm, machine.c_str(),
+        args.offsets.empty() ? "zero" : args.offsets.c_str());
     return kExitOk;
   }
   std::printf(

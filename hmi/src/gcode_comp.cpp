@@ -60,10 +60,10 @@ P2 tangent(const CompMove& m, P2 p) {
 struct WireOffset::Element {
   bool arc{false};
   bool ccw{false};
-  P2 p, u;     // line
-  P2 c;        // arc centre
+  P2 p, u;  // line
+  P2 c;     // arc centre
   double r{0.0};
-  P2 a, b;     // extent: from a to b
+  P2 a, b;  // extent: from a to b
 
   /// Whether q (on the line or circle) lies within the extent.
   [[nodiscard]] bool holds(P2 q) const {
@@ -158,8 +158,10 @@ std::optional<CompError> WireOffset::move(const CompMove& m, std::vector<MotionB
     const double rr = m.b.kind == MotionKind::kArcCcw ? r - s * d_ : r + s * d_;
     if (!(rr > kOnTol)) {
       return CompError{m.b.line, m.b.col,
-                       "the wire offset " + mm3(d_) + " mm cannot be applied: this concave arc's "
-                       "radius " + mm3(r) + " mm is not larger than the offset"};
+                       "the wire offset " + mm3(d_) +
+                           " mm cannot be applied: this concave arc's "
+                           "radius " +
+                           mm3(r) + " mm is not larger than the offset"};
     }
   }
   if (lead_in_) {
@@ -182,7 +184,8 @@ std::optional<CompError> WireOffset::move(const CompMove& m, std::vector<MotionB
   if (auto e = join(*pending_, m, out)) return e;
   if (stopping_) {
     if (norm(xy(m.b.target) - xy(pending_from_)) <= kOnTol) {
-      return CompError{m.b.line, m.b.col, "the lead-out move is too short to switch the offset off"};
+      return CompError{m.b.line, m.b.col,
+                       "the lead-out move is too short to switch the offset off"};
     }
     out.push_back(m.b);  // from the junction to the programmed (uncompensated) end
     pending_.reset();
@@ -253,8 +256,9 @@ std::optional<CompError> WireOffset::join(const CompMove& a, const CompMove& b,
     }
     if (!found) {
       return CompError{b.b.line, b.b.col,
-                       "the wire offset " + mm3(d_) + " mm cannot be applied at this inside "
-                       "corner: a move next to it is too short for the offset"};
+                       "the wire offset " + mm3(d_) +
+                           " mm cannot be applied at this inside "
+                           "corner: a move next to it is too short for the offset"};
     }
     finish(best);
     pending_from_ = {best.x, best.y, b.from.z};

@@ -52,8 +52,7 @@ class WireOffset {
  private:
   std::optional<CompError> join(const CompMove& a, const CompMove& b,
                                 std::vector<machining::MotionBlock>& out);
-  void emit(const CompMove& m, machining::Vec3 to,
-            std::vector<machining::MotionBlock>& out) const;
+  void emit(const CompMove& m, machining::Vec3 to, std::vector<machining::MotionBlock>& out) const;
 
   int side_{0};
   double d_{0.0};

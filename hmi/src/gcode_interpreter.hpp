@@ -6,11 +6,10 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <map>
 
 #include "edm/hmi/gcode.hpp"
 #include "gcode_block.hpp"

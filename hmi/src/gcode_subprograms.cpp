@@ -46,8 +46,9 @@ void Interpreter::scan_subprograms() {
     const int line = static_cast<int>(i + 1);
     if (o_word) {
       if (open.o_line != 0) {
-        error(line, w.col, "subprogram definitions do not nest: O" + std::to_string(open_n) +
-                               " (line " + std::to_string(open.o_line) + ") has no M99 yet");
+        error(line, w.col,
+              "subprogram definitions do not nest: O" + std::to_string(open_n) + " (line " +
+                  std::to_string(open.o_line) + ") has no M99 yet");
         continue;
       }
       if (lexed.words.size() != 1) {

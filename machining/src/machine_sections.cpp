@@ -85,9 +85,9 @@ std::optional<char> read_axis(yaml::Reader& r, const Value& v, LocatedAxis& out,
 SourceLoc read_condition(yaml::Reader& r, const Value& v, LocatedCondition& out) {
   out.loc = v.loc;
   SourceLoc e_loc = v.loc;
-  auto m = r.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
-                     "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio", "area_ratio",
-                     "offset_mm"});
+  auto m =
+      r.map(v, {"E", "name", "polarity", "open_voltage_v", "peak_current_a", "on_time_us",
+                "off_time_us", "tdr_us", "servo_ref_v", "wear_ratio", "area_ratio", "offset_mm"});
   if (!m) {
     return e_loc;
   }

@@ -8,7 +8,7 @@ namespace edm::machining {
 namespace {
 constexpr std::array<std::string_view, kMotionKindCount> kNames{
     "rapid", "linear",    "arc_cw",   "arc_ccw",  "drill", "orbit_finish",
-    "dwell", "condition", "rotation", "flushing", "end", "program_stop"};
+    "dwell", "condition", "rotation", "flushing", "end",   "program_stop"};
 }  // namespace
 
 std::string_view to_string(MotionKind k) noexcept { return enum_name(kNames, k); }

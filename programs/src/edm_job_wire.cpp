@@ -15,10 +15,9 @@ bool EdmJob::run_cut(const machining::MotionBlock& b, const rt::CycleContext& ct
     step_ = Step::kBusy;
   }
   const std::int64_t n_short = pulses.n_short.get();
-  const std::int64_t n = pulses.n_open.get() + n_normal.get() + n_transient_arc.get() +
-                         n_stable_arc.get() + n_short;
-  const double cap =
-      (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s) * feed_override_;
+  const std::int64_t n =
+      pulses.n_open.get() + n_normal.get() + n_transient_arc.get() + n_stable_arc.get() + n_short;
+  const double cap = (b.feed_mm_s > 0.0 ? b.feed_mm_s : params_.feed_default_mm_s) * feed_override_;
   const double u_ref = condition_ != nullptr ? condition_->servo_ref_v : 0.0;
   const bool done = wire_.step(ctx.dt_s, gap_voltage_v.get(), u_ref, n_short, n, cap, hold);
   set_reference(wire_.ref_x(), wire_.ref_y(), hold_z_, wire_.v_x(), wire_.v_y(), 0.0);

@@ -146,8 +146,8 @@ bool WireCut::step(double dt_s, double gap_voltage_v, double servo_ref_v, std::i
   } else {
     u_f_ += (gap_voltage_v - u_f_) * (tau > 0.0 ? std::min(1.0, dt_s / tau) : 1.0);
   }
-  const bool is_short =
-      n_pulses > 0 && static_cast<double>(n_short) >= params_.short_fraction * static_cast<double>(n_pulses);
+  const bool is_short = n_pulses > 0 && static_cast<double>(n_short) >=
+                                            params_.short_fraction * static_cast<double>(n_pulses);
   shorted.set(is_short);
   if (is_short && retreat_ <= 0.0) {
     shorts.set(shorts.get() + 1);

@@ -21,8 +21,8 @@ std::optional<std::string> Parser::identifier(const Value& v, const char* what) 
 
 void Parser::parse_machine(const Value& v, MachineSpec& out) {
   out.loc = v.loc;
-  auto m = r_.map(v, {"name", "kind", "io", "electrode", "condition_edit", "axes", "safety",
-                        "realtime"});
+  auto m = r_.map(
+      v, {"name", "kind", "io", "electrode", "condition_edit", "axes", "safety", "realtime"});
   if (!m) {
     return;
   }

@@ -72,8 +72,9 @@ std::vector<rt::ParamError> SimParams::cross_field_errors() const {
     if (!(w > 0.0 && hgt > 0.0)) {
       e.push_back({"wire_plate_x_max_mm", "the plate must have a positive extent in X and Y"});
     } else if ((w + 1.0) * (hgt + 1.0) / (wire_grid_um * wire_grid_um * 1e-6) > 64e6) {
-      e.push_back({"wire_grid_um", "the plate's field would exceed 64 M cells: a coarser grid "
-                                   "or a smaller plate"});
+      e.push_back({"wire_grid_um",
+                   "the plate's field would exceed 64 M cells: a coarser grid "
+                   "or a smaller plate"});
     }
     if (wire_void_d_mm > 0.0 && !(wire_void_height_mm < wire_plate_mm)) {
       e.push_back({"wire_void_height_mm", "must be < wire_plate_mm"});

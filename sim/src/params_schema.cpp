@@ -289,7 +289,8 @@ void SimParams::visit_wire(rt::ParamVisitor& v) {
   v.param("wire_plate_x_max_mm", wire_plate_x_max_mm, {"mm", "2-D: plate extent, machine X max"});
   v.param("wire_plate_y_min_mm", wire_plate_y_min_mm, {"mm", "2-D: plate extent, machine Y min"});
   v.param("wire_plate_y_max_mm", wire_plate_y_max_mm, {"mm", "2-D: plate extent, machine Y max"});
-  v.param("wire_grid_um", wire_grid_um, {"um", "2-D: material field pitch", rt::closed(1.0, 100.0)});
+  v.param("wire_grid_um", wire_grid_um,
+          {"um", "2-D: material field pitch", rt::closed(1.0, 100.0)});
   v.param("wire_start_hole_x_mm", wire_start_hole_x_mm, {"mm", "2-D: start hole centre X"});
   v.param("wire_start_hole_y_mm", wire_start_hole_y_mm, {"mm", "2-D: start hole centre Y"});
   v.param("wire_start_hole_d_mm", wire_start_hole_d_mm,

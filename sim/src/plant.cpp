@@ -137,7 +137,8 @@ void Plant::step_axes(std::int64_t t_ns) noexcept {
     axes_[2].reset(hold_gap_um_ * 1e-3 + bottom_mm() - wear_length_mm_);
   } else {
     double vz = cmd_.vz_mm_s;
-    if (cmd_.servo_ref_v > 0.0 && !plane_.active()) {  // the machine's own servo: advance while U_av > reference
+    if (cmd_.servo_ref_v > 0.0 &&
+        !plane_.active()) {  // the machine's own servo: advance while U_av > reference
       vz -= params_.servo_gain_mm_s_per_v * (state_.gap_voltage_filtered_v - cmd_.servo_ref_v);
     }
     axes_[2].step(vz, dt);

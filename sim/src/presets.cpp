@@ -1,7 +1,7 @@
 #include "edm/sim/params.hpp"
 
-// The named presets of the simulator (drill, sink, wire, wire-xy): SimParams defaults are DRILL; the others
-// change what differs. The schema and its validation are params.cpp.
+// The named presets of the simulator (drill, sink, wire, wire-xy): SimParams defaults are DRILL;
+// the others change what differs. The schema and its validation are params.cpp.
 
 #include <optional>
 #include <string>

@@ -8,7 +8,7 @@ namespace edm::sim {
 namespace {
 
 constexpr double kMarginMm = 0.5;  // grid beyond the plate: void
-constexpr double kFarMm = 2.0;     // |φ| is clamped here (only the boundary's neighbourhood counts)
+constexpr double kFarMm = 2.0;  // |φ| is clamped here (only the boundary's neighbourhood counts)
 constexpr double kReuseMm = 0.001;  // the cached boundary point serves within this distance
 
 }  // namespace
@@ -128,8 +128,7 @@ double WirePlane::clearance_mm(double x, double y) const noexcept {
 double WirePlane::cut_thickness_mm(double x, double y) const noexcept {
   double h = g_.thickness_mm;
   if (g_.step_mm != 0.0 && x >= g_.step_x_mm) h += g_.step_mm;
-  if (g_.void_d_mm > 0.0 &&
-      std::hypot(x - g_.void_x_mm, y - g_.void_y_mm) < g_.void_d_mm / 2.0) {
+  if (g_.void_d_mm > 0.0 && std::hypot(x - g_.void_x_mm, y - g_.void_y_mm) < g_.void_d_mm / 2.0) {
     h -= g_.void_height_mm;
   }
   return std::max(h, 1e-3);
@@ -147,6 +146,12 @@ double WirePlane::erode(double x, double y, double reach_mm, double volume_mm3) 
     }
     if (hits > 0) break;
     rho += h_;
+  }
+  // A sliver thinner than the samples' spacing (19 µm at the wire's radius) may fall between
+  // them: the clearance says material is there, so it is one sample's arc.
+  if (hits == 0 && d <= reach_mm) {
+    hits = 1;
+    rho = d + 0.5 * h_;
   }
   if (hits == 0) return volume_mm3;  // nothing to remove within reach
   const double engaged_mm = 2.0 * std::numbers::pi * rho * hits / kDirections;

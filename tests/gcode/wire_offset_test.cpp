@@ -44,8 +44,7 @@ std::vector<MotionBlock> moves(const GcodeResult& r) {
   return out;
 }
 
-const char* kSquare =
-    "E1 F3\nG41 G01 X-5 Y0\nY5\nX5\nY-5\nX-5\nY0\nG40 X-9 Y0\n";
+const char* kSquare = "E1 F3\nG41 G01 X-5 Y0\nY5\nX5\nY-5\nX-5\nY0\nG40 X-9 Y0\n";
 
 TEST(WireOffset, ASquareIsOffsetByTheConditionsOffsetWithArcsAtItsOutsideCorners) {
   const GcodeResult r = wire(kSquare);
@@ -66,8 +65,7 @@ TEST(WireOffset, ASquareIsOffsetByTheConditionsOffsetWithArcsAtItsOutsideCorners
     EXPECT_EQ(m[k].kind, MotionKind::kArcCw) << k;
     EXPECT_NEAR(std::fabs(m[k].centre.x), 5, 1e-12) << k;
     EXPECT_NEAR(std::fabs(m[k].centre.y), 5, 1e-12) << k;
-    EXPECT_NEAR(std::hypot(m[k].target.x - m[k].centre.x, m[k].target.y - m[k].centre.y), d,
-                1e-12);
+    EXPECT_NEAR(std::hypot(m[k].target.x - m[k].centre.x, m[k].target.y - m[k].centre.y), d, 1e-12);
   }
   // The lead-in ends on the offset left edge, where the lead-in's own offset line crosses it.
   EXPECT_NEAR(m[0].target.x, -5 - d, 1e-12);
@@ -147,7 +145,8 @@ TEST(WireOffset, RandomConvexPolygonsAreOffsetExactly) {
       const auto [x0, y0] = p[static_cast<std::size_t>((v + n - 1) % n)];
       const auto [x1, y1] = p[static_cast<std::size_t>(v)];
       const double len = std::hypot(x1 - x0, y1 - y0);
-      const double dist = ((x1 - x0) * (m[k].target.y - y0) - (y1 - y0) * (m[k].target.x - x0)) / len;
+      const double dist =
+          ((x1 - x0) * (m[k].target.y - y0) - (y1 - y0) * (m[k].target.x - x0)) / len;
       EXPECT_NEAR(dist, -d, 1e-5) << "edge of line " << m[k].line << "\n" << prog;
     }
   }

@@ -2,11 +2,11 @@
 // punch measured from the simulator's truth after each pass.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
-#include <chrono>
 #include <string>
 
 #include "wire_rig.hpp"
@@ -18,47 +18,69 @@ std::string punch_program() {
   return read_text(std::string(EDM_SOURCE_DIR) + "/examples/parts/wire-punch.nc");
 }
 
-// EDM_WIRE_SEEDS=1000-1004 prints the calibration (the offsets of wire-sim.yaml's conditions).
-std::pair<int, int> seeds(int lo, int hi) {
-  if (const char* s = std::getenv("EDM_WIRE_SEEDS")) {
-    int a = lo, b = hi;
-    if (std::sscanf(s, "%d-%d", &a, &b) == 2) return {a, b};
-  }
-  return {lo, hi};
-}
-
 void print(const char* what, int seed, const PunchSize& s) {
   // The corner's error: its distance from the centre along the diagonal less a sharp corner's
   // for the punch's own size (negative: rounded off).
   const double half = (s.x_min + s.x_max + s.y_min + s.y_max) / 8.0;
   std::printf("seed %d %s: X %.4f..%.4f Y %.4f..%.4f mm, corner %+.4f mm\n", seed, what, s.x_min,
               s.x_max, s.y_min, s.y_max, s.corner_mm - half * std::sqrt(2.0));
+  std::fflush(stdout);
 }
 
-TEST(WirePunch, TheSquarePunchIsTenMillimetresAfterTheLastSkim) {
-  const auto [lo, hi] = seeds(1, 5);
+// Runs the punch on `seed`, printing its size after each pass; the run's end state. Under a
+// sanitizer (about 10x slower; it looks for memory errors, not figures) only the first
+// `sanitizer_s` of the main cut run.
+WireRun& cut_punch(WireRun& run, int seed, double limit_s) {
+  const bool verbose = std::getenv("EDM_WIRE_VERBOSE") != nullptr;
+  double line = 0.0;
+  run.run(limit_s, [&](WireRun& r) {
+    const double now = r.read("cnc.job.line");
+    if (now != line && (now == 10.0 || now == 11.0)) {  // a skim begins: the pass before
+      print(now == 10.0 ? "main cut" : "skim 1", seed, measure_punch(r.plant().wire_plane(), 0, 0));
+    }
+    line = now;
+    if (verbose && r.k % 5000 == 0) std::printf("%s\n", r.where().c_str());
+  });
+  return run;
+}
+
+#if defined(EDM_UNDER_SANITIZER)
+constexpr bool kSanitizer = true;
+#else
+constexpr bool kSanitizer = false;
+#endif
+constexpr double kSanitizerSeconds = 60.0;
+
+// The acceptance: examples/parts/wire-punch.nc on wire-sim, the punch 10.000 mm ± 5 µm on both
+// sides after the last skim, scoring seeds 1-5 (the offsets were calibrated on 1000-1002: run
+// the calibration with EDM_WIRE_SEEDS=1000-1002 and --gtest_filter='WirePunchCalibration.*').
+class WirePunch : public ::testing::TestWithParam<int> {};
+
+TEST_P(WirePunch, IsTenMillimetresAfterTheLastSkim) {
+  const int seed = GetParam();
+  WireRun run(seed, punch_program());
+  cut_punch(run, seed, kSanitizer ? kSanitizerSeconds : 3600.0 * 3);
+  if (kSanitizer) {
+    EXPECT_GT(run.read("io.depth_mm"), 0.1) << "it cut; " << run.where();
+    return;
+  }
+  ASSERT_TRUE(run.finished) << "seed " << seed << " " << run.where();
+  const PunchSize s = measure_punch(run.plant().wire_plane(), 0.0, 0.0);
+  print("skim 2", seed, s);
+  for (double w : {s.x_min, s.x_max, s.y_min, s.y_max}) EXPECT_NEAR(w, 10.0, 0.005) << seed;
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, WirePunch, ::testing::Range(1, kSanitizer ? 2 : 6));
+
+TEST(WirePunchCalibration, PrintsTheSizesOnTheTuningSeeds) {
+  const char* s = std::getenv("EDM_WIRE_SEEDS");
+  int lo = 0, hi = 0;
+  if (s == nullptr || std::sscanf(s, "%d-%d", &lo, &hi) != 2) GTEST_SKIP() << "EDM_WIRE_SEEDS";
   for (int seed = lo; seed <= hi; ++seed) {
     WireRun run(seed, punch_program());
-    const bool verbose = std::getenv("EDM_WIRE_VERBOSE") != nullptr;
-    double line = 0.0;
-    run.run(3600.0 * 3, [&](WireRun& r) {
-      const double now = r.read("cnc.job.line");
-      if (now != line && (now == 10.0 || now == 11.0)) {  // a skim begins: the pass before
-        print(now == 10.0 ? "main cut" : "skim 1", seed, measure_punch(r.plant().wire_plane(), 0, 0));
-      }
-      line = now;
-      if (verbose && r.k % 5000 == 0) {
-        std::printf("t %.0f line %.0f x %.4f y %.4f v %.4f back %.4f U %.1f gap %.1f\n",
-                    static_cast<double>(r.k) * 1e-3, now, r.read("io.x_mm"), r.read("io.y_mm"),
-                    r.read("cnc.job.wire.path_speed_mm_s"), r.read("cnc.job.wire.back_mm"),
-                    r.read("io.gap_voltage_v"), r.read("io.true_gap_um"));
-      }
-    });
-    ASSERT_TRUE(run.finished) << "seed " << seed << " " << run.where();
-    const PunchSize s = measure_punch(run.plant().wire_plane(), 0.0, 0.0);
-    print("skim 2", seed, s);
-    std::printf("seed %d: %.1f s\n", seed, static_cast<double>(run.k) * 1e-3);
-    for (double w : {s.x_min, s.x_max, s.y_min, s.y_max}) EXPECT_NEAR(w, 10.0, 0.005) << seed;
+    cut_punch(run, seed, 3600.0 * 3);
+    ASSERT_TRUE(run.finished) << run.where();
+    print("skim 2", seed, measure_punch(run.plant().wire_plane(), 0.0, 0.0));
   }
 }
 
@@ -68,9 +90,10 @@ TEST(WirePunch, TheSquarePunchIsTenMillimetresAfterTheLastSkim) {
 TEST(WireCut, AContactBacksTheWireAlongThePathAcrossACornerNeverForwardWhileShort) {
   WireRun run(6, punch_program());
   bool injected = false;
+  const double limit_s = kSanitizer ? 200.0 : 3600.0 * 3;  // the contact comes at ≈ 176 s
   std::int64_t inject_k = 0, forward_while_short = 0, short_cycles = 0;
   double y_min_after = 1e9, x_off_path = 0.0;
-  run.run(3600.0 * 3, [&](WireRun& r) {
+  run.run(limit_s, [&](WireRun& r) {
     const double x = r.read("io.x_mm"), y = r.read("io.y_mm");
     // On the top edge's offset (y 5.2), 20 µm past the corner arc's end (x −5), in the main cut.
     if (!injected && r.read("cnc.job.line") == 18.0 && y > 5.19 && x > -4.98) {
@@ -89,6 +112,7 @@ TEST(WireCut, AContactBacksTheWireAlongThePathAcrossACornerNeverForwardWhileShor
     }
   });
   ASSERT_TRUE(injected);
+  if (kSanitizer) return;
   ASSERT_TRUE(run.finished) << run.where();
   EXPECT_GT(short_cycles, 1000) << "the contact held the gap short";
   EXPECT_EQ(forward_while_short, 0);

@@ -47,10 +47,10 @@ struct PunchSize {
 inline PunchSize measure_punch(const sim::WirePlane& plane, double cx, double cy) {
   PunchSize s;
   for (double off : {-2.5, 2.5}) {
-    const double wx = plane.edge_along_mm(cx, cy + off, 1, 0, 20) +
-                      plane.edge_along_mm(cx, cy + off, -1, 0, 20);
-    const double wy = plane.edge_along_mm(cx + off, cy, 0, 1, 20) +
-                      plane.edge_along_mm(cx + off, cy, 0, -1, 20);
+    const double wx =
+        plane.edge_along_mm(cx, cy + off, 1, 0, 20) + plane.edge_along_mm(cx, cy + off, -1, 0, 20);
+    const double wy =
+        plane.edge_along_mm(cx + off, cy, 0, 1, 20) + plane.edge_along_mm(cx + off, cy, 0, -1, 20);
     s.x_min = std::min(s.x_min, wx);
     s.x_max = std::max(s.x_max, wx);
     s.y_min = std::min(s.y_min, wy);
@@ -95,7 +95,8 @@ struct WireRun {
   double read(const char* name) { return vars().read(name).value(); }
 
   /// Starts the job and runs it until it finishes, the machine falls into a safe state, or
-  /// `limit_s` (100 ms after a safe state began); M00/M01 holds are resumed at once. `each` sees every motion cycle.
+  /// `limit_s` (100 ms after a safe state began); M00/M01 holds are resumed at once. `each` sees
+  /// every motion cycle.
   void run(double limit_s, const std::function<void(WireRun&)>& each = {}) {
     EXPECT_EQ(runtime->machine().command(rt::MachineCommand::kStart), rt::CommandResult::kOk);
     rt::Task& motion = *runtime->tasks()[0];

@@ -224,8 +224,8 @@ class EdmJob final : public rt::BlockWithParams<EdmJobParams, rt::CompositeBlock
   rt::TimePoint wait_until_{};
   const machining::Condition* condition_{nullptr};
   bool polarity_positive_value_{false};
-  bool cut_continuing_{false};  // the previous block was a cut: the wire's history goes on
-  bool cutting_{false};         // a cut runs this cycle (the generator's on)
+  bool cut_continuing_{false};   // the previous block was a cut: the wire's history goes on
+  bool cutting_{false};          // a cut runs this cycle (the generator's on)
   bool drill_returning_{false};  // the drill is done; rapid back to the block's start
   machining::MotionBlock drill_return_{};
   machining::MotionBlock probe_move_{};

@@ -25,12 +25,12 @@
 namespace edm::programs {
 
 struct WireCutParams {
-  double kv_mm_s_per_v{0.003};    // [mm/s/V] path speed per volt above the servo reference
+  double kv_mm_s_per_v{0.003};  // [mm/s/V] path speed per volt above the servo reference
   rt::Duration u_tau{std::chrono::milliseconds(5)};  // U_f filter
-  double back_speed_mm_s{0.1};    // [mm/s] back along the path on a short
-  double back_min_mm{0.02};       // [mm] a short backs up at least this far
-  double ramp_mm_s2{2.0};         // [mm/s²] rise of the forward speed
-  double short_fraction{0.5};     // a cycle with this share of shorts reads short
+  double back_speed_mm_s{0.1};                       // [mm/s] back along the path on a short
+  double back_min_mm{0.02};                          // [mm] a short backs up at least this far
+  double ramp_mm_s2{2.0};                            // [mm/s²] rise of the forward speed
+  double short_fraction{0.5};  // a cycle with this share of shorts reads short
 
   void visit(rt::ParamVisitor& v);
 };
@@ -42,10 +42,10 @@ class WireCut final : public rt::BlockWithParams<WireCutParams> {
   static_assert((kHistoryPoints & (kHistoryPoints - 1)) == 0);
 
   rt::Output<double> path_speed_mm_s{pins_, "path_speed_mm_s", "mm/s"};
-  rt::Output<double> back_mm{pins_, "back_mm", "mm"};    // behind the furthest point cut
+  rt::Output<double> back_mm{pins_, "back_mm", "mm"};              // behind the furthest point cut
   rt::Output<double> block_done_mm{pins_, "block_done_mm", "mm"};  // of the block running
-  rt::Output<std::int64_t> shorts{pins_, "shorts"};      // back-ups since activation
-  rt::Output<bool> shorted{pins_, "shorted"};            // the gap reads short this cycle
+  rt::Output<std::int64_t> shorts{pins_, "shorts"};                // back-ups since activation
+  rt::Output<bool> shorted{pins_, "shorted"};                      // the gap reads short this cycle
 
   void activate() noexcept override;
   rt::BlockStatus update(const rt::CycleContext& /*ctx*/) noexcept override {
@@ -79,10 +79,10 @@ class WireCut final : public rt::BlockWithParams<WireCutParams> {
   double x0_{0.0}, y0_{0.0}, x1_{0.0}, y1_{0.0}, cx_{0.0}, cy_{0.0};
   double r_{0.0}, a0_{0.0}, sweep_{0.0};  // arc: radius, start angle, signed sweep (rad)
   double length_{0.0};
-  double s_{0.0};       // the frontier along the block
-  double back_{0.0};    // how far behind the frontier the wire is
+  double s_{0.0};        // the frontier along the block
+  double back_{0.0};     // how far behind the frontier the wire is
   double retreat_{0.0};  // a short's back-up still to make
-  double v_{0.0};       // path speed now (negative: backing up)
+  double v_{0.0};        // path speed now (negative: backing up)
   double u_f_{0.0};
   bool u_init_{false};
   double since_push_{0.0};  // path length since the newest history point

@@ -231,17 +231,17 @@ struct SimParams {
   // signed-distance field eroded by the pulses (WirePlane); Z is the upper guide's height and
   // plays no part. The 1-D profile, hole and cavity above (cut-length keyed) are not used.
   bool wire_plane{false};
-  double wire_plate_mm{20.0};  // thickness
+  double wire_plate_mm{20.0};                                    // thickness
   double wire_plate_x_min_mm{-15.0}, wire_plate_x_max_mm{15.0};  // extent, machine XY
   double wire_plate_y_min_mm{-15.0}, wire_plate_y_max_mm{15.0};
-  double wire_grid_um{10.0};                     // field pitch
+  double wire_grid_um{10.0};  // field pitch
   double wire_start_hole_x_mm{0.0}, wire_start_hole_y_mm{0.0};
-  double wire_start_hole_d_mm{0.0};              // 0: none (cut from the plate's edge)
+  double wire_start_hole_d_mm{0.0};               // 0: none (cut from the plate's edge)
   double wire_step_x_mm{0.0}, wire_step_mm{0.0};  // x >= step_x: thickness + step
   double wire_void_x_mm{0.0}, wire_void_y_mm{0.0};
   double wire_void_d_mm{0.0}, wire_void_height_mm{0.0};  // an internal void (0: none)
-  double wire_reach_um{60.0};     // discharges reach material this far from the wire's surface
-  double wire_erode_ms{2.0};      // the field takes the pulses' removal this often
+  double wire_reach_um{60.0};  // discharges reach material this far from the wire's surface
+  double wire_erode_ms{2.0};   // the field takes the pulses' removal this often
 
   // --- Sensors (§6.2 step 8) ---
   double rab_window_ms{40.0};

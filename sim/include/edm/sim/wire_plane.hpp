@@ -25,12 +25,12 @@ struct WirePlaneGeometry {
   double x_min_mm{-15.0}, x_max_mm{15.0};  // the plate, machine XY
   double y_min_mm{-15.0}, y_max_mm{15.0};
   double thickness_mm{20.0};
-  double cell_mm{0.01};                            // grid pitch
-  double hole_x_mm{0.0}, hole_y_mm{0.0};           // the start hole's centre ...
-  double hole_d_mm{0.0};                           // ... and diameter (0: none)
-  double step_x_mm{0.0}, step_mm{0.0};             // x >= step_x: thickness + step (0: none)
-  double void_x_mm{0.0}, void_y_mm{0.0};           // an internal void's centre ...
-  double void_d_mm{0.0}, void_height_mm{0.0};      // ... diameter and height (0: none)
+  double cell_mm{0.01};                        // grid pitch
+  double hole_x_mm{0.0}, hole_y_mm{0.0};       // the start hole's centre ...
+  double hole_d_mm{0.0};                       // ... and diameter (0: none)
+  double step_x_mm{0.0}, step_mm{0.0};         // x >= step_x: thickness + step (0: none)
+  double void_x_mm{0.0}, void_y_mm{0.0};       // an internal void's centre ...
+  double void_d_mm{0.0}, void_height_mm{0.0};  // ... diameter and height (0: none)
 };
 
 class WirePlane {
