@@ -408,7 +408,7 @@ bool EdmJob::run_block(const MotionBlock& b, const rt::CycleContext& ctx, bool h
     case MotionKind::kArcCcw:
       if (b.cut && !dry_run.get()) return run_cut(b, ctx, hold);
       return run_arc(b, ctx, hold, status);
-    case MotionKind::kProgramStop: return run_program_stop(ctx);
+    case MotionKind::kProgramStop: return b.on || run_program_stop(ctx);  // M01: no switch yet
     case MotionKind::kDrill:
       return dry_run.get() || run_drill(b, ctx, hold, status);  // a dry run skips it
     case MotionKind::kOrbitFinish: return dry_run.get() || run_finish(b, hold);

@@ -35,9 +35,9 @@ enum class MotionKind : std::uint8_t {
   kRotation = 8,   // M03 (`on` = true) / M05 (false): electrode rotation
   kFlushing = 9,   // M08 (`on` = true) / M09 (false)
   kEnd = 10,       // M02 / M30: end of program
-  kProgramStop = 11,  // M00 (`on` = false) / M01 optional stop (`on` = true): the job holds
-                      // with the generator off until the operator resumes (M01: only when the
-                      // job was started with optional stops on)
+  kProgramStop = 11,  // M00 (`on` = false): the job holds with the generator off until the
+                      // operator resumes; M01 (`on` = true), the optional stop, is skipped (there
+                      // is no optional-stop switch yet)
 };
 
 inline constexpr int kMotionKindCount = 12;
