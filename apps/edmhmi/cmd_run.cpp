@@ -143,7 +143,12 @@ int cmd_run(const RunArgs& args, const edm::hmi::ConnectionSettings& settings) {
     for (const std::string& m : g.messages()) std::fprintf(stderr, "%s\n", m.c_str());
     return kExitBadInput;
   }
-  if (!quiet) {
+  if (!quiet && machine.tables.kind == edm::machining::MachineKind::kWire) {
+    std::fprintf(stderr,
+                 "edmhmi: %s: %zu blocks (%d cut blocks, %.3f mm of cut path) → %s at %s:%u\n",
+                 part.c_str(), g.blocks.size(), g.cut_blocks, g.cut_length_mm, machine.name.c_str(),
+                 settings.host.c_str(), unsigned{settings.port});
+  } else if (!quiet) {
     std::fprintf(stderr,
                  "edmhmi: %s: %zu blocks (%d drilling, %.3f mm, estimated electrode wear %.3f "
                  "mm) → %s at %s:%u\n",
