@@ -148,5 +148,43 @@ TEST(WireCut, AWireBreakMidCutIsTheSafeStateWithAlarm170) {
   EXPECT_EQ(run.runtime->job().progress().outcome, rt::JobOutcome::kAborted);
 }
 
+// Centre finding with the wire by electrical contact (issue 34 item 1): from off the centre of
+// the Ø1 start hole at X-9 Y0 (the simulator's truth), touch X± and Y± and end at the centre.
+TEST(WireMachine, TheWireFindsTheStartHolesCentreByContact) {
+  VirtualMachine m("wire-sim", seeded(1));
+  m.run_until(rt::TimePoint{std::chrono::milliseconds(5)});
+  rt::TimePoint now{std::chrono::milliseconds(5)};
+  auto request = [&](rt::ManualRequest r) {
+    const std::uint64_t seq = m.runtime->manual().request(r);
+    for (int k = 0; k < 120'000; ++k) {
+      now += std::chrono::milliseconds(1);
+      m.run_until(now);
+      const rt::ManualStatus st = m.runtime->manual().status();
+      if (st.seen_seq >= seq && !st.busy) return st.result;
+    }
+    ADD_FAILURE() << "manual request still busy";
+    return m.runtime->manual().status().result;
+  };
+  for (auto [axis, mm] : {std::pair{0, 0.13}, std::pair{1, -0.21}}) {
+    rt::ManualRequest jog;
+    jog.op = rt::ManualOp::kJogDistance;
+    jog.axis = static_cast<std::uint8_t>(axis);
+    jog.value = mm;
+    ASSERT_TRUE(request(jog).ok);
+  }
+  rt::ManualRequest touch;
+  touch.op = rt::ManualOp::kTouch;
+  touch.target = rt::TouchTarget::kCenter;
+  const rt::ManualResult r = request(touch);
+  ASSERT_TRUE(r.ok) << rt::to_string(r.error);
+  EXPECT_NEAR(r.x, -9.0, 0.003);
+  EXPECT_NEAR(r.y, 0.0, 0.003);
+  EXPECT_NEAR(r.size, 1.0, 0.005) << "the hole's diameter";
+  std::printf("start hole centre found at (%+.4f, %+.4f) mm of the truth, size %.4f mm\n",
+              r.x + 9.0, r.y, r.size);
+  const sim::PlantState& t = dynamic_cast<sim::SimDriver&>(m.runtime->driver()).plant().state();
+  EXPECT_EQ(t.pulses, 0U) << "the generator never on";
+}
+
 }  // namespace
 }  // namespace edm::test
