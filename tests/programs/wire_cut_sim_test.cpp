@@ -67,6 +67,7 @@ TEST_P(WirePunch, IsTenMillimetresAfterTheLastSkim) {
   ASSERT_TRUE(run.finished) << "seed " << seed << " " << run.where();
   const PunchSize s = measure_punch(run.plant().wire_plane(), 0.0, 0.0);
   print("skim 2", seed, s);
+  std::printf("seed %d: %.1f s of machining\n", seed, static_cast<double>(run.k) * 1e-3);
   for (double w : {s.x_min, s.x_max, s.y_min, s.y_max}) EXPECT_NEAR(w, 10.0, 0.005) << seed;
 }
 

@@ -65,8 +65,13 @@ class WirePlane {
  private:
   [[nodiscard]] double phi(double x, double y) const noexcept;  // bilinear
   [[nodiscard]] double cell_phi(long i, long j) const noexcept;
-  /// The nearest boundary point from (x, y) in the void, by the rays; false if none within 2 mm.
+  /// The nearest boundary point from (x, y) in the void, by the rays and then by halving the
+  /// angle about the best one; false if none within 2 mm.
   bool search(double x, double y, double& qx, double& qy) const noexcept;
+  /// Where the ray from (x, y) along (ux, uy) first meets material, marching from `lo` up to
+  /// `limit` (mm); kFar when it does not.
+  [[nodiscard]] double crossing(double x, double y, double ux, double uy, double lo,
+                                double limit) const noexcept;
 
   static constexpr int kDirections = 48;  // rays of the clearance, samples of the engaged arc
   std::array<double, kDirections> cos_{}, sin_{};
@@ -75,6 +80,10 @@ class WirePlane {
   double x0_{0.0}, y0_{0.0}, h_{0.0};
   std::vector<float> phi_;
   std::vector<float> phi0_;  // the field at the start (removed_mm3)
+  struct ShellCell {
+    double rho, m;  // distance from the erosion's centre, the cell's φ
+  };
+  std::vector<ShellCell> shell_;  // erode()'s cells near the boundary (allocated once)
   // The cache of clearance_mm(): where it searched, the boundary point it found.
   mutable bool cached_{false};
   mutable bool cached_none_{false};
