@@ -1,6 +1,7 @@
 #include "edm/hal/component.hpp"
 
 #include <hal.h>  // a system header (CMake): it trips -Wvolatile and -Wpedantic otherwise
+#include <rtapi.h>
 #include <sys/ipc.h>
 #include <sys/shm.h>
 
@@ -92,7 +93,12 @@ std::string Component::add_pin(std::string_view pin, HalType type, HalDir dir, P
 std::string Component::link(std::string_view pin, std::string_view signal, HalType type) {
   const std::string full = name_ + "." + std::string(pin);
   const std::string sig(signal);
+  // An existing signal (a .hal file netted the hardware first) is the usual case: quiet HAL's
+  // "duplicate signal" message for this one call.
+  const int level = rtapi_get_msg_level();
+  rtapi_set_msg_level(RTAPI_MSG_NONE);
   int rc = hal_signal_new(sig.c_str(), hal_type_of(type));
+  rtapi_set_msg_level(level);
   // -EINVAL: it exists already (of any type: hal_link says whether the types agree).
   if (rc != 0 && rc != -EINVAL) {
     return "HAL signal '" + sig + "' cannot be created: " + why(rc);

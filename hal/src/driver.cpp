@@ -210,13 +210,16 @@ void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
     online_.set(true);
     return;
   }
+  // age_: cycles since the last change (0 in the cycle that sees one). The first reading is no
+  // beat: until the first change the age counts from the first cycle.
   const std::uint32_t beat = pin_read_u32(slots_[heartbeat_]);
-  if (!beat_valid_ || beat != beat_seen_) {
-    if (beat_valid_) age_ = 0;  // the first reading is no beat: its age counts from start
-    beat_seen_ = beat;
-    beat_valid_ = true;
+  if (beat_valid_ && beat != beat_seen_) {
+    age_ = 0;
+  } else if (age_ < UINT64_MAX) {
+    ++age_;
   }
-  if (age_ < UINT64_MAX) ++age_;
+  beat_seen_ = beat;
+  beat_valid_ = true;
   const auto limit = static_cast<std::uint64_t>(params_.stale_cycles);
   online_.set(age_ <= limit);
   if (machine_ == nullptr) return;
@@ -237,7 +240,9 @@ void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
 }
 
 void HalDriver::write_outputs(const rt::CycleContext& ctx) noexcept {
-  const bool fault = rt::is_safe_state(ctx.state);
+  // The cycle that raises 121 already holds the safe values: the state the cycle started with
+  // (ctx.state) only becomes FAULT in the next one.
+  const bool fault = rt::is_safe_state(ctx.state) || stale_;
   const bool estop = ctx.state == rt::MachineState::kEstop;
   for (std::size_t i = 0; i < map_.size(); ++i) {
     const HalPin& m = map_[i];

@@ -93,8 +93,8 @@ HalPin parse_pin_entry(const rt::PinMapEntry& entry, std::size_t index,
                        " (bit, float, s32, u32)");
       }
     } else if (f.key == "direction") {
+      has_dir = true;
       if (f.value == "in" || f.value == "out") {
-        has_dir = true;
         m.input = f.value == "in";
       } else {
         err(f.key, "must be in (a machine input, read by edmplc) or out, got " +

@@ -40,10 +40,10 @@ const std::string kPins =
     "      - {name: beat, type: u32, direction: in, role: heartbeat}\n"
     "      - {name: gen_on, type: bit, direction: out, safe: false}\n"
     "      - {name: vz_cmd, type: float, direction: out, safe: 0, safe_in: estop, scale: 2}\n"
-    "      - {name: steps, type: s32, direction: out}\n"
+    "      - {name: steps, type: s32, direction: out, scale: 0.5}\n"
     "      - {name: plc_beat, type: u32, direction: out, role: heartbeat_out}\n";
 const std::string kWires =
-    "      io.gen_on: true\n      io.vz_cmd: -3.0\n      io.steps: 41.6\n";
+    "      io.gen_on: true\n      io.vz_cmd: -3.0\n      io.steps: 20.8\n";
 
 struct Built {
   std::unique_ptr<rt::Runtime> rt;
@@ -130,7 +130,7 @@ TEST(HalDriverDetached, InputsScaleCountAndOutputsHoldTheirSafeValues) {
   EXPECT_EQ(b.read("io.n_short"), 0.0) << "no new pulses";
   EXPECT_EQ(b.driver->raw(b.index("gen_on")), 1.0);
   EXPECT_EQ(b.driver->raw(b.index("vz_cmd")), -1.5) << "raw = value / scale";
-  EXPECT_EQ(b.driver->raw(b.index("steps")), 42.0) << "s32: rounded";
+  EXPECT_EQ(b.driver->raw(b.index("steps")), 42.0) << "s32: 20.8 / 0.5 rounded";
   const double beat0 = b.driver->raw(b.index("plc_beat"));
   b.cycles(1);
   EXPECT_EQ(b.driver->raw(b.index("plc_beat")), beat0 + 1.0) << "edmplc's heartbeat counts";
@@ -166,12 +166,15 @@ TEST(HalDriverDetached, AStoppedHeartbeatIsAlarm121AndTheSafeStateWithinStaleCyc
   while (b.rt->machine().state() == rt::MachineState::kReady && cycles_to_fault < 100) {
     b.cycles(1);
     ++cycles_to_fault;
+    if (cycles_to_fault <= 5) {
+      EXPECT_EQ(b.driver->raw(b.index("gen_on")), 1.0) << cycles_to_fault;
+    }
   }
   EXPECT_EQ(cycles_to_fault, 6) << "stale_cycles 5: the 6th cycle without a beat";
   EXPECT_EQ(b.rt->machine().state(), rt::MachineState::kFault);
   EXPECT_EQ(b.rt->machine().last_cause(), rt::AlarmCode::kIoStale);
   EXPECT_TRUE(b.has_alarm(rt::AlarmCode::kIoStale));
-  EXPECT_EQ(b.driver->raw(b.index("gen_on")), 0.0) << "generator off in the safe state";
+  EXPECT_EQ(b.driver->raw(b.index("gen_on")), 0.0) << "generator off in the cycle of the alarm";
   b.driver->set_raw(beat, 51.0);
   b.cycles(1);
   EXPECT_FALSE(b.has_alarm(rt::AlarmCode::kIoStale)) << "beats again: cleared";
@@ -193,7 +196,7 @@ TEST(HalDriverAttached, HalNotRunningIsAConfigErrorAtTheComponent) {
   const apps::RunResult r =
       apps::run({EDM_EDMPLC_PATH, "--config", path, "--run-for", "1s"}, o, std::chrono::seconds(30));
   EXPECT_EQ(r.exit_code, 2) << r.out;
-  EXPECT_NE(r.out.find(path + ":6:17: I/O driver 'hal': component: HAL is not running"),
+  EXPECT_NE(r.out.find(path + ":6:25: I/O driver 'hal': component HAL is not running"),
             std::string::npos)
       << r.out;
   fs::remove(path);
@@ -242,8 +245,8 @@ TEST_F(HalDriverAttachedTest, AComponentNameInUseIsAConfigError) {
   } catch (const rt::ConfigError& e) {
     const rt::Diagnostic& d = e.diagnostics().front();
     EXPECT_EQ(d.loc.line, 6) << d.message;
-    EXPECT_EQ(d.loc.col, 17) << d.message;
-    EXPECT_NE(d.message.find("component: HAL refused component 'edmtaken': the name is in use"),
+    EXPECT_EQ(d.loc.col, 25) << d.message;
+    EXPECT_NE(d.message.find("component HAL refused component 'edmtaken': the name is in use"),
               std::string::npos)
         << d.message;
   }
