@@ -70,9 +70,13 @@ class SilTest : public ::testing::Test {
 
   /// The plant's heartbeat signal changes (edm-sim-hal is stepping).
   bool plant_beats() {
-    const auto first = hal_->gets("edm-heartbeat");
-    return first && poll_until([&] { return hal_->gets("edm-heartbeat") != first; },
-                               std::chrono::seconds(10));
+    std::optional<std::string> first;
+    if (!poll_until([&] { return (first = hal_->gets("edm-heartbeat")).has_value(); },
+                    std::chrono::seconds(20), std::chrono::milliseconds(50))) {
+      return false;  // drill-sil.hal never netted it
+    }
+    return poll_until([&] { return hal_->gets("edm-heartbeat") != first; },
+                      std::chrono::seconds(10));
   }
   std::string plc_log() const { return edm::test::read_file(hal_->file("edmplc.log")); }
 
