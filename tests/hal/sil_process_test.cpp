@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <cstdlib>
 #include <optional>
 #include <regex>
 
@@ -141,9 +142,14 @@ TEST_F(SilTest, KillingEdmSimHalMidJobIsAlarm121AndTheSafeState) {
                                std::to_string(port_), "run", "--detach",
                                test::kSourceDir + "/examples/parts/demo.nc"},
       o));
-  ASSERT_TRUE(poll_until([&] { return hal_->gets("edm-gen-on") == "TRUE"; },
-                         std::chrono::seconds(60)))
-      << "the generator never sparked\n"
+  // Mid-hole: sparking, 1 mm deep (edm-sim-hal's truth pin, netted to edm-truth-depth).
+  ASSERT_TRUE(poll_until(
+      [&] {
+        const auto depth = hal_->gets("edm-truth-depth");
+        return hal_->gets("edm-gen-on") == "TRUE" && depth && std::atof(depth->c_str()) > 1.0;
+      },
+      std::chrono::seconds(60), std::chrono::milliseconds(100)))
+      << "the generator never sparked 1 mm deep\n"
       << plc_log();
   // The plant's pid: halcmd lists user components with theirs.
   const auto comps = hal_->halcmd({"-s", "show", "comp", "edm-sim"});
@@ -158,6 +164,8 @@ TEST_F(SilTest, KillingEdmSimHalMidJobIsAlarm121AndTheSafeState) {
   const Outcome s = status_until("state FAULT", std::chrono::seconds(2));
   EXPECT_NE(s.out.find("state FAULT"), std::string::npos) << s.out << "\n" << plc_log();
   EXPECT_NE(s.out.find("121"), std::string::npos) << s.out;
+  EXPECT_NE(s.out.find("io.hal(edmplc)"), std::string::npos) << s.out;
+  std::printf("%s", s.out.c_str());  // what docs/hal.md quotes
   EXPECT_EQ(hal_->gets("edm-gen-on").value_or("?"), "FALSE") << "generator off";
   EXPECT_EQ(hal_->gets("edm-gen-arm").value_or("?"), "FALSE");
   EXPECT_EQ(hal_->gets("edm-servo-ref-v").value_or("?").substr(0, 1), "0");
