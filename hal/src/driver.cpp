@@ -32,6 +32,12 @@ void HalDriverParams::visit(rt::ParamVisitor& v) {
   v.param("start_timeout", start_timeout,
           rt::load_time({"s", "before the first cycle, wait this long at most for the heartbeat",
                          rt::closed(0.0, 60.0)}));
+  v.param("pace_wait", pace_wait,
+          rt::load_time({"s",
+                         "> 0: each cycle first waits (spinning) up to this long for the next "
+                         "heartbeat, latching the inputs just after the HAL side's step; 0: "
+                         "free-running",
+                         rt::closed(0.0, 0.01)}));
   v.param("online_pin", online_pin,
           rt::load_time(
               {"", "name of a BOOL output pin, true while the heartbeat is fresh (\"\": none)"}));
@@ -90,6 +96,10 @@ std::vector<rt::ParamError> HalDriver::configure(const rt::BlockSetup& setup) {
       case IoType::kReal: add(real_in_, real_out_); break;
       case IoType::kInt: add(int_in_, int_out_); break;
     }
+  }
+  if (params_.pace_wait >= setup.period && setup.period.count() > 0) {
+    return {{"pace_wait", "must be shorter than the I/O task's interval (" +
+                              rt::format_duration(setup.period) + ")"}};
   }
   last_count_.assign(map_.size(), 0U);
   stale_source_ = "io.hal(" + params_.component + ")";
@@ -165,6 +175,9 @@ void HalDriver::activate() noexcept {
 }
 
 void HalDriver::start() {
+  if (params_.pace_wait.count() > 0 && heartbeat_ == SIZE_MAX) {
+    spdlog::warn("hal: pace_wait needs a heartbeat pin (role: heartbeat): free-running");
+  }
   if (heartbeat_ == SIZE_MAX || !attached()) return;
   const std::uint32_t first = pin_read_u32(slots_[heartbeat_]);
   const auto deadline = std::chrono::steady_clock::now() + params_.start_timeout;
@@ -182,6 +195,16 @@ void HalDriver::start() {
 void HalDriver::stop() noexcept { write_safe(true); }
 
 void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
+  if (params_.pace_wait.count() > 0 && heartbeat_ != SIZE_MAX && beat_valid_) {
+    const auto t0 = std::chrono::steady_clock::now();  // vDSO: no system call
+    while (pin_read_u32(slots_[heartbeat_]) == beat_seen_) {
+      if (std::chrono::steady_clock::now() - t0 >= params_.pace_wait) break;
+#if defined(__x86_64__) || defined(__i386__)
+      __builtin_ia32_pause();
+#endif
+    }
+    if (pin_read_u32(slots_[heartbeat_]) != beat_seen_) ++paced_;
+  }
   for (std::size_t i = 0; i < map_.size(); ++i) {
     const HalPin& m = map_[i];
     if (!m.input) continue;

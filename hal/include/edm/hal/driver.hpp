@@ -24,6 +24,10 @@
 // cycle while it lasts, so the safe state comes `stale_cycles + 1` cycles after the last beat.
 // An output with `role: heartbeat_out` counts edmplc's cycles for the HAL side's own watchdog.
 //
+// Pacing (`pace_wait` > 0): read_inputs() first spins (no system call, no lock) until the
+// heartbeat changes or pace_wait has passed, so the inputs are latched just after the HAL side's
+// step instead of up to a period later; it costs the CPU time of the wait (docs/hal.md "Timing").
+//
 // Thread-safety: the RT methods from the I/O task's thread; configure/start/stop from the
 // controlling thread.
 
@@ -43,6 +47,7 @@ struct HalDriverParams {
   std::string component{"edmplc"};
   std::int64_t stale_cycles{20};
   rt::Duration start_timeout{std::chrono::seconds(5)};
+  rt::Duration pace_wait{0};  // > 0: each cycle waits up to this long for the next heartbeat
   std::string online_pin;  // a BOOL output pin, true while the heartbeat is fresh; "" = none
 
   void visit(rt::ParamVisitor& v);
@@ -76,6 +81,8 @@ class HalDriver : public rt::BlockWithParams<HalDriverParams, rt::IoDriver> {
   /// Pin i's raw value. RT-safe.
   [[nodiscard]] double raw(std::size_t i) const noexcept { return pin_read(slots_[i]); }
   [[nodiscard]] bool attached() const noexcept { return component_.is_open(); }
+  /// Cycles whose pacing wait ended on a beat (not on pace_wait). I/O task's thread.
+  [[nodiscard]] std::uint64_t paced_cycles() const noexcept { return paced_; }
 
  private:
   struct Local {  // a detached pin's storage: the slot points at the value
@@ -111,6 +118,7 @@ class HalDriver : public rt::BlockWithParams<HalDriverParams, rt::IoDriver> {
   std::uint32_t beat_out_{0};
   bool beat_valid_{false};
   std::uint64_t age_{0};
+  std::uint64_t paced_{0};  // cycles whose wait saw the beat (pacing), for the statistics
   bool stale_{false};
   std::string stale_source_;  // "io.hal(<component>)": alarm sources live as long as this
 };
