@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
   }
   edm::apps::SpawnOptions o;
   o.out = edm::apps::Stream::kNull;
-  o.err = edm::apps::Stream::kNull;
+  o.err = edm::apps::Stream::kInherit;  // its log: the pacing statistics at the end
   edm::apps::Process plc({edmplc, "--config", config, "--bridge-port", "0"}, o);
   if (!plc.started()) {
     std::fprintf(stderr, "edm-bench-hal: %s\n", plc.error().c_str());
@@ -92,7 +92,8 @@ int main(int argc, char** argv) {
     edm::hal::pin_write_u32(beat, ++beats);  // the step is complete
     if (!sample) continue;
     Ns t1 = monotonic();
-    while (edm::hal::pin_read_u32(echo) != n && (t1 = monotonic()) - t0 < std::chrono::milliseconds(5)) {
+    while (edm::hal::pin_read_u32(echo) != n &&
+           (t1 = monotonic()) - t0 < std::chrono::milliseconds(5)) {
     }
     if (edm::hal::pin_read_u32(echo) != n) {
       if (up) ++lost;
@@ -112,11 +113,13 @@ int main(int argc, char** argv) {
   plc.stop();
   std::sort(rtt.begin(), rtt.end());
   const auto q = [&](double f) {
-    return rtt[std::min(rtt.size() - 1, static_cast<std::size_t>(f * static_cast<double>(rtt.size())))];
+    return rtt[std::min(rtt.size() - 1,
+                        static_cast<std::size_t>(f * static_cast<double>(rtt.size())))];
   };
   std::printf("config %s\nround trips %zu (lost %d)\n", config.c_str(), rtt.size(), lost);
-  std::printf("HAL stamp -> edmplc cycle -> HAL echo, us: min %.1f  median %.1f  p90 %.1f  p99 %.1f"
-              "  max %.1f\n",
-              us(rtt.front()), us(q(0.5)), us(q(0.9)), us(q(0.99)), us(rtt.back()));
+  std::printf(
+      "HAL stamp -> edmplc cycle -> HAL echo, us: min %.1f  median %.1f  p90 %.1f  p99 %.1f"
+      "  max %.1f\n",
+      us(rtt.front()), us(q(0.5)), us(q(0.9)), us(q(0.99)), us(rtt.back()));
   return 0;
 }

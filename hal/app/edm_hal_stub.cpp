@@ -1,7 +1,8 @@
 // edm-hal-stub: a HAL userspace component with the pins it is told, and nothing else, for loading
 // a hardware .hal file where the hardware is not (examples/hal/*-sim.hal, docs/hal.md): it stands
 // in for a card's driver (hm2_eth's hm2_7i96s.0.*) or the parallel port's with the same pin names.
-//   edm-hal-stub --name hm2_7i96s.0 stepgen.00.velocity-cmd:float:in stepgen.00.position-fb:float:out
+//   edm-hal-stub --name hm2_7i96s.0 stepgen.00.velocity-cmd:float:in
+//   stepgen.00.position-fb:float:out
 // A pin spec is NAME:TYPE:DIR (TYPE bit, float, s32, u32; DIR in or out, the card's own view).
 // Ends on SIGTERM/SIGINT.
 #include <unistd.h>
@@ -29,7 +30,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> specs;
   app.add_option("--name", name, "HAL component name; pins are <name>.<pin>")->required();
   app.add_option("pins", specs, "NAME:TYPE:DIR (bit|float|s32|u32, in|out)")->required();
-  if (const auto code = edm::apps::parse(app, argc, argv, "edm-hal-stub --name N PIN:TYPE:DIR...")) {
+  if (const auto code =
+          edm::apps::parse(app, argc, argv, "edm-hal-stub --name N PIN:TYPE:DIR...")) {
     return *code;
   }
   std::signal(SIGTERM, on_signal);
@@ -67,8 +69,8 @@ int main(int argc, char** argv) {
       return 2;
     }
     edm::hal::PinSlot slot;
-    if (const std::string e =
-            comp.add_pin(pin, t, dir == "in" ? edm::hal::HalDir::kIn : edm::hal::HalDir::kOut, slot);
+    if (const std::string e = comp.add_pin(
+            pin, t, dir == "in" ? edm::hal::HalDir::kIn : edm::hal::HalDir::kOut, slot);
         !e.empty()) {
       std::fprintf(stderr, "edm-hal-stub: %s\n", e.c_str());
       return 2;

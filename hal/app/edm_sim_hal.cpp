@@ -33,8 +33,7 @@ std::chrono::nanoseconds monotonic() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"The EDM plant simulator as a LinuxCNC HAL component (docs/hal.md)",
-               "edm-sim-hal"};
+  CLI::App app{"The EDM plant simulator as a LinuxCNC HAL component (docs/hal.md)", "edm-sim-hal"};
   edm::hal::SimComponentOptions o;
   std::int64_t period_us = 1000;
   std::int64_t plc_timeout_ms = 50;

@@ -105,8 +105,8 @@ std::string Component::link(std::string_view pin, std::string_view signal, HalTy
   }
   rc = hal_link(full.c_str(), sig.c_str());
   if (rc != 0) {
-    return "HAL pin '" + full + "' cannot be linked to signal '" + sig +
-           "': " + (rc == -EINVAL ? "the signal has another type or already has a writer" : why(rc));
+    return "HAL pin '" + full + "' cannot be linked to signal '" + sig + "': " +
+           (rc == -EINVAL ? "the signal has another type or already has a writer" : why(rc));
   }
   return {};
 }

@@ -49,8 +49,8 @@ std::vector<rt::ParamError> HalDriverParams::validate() const {
     errs.push_back({"component", "must be 1 to 40 characters (HAL names are at most 47)"});
   }
   for (const char c : component) {
-    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-          c == '-' || c == '_')) {
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+          c == '_')) {
       errs.push_back({"component", "must be letters, digits, '-' and '_'"});
       break;
     }
@@ -122,8 +122,8 @@ std::vector<rt::ParamError> HalDriver::attach() {
   for (std::size_t i = 0; i < map_.size(); ++i) {
     const HalPin& m = map_[i];
     const std::string at = "pins[" + std::to_string(i) + "] (io." + m.name + "): ";
-    if (std::string e = component_.add_pin(m.hal, m.type, m.input ? HalDir::kIn : HalDir::kOut,
-                                           slots_[i]);
+    if (std::string e =
+            component_.add_pin(m.hal, m.type, m.input ? HalDir::kIn : HalDir::kOut, slots_[i]);
         !e.empty()) {
       component_.close();
       return {{"", at + e}};
@@ -192,7 +192,13 @@ void HalDriver::start() {
                params_.component, map_[heartbeat_].hal, rt::format_duration(params_.start_timeout));
 }
 
-void HalDriver::stop() noexcept { write_safe(true); }
+void HalDriver::stop() noexcept {
+  write_safe(true);
+  if (params_.pace_wait.count() > 0) {
+    spdlog::info("hal: {} of {} cycles latched on a heartbeat within pace_wait {}", paced_, cycles_,
+                 rt::format_duration(params_.pace_wait));
+  }
+}
 
 void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
   if (params_.pace_wait.count() > 0 && heartbeat_ != SIZE_MAX && beat_valid_) {
@@ -205,6 +211,7 @@ void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
     }
     if (pin_read_u32(slots_[heartbeat_]) != beat_seen_) ++paced_;
   }
+  ++cycles_;
   for (std::size_t i = 0; i < map_.size(); ++i) {
     const HalPin& m = map_[i];
     if (!m.input) continue;
@@ -221,10 +228,10 @@ void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
       case IoType::kBool: bool_in_[k]->set(pin_read_u32(slots_[i]) != 0U); break;
       case IoType::kReal: real_in_[k]->set(pin_read(slots_[i]) * m.scale + m.offset); break;
       case IoType::kInt:
-        int_in_[k]->set(m.type == HalType::kS32
-                            ? static_cast<std::int64_t>(static_cast<std::int32_t>(
-                                  pin_read_u32(slots_[i])))
-                            : static_cast<std::int64_t>(pin_read_u32(slots_[i])));
+        int_in_[k]->set(
+            m.type == HalType::kS32
+                ? static_cast<std::int64_t>(static_cast<std::int32_t>(pin_read_u32(slots_[i])))
+                : static_cast<std::int64_t>(pin_read_u32(slots_[i])));
         break;
     }
   }

@@ -89,8 +89,8 @@ HalPin parse_pin_entry(const rt::PinMapEntry& entry, std::size_t index,
         m.type = HalType::kU32;
       } else {
         has_type = false;
-        err(f.key, "unknown HAL pin type " + machining::yaml::quote(f.value) +
-                       " (bit, float, s32, u32)");
+        err(f.key,
+            "unknown HAL pin type " + machining::yaml::quote(f.value) + " (bit, float, s32, u32)");
       }
     } else if (f.key == "direction") {
       has_dir = true;
@@ -140,9 +140,10 @@ HalPin parse_pin_entry(const rt::PinMapEntry& entry, std::size_t index,
       } else if (f.value == "heartbeat_out") {
         m.role = Role::kHeartbeatOut;
       } else {
-        err(f.key, "must be heartbeat (the HAL side's, an input) or heartbeat_out (edmplc's), "
-                   "got " +
-                       machining::yaml::quote(f.value));
+        err(f.key,
+            "must be heartbeat (the HAL side's, an input) or heartbeat_out (edmplc's), "
+            "got " +
+                machining::yaml::quote(f.value));
       }
     } else if (f.key == "unit") {
       m.unit = f.value;

@@ -15,9 +15,9 @@ struct SimComponent::Pins {
   PinSlot n[5], td_sum_ns, td_count, ratio[5], gap_voltage, short_now, hist_open, hist_short,
       hist_arc, rab;
   PinSlot pos_fb[3], ref[3], contact, drive_fault, heartbeat;
-  PinSlot vel_cmd[3], gen_arm, gen_on, polarity_positive, on_time_us, off_time_us,
-      arc_off_time_us, servo_ref_v, flushing_on, flushing_strength, rotation_on, touch_mode,
-      pos_set[3], pos_value[3], plc_heartbeat;
+  PinSlot vel_cmd[3], gen_arm, gen_on, polarity_positive, on_time_us, off_time_us, arc_off_time_us,
+      servo_ref_v, flushing_on, flushing_strength, rotation_on, touch_mode, pos_set[3],
+      pos_value[3], plc_heartbeat;
   PinSlot depth, wall, electrode, hole_x, hole_y;
 };
 
@@ -131,9 +131,9 @@ void SimComponent::step(std::chrono::nanoseconds t) noexcept {
     total_ns += s.time_ns[k];
   }
   for (std::size_t k = 0; k < 5; ++k) {
-    pin_write(p.ratio[k], total_ns > 0 ? static_cast<double>(s.time_ns[k]) /
-                                             static_cast<double>(total_ns)
-                                       : 0.0);
+    pin_write(p.ratio[k], total_ns > 0
+                              ? static_cast<double>(s.time_ns[k]) / static_cast<double>(total_ns)
+                              : 0.0);
   }
   counters_[5] += static_cast<std::uint32_t>(s.td_sum_ns);
   counters_[6] += static_cast<std::uint32_t>(s.td_count);

@@ -42,8 +42,7 @@ const std::string kPins =
     "      - {name: vz_cmd, type: float, direction: out, safe: 0, safe_in: estop, scale: 2}\n"
     "      - {name: steps, type: s32, direction: out, scale: 0.5}\n"
     "      - {name: plc_beat, type: u32, direction: out, role: heartbeat_out}\n";
-const std::string kWires =
-    "      io.gen_on: true\n      io.vz_cmd: -3.0\n      io.steps: 20.8\n";
+const std::string kWires = "      io.gen_on: true\n      io.vz_cmd: -3.0\n      io.steps: 20.8\n";
 
 struct Built {
   std::unique_ptr<rt::Runtime> rt;
@@ -103,9 +102,8 @@ TEST(HalConfig, BadConfigsAreRefusedAtFileLineColByEdmplcCheck) {
     const apps::RunResult r = apps::run({EDM_EDMPLC_PATH, "--config", e.path().string(), "--check"},
                                         o, std::chrono::seconds(30));
     EXPECT_EQ(r.exit_code, 2) << e.path() << "\n" << r.out;
-    EXPECT_NE(r.out.find(expect), std::string::npos)
-        << "expected: " << expect << "\ngot:\n"
-        << r.out;
+    EXPECT_NE(r.out.find(expect), std::string::npos) << "expected: " << expect << "\ngot:\n"
+                                                     << r.out;
   }
   EXPECT_GE(cases, 8);
 }
@@ -188,13 +186,11 @@ TEST(HalDriverDetached, AStoppedHeartbeatIsAlarm121AndTheSafeStateWithinStaleCyc
 TEST(HalDriverAttached, HalNotRunningIsAConfigErrorAtTheComponent) {
   if (hal_running()) GTEST_SKIP() << "a HAL session is running on this machine";
   const std::string path = (fs::temp_directory_path() / "edm-hal-not-running.yaml").string();
-  {
-    std::ofstream(path) << machine("edmtest", kPins, kWires);
-  }
+  { std::ofstream(path) << machine("edmtest", kPins, kWires); }
   apps::SpawnOptions o;
   o.err = apps::Stream::kStdout;
-  const apps::RunResult r =
-      apps::run({EDM_EDMPLC_PATH, "--config", path, "--run-for", "1s"}, o, std::chrono::seconds(30));
+  const apps::RunResult r = apps::run({EDM_EDMPLC_PATH, "--config", path, "--run-for", "1s"}, o,
+                                      std::chrono::seconds(30));
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_NE(r.out.find(path + ":6:25: I/O driver 'hal': component HAL is not running"),
             std::string::npos)
@@ -254,8 +250,7 @@ TEST_F(HalDriverAttachedTest, AComponentNameInUseIsAConfigError) {
 
 TEST_F(HalDriverAttachedTest, ALinkHalRefusesIsAConfigErrorNamingThePin) {
   ASSERT_TRUE(session_->halcmd({"newsig", "t-float", "float"}));
-  const std::string pins =
-      "      - {name: gen_on, type: bit, direction: out, signal: t-float}\n";
+  const std::string pins = "      - {name: gen_on, type: bit, direction: out, signal: t-float}\n";
   try {
     Built b(machine("edmlink", pins), true);
     ADD_FAILURE() << "a bit pin was linked to a float signal";

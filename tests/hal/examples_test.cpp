@@ -15,9 +15,9 @@ using test::HalSession;
 using test::poll_until;
 
 struct Board {
-  const char* file;      // examples/hal/<file>-sim.hal
-  const char* vel_pin;   // the card's pin edm-x-vel-cmd must reach
-  const char* gen_pin;   // the card's pin edm-gen-on must reach
+  const char* file;     // examples/hal/<file>-sim.hal
+  const char* vel_pin;  // the card's pin edm-x-vel-cmd must reach
+  const char* gen_pin;  // the card's pin edm-gen-on must reach
 };
 
 void PrintTo(const Board& b, std::ostream* os) { *os << b.file; }
@@ -32,8 +32,8 @@ TEST_P(HalExamples, LoadsWithStandInsAndEdmplcLinksToItsSignals) {
   ASSERT_TRUE(poll_until([&] { return (first = hal.gets("edm-heartbeat")).has_value(); },
                          std::chrono::seconds(20), std::chrono::milliseconds(50)))
       << hal.log();
-  ASSERT_TRUE(poll_until([&] { return hal.gets("edm-heartbeat") != first; },
-                         std::chrono::seconds(10)))
+  ASSERT_TRUE(
+      poll_until([&] { return hal.gets("edm-heartbeat") != first; }, std::chrono::seconds(10)))
       << "the servo thread's heartbeat does not count\n"
       << hal.log();
   const auto vel = hal.halcmd({"-s", "show", "sig", "edm-x-vel-cmd"});
@@ -45,7 +45,8 @@ TEST_P(HalExamples, LoadsWithStandInsAndEdmplcLinksToItsSignals) {
   EXPECT_EQ(hal.log().find("rror"), std::string::npos) << hal.log();
 
   // No electrode sensor on these boards: drill-hal.yaml's electrode check reads the simulator's
-  // truth signal, a HAL constant here: a new electrode's 300 mm (docs/hal.md says what a real machine wires).
+  // truth signal, a HAL constant here: a new electrode's 300 mm (docs/hal.md says what a real
+  // machine wires).
   ASSERT_TRUE(hal.halcmd({"loadrt", "constant"}));
   ASSERT_TRUE(hal.halcmd({"setp", "constant.0.value", "300"}));
   ASSERT_TRUE(hal.halcmd({"addf", "constant.0", "servo-thread"}));
@@ -54,10 +55,10 @@ TEST_P(HalExamples, LoadsWithStandInsAndEdmplcLinksToItsSignals) {
   o.err = apps::Stream::kStdout;
   o.set_env = hal.env();
   o.unset_env = {"EDM_STATE_DIR"};
-  const apps::RunResult r = apps::run(
-      {EDM_EDMPLC_PATH, "--config", test::kSourceDir + "/config/machines/drill-hal.yaml",
-       "--bridge-port", "0", "--run-for", "1s"},
-      o, std::chrono::seconds(60));
+  const apps::RunResult r =
+      apps::run({EDM_EDMPLC_PATH, "--config", test::kSourceDir + "/config/machines/drill-hal.yaml",
+                 "--bridge-port", "0", "--run-for", "1s"},
+                o, std::chrono::seconds(60));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_EQ(r.out.find("cannot be linked"), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("ALARM 121"), std::string::npos) << r.out;

@@ -30,8 +30,7 @@ using namespace std::chrono_literals;
 using Env = std::vector<std::pair<std::string, std::string>>;
 
 inline const std::string kSourceDir = EDM_SOURCE_DIR;
-inline const std::string kBinDir =
-    std::filesystem::path(EDM_EDMPLC_PATH).parent_path().string();
+inline const std::string kBinDir = std::filesystem::path(EDM_EDMPLC_PATH).parent_path().string();
 
 /// The environment every HAL process of a test gets (rtapi_app's, halcmd's, edmplc's).
 inline Env hal_env(const std::string& fifo_dir) {
@@ -73,8 +72,8 @@ class HalSession {
     o.out_file = o.err_file = dir_.file("halrun.log");
     o.set_env = env_;
     proc_ = std::make_unique<apps::Process>(
-        std::vector<std::string>{"bash", "-c", "cd " + kSourceDir + " && exec halrun -I -f " +
-                                                   hal_file},
+        std::vector<std::string>{"bash", "-c",
+                                 "cd " + kSourceDir + " && exec halrun -I -f " + hal_file},
         o);
     if (!proc_->started()) {
       error_ = proc_->error();

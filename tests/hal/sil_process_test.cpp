@@ -111,8 +111,7 @@ class SilTest : public ::testing::Test {
 // The acceptance of issue 36: the demo hole through HAL, as on the in-process simulator
 // (README's report: 12.0030 mm deep, wall 0.5996 mm, no alarms).
 TEST_F(SilTest, TheDemoHoleIsDrilledAndFinishedThroughHal) {
-  const Outcome r =
-      edmhmi({"run", test::kSourceDir + "/examples/parts/demo.nc"}, 240000);
+  const Outcome r = edmhmi({"run", test::kSourceDir + "/examples/parts/demo.nc"}, 240000);
   ASSERT_EQ(r.code, 0) << r.out << "\n--- edmplc\n" << plc_log();
   EXPECT_NE(r.out.find("job report: " + test::kSourceDir + "/examples/parts/demo.nc on drill-hal"),
             std::string::npos)

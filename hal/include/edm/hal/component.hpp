@@ -45,8 +45,7 @@ struct PinSlot {
   void* const v = *p.slot;
   switch (p.type) {
     case HalType::kBit: return *static_cast<volatile bool*>(v) ? 1U : 0U;
-    case HalType::kS32:
-      return static_cast<std::uint32_t>(*static_cast<volatile std::int32_t*>(v));
+    case HalType::kS32: return static_cast<std::uint32_t>(*static_cast<volatile std::int32_t*>(v));
     case HalType::kU32: return *static_cast<volatile std::uint32_t*>(v);
     case HalType::kFloat: break;
   }
@@ -85,8 +84,7 @@ class Component {
   /// Joins HAL as `name`; "" on success, else why not (HAL not running, the name in use, ...).
   [[nodiscard]] std::string open(const std::string& name);
   /// Creates `<name>.<pin>`; "" on success. The slot stays valid until close().
-  [[nodiscard]] std::string add_pin(std::string_view pin, HalType type, HalDir dir,
-                                    PinSlot& out);
+  [[nodiscard]] std::string add_pin(std::string_view pin, HalType type, HalDir dir, PinSlot& out);
   /// Links the pin `<name>.<pin>` to signal `signal`, created with `type` when absent; "" on
   /// success, else why not (a signal of another type, a second writer).
   [[nodiscard]] std::string link(std::string_view pin, std::string_view signal, HalType type);

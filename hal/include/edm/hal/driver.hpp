@@ -48,7 +48,7 @@ struct HalDriverParams {
   std::int64_t stale_cycles{20};
   rt::Duration start_timeout{std::chrono::seconds(5)};
   rt::Duration pace_wait{0};  // > 0: each cycle waits up to this long for the next heartbeat
-  std::string online_pin;  // a BOOL output pin, true while the heartbeat is fresh; "" = none
+  std::string online_pin;     // a BOOL output pin, true while the heartbeat is fresh; "" = none
 
   void visit(rt::ParamVisitor& v);
   [[nodiscard]] std::vector<rt::ParamError> validate() const;
@@ -118,7 +118,8 @@ class HalDriver : public rt::BlockWithParams<HalDriverParams, rt::IoDriver> {
   std::uint32_t beat_out_{0};
   bool beat_valid_{false};
   std::uint64_t age_{0};
-  std::uint64_t paced_{0};  // cycles whose wait saw the beat (pacing), for the statistics
+  std::uint64_t paced_{0};   // cycles whose wait saw the beat (pacing), for the statistics
+  std::uint64_t cycles_{0};  // read_inputs() calls
   bool stale_{false};
   std::string stale_source_;  // "io.hal(<component>)": alarm sources live as long as this
 };
