@@ -33,19 +33,33 @@ TEST(AllocationsHal, NoneInsideCyclesIdleInAJobAndWhenTheHeartbeatStops) {
   r->machine().command(rt::MachineCommand::kPowerOn);
   auto& d = dynamic_cast<hal::HalDriver&>(r->driver());
   std::size_t beat = 0;
-  std::size_t z = 0;
-  for (std::size_t i = 0; i < d.pin_map().size(); ++i) {
-    if (d.pin_map()[i].name == "hal_heartbeat") beat = i;
-    if (d.pin_map()[i].name == "z_mm") z = i;
+  std::size_t electrode = 0;
+  std::array<std::size_t, 3> pos{};
+  std::array<std::size_t, 3> vel{};
+  const auto& map = d.pin_map();
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    if (map[i].name == "hal_heartbeat") beat = i;
+    if (map[i].name == "electrode_mm") electrode = i;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const std::string axis(1, "xyz"[a]);
+      if (map[i].name == axis + "_mm") pos[a] = i;
+      if (map[i].name == "v" + axis + "_cmd") vel[a] = i;
+    }
   }
-  d.set_raw(z, 5.0);
+  d.set_raw(pos[2], 5.0);
+  d.set_raw(electrode, 300.0);  // edm-sim-hal's truth.electrode-mm: a new electrode
   rt::VirtualClock clock;
   std::int64_t k = 0;
   std::uint32_t beats = 0;
   const auto run = [&](int n, bool beating) {
     std::size_t total = 0;
     for (int i = 0; i < n; ++i, ++k) {
-      if (beating) d.set_raw(beat, ++beats);  // the HAL side, between cycles
+      if (beating) {  // the HAL side, between cycles: the beat, and drives that follow
+        d.set_raw(beat, ++beats);
+        for (std::size_t a = 0; a < 3; ++a) {
+          d.set_raw(pos[a], d.raw(pos[a]) + d.raw(vel[a]) * 0.001);
+        }
+      }
       const rt::TimePoint release{1ms * k};
       clock.advance_to(release);
       total += allocations_in([&] {
