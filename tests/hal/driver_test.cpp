@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -180,6 +181,23 @@ TEST(HalDriverDetached, AStoppedHeartbeatIsAlarm121AndTheSafeStateWithinStaleCyc
   b.driver->set_raw(beat, 52.0);
   b.cycles(1);
   EXPECT_EQ(b.rt->machine().state(), rt::MachineState::kReady);
+}
+
+// Pacing: a cycle whose heartbeat has not moved waits pace_wait (then goes on: the stale check
+// counts it); one whose heartbeat moved since the last cycle latches at once and counts as paced.
+TEST(HalDriverDetached, PacingWaitsForTheBeatAtMostPaceWait) {
+  Built b(machine("edmtest", kPins, kWires, "pace_wait: 0.5ms"), false);
+  const std::size_t beat = b.index("beat");
+  b.driver->set_raw(beat, 1.0);
+  b.cycles(1);  // the first reading: no wait (no beat seen yet)
+  const auto t0 = std::chrono::steady_clock::now();
+  b.cycles(1);  // the beat has not moved: waits pace_wait
+  const auto waited = std::chrono::steady_clock::now() - t0;
+  EXPECT_GE(waited, std::chrono::microseconds(500));
+  EXPECT_EQ(b.driver->paced_cycles(), 0u);
+  b.driver->set_raw(beat, 2.0);
+  b.cycles(1);  // it moved: latched at once, on the beat
+  EXPECT_EQ(b.driver->paced_cycles(), 1u);
 }
 
 // Without a HAL session, an attached build refuses at the config (edmplc: exit 2).
