@@ -37,7 +37,7 @@ void HalDriverParams::visit(rt::ParamVisitor& v) {
                          "> 0: each cycle first waits (spinning) up to this long for the next "
                          "heartbeat, latching the inputs just after the HAL side's step; 0: "
                          "free-running",
-                         rt::closed(0.0, 0.01)}));
+                         rt::closed(0.0, 1.0)}));
   v.param("online_pin", online_pin,
           rt::load_time(
               {"", "name of a BOOL output pin, true while the heartbeat is fresh (\"\": none)"}));
@@ -201,15 +201,18 @@ void HalDriver::stop() noexcept {
 }
 
 void HalDriver::read_inputs(const rt::CycleContext& ctx) noexcept {
-  if (params_.pace_wait.count() > 0 && heartbeat_ != SIZE_MAX && beat_valid_) {
+  if (params_.pace_wait.count() > 0 && heartbeat_ != SIZE_MAX) {
+    // The HAL side's next step after this cycle's release: waiting for one newer than the last
+    // cycle's would not wait at all once the phase puts the step before the release.
+    const std::uint32_t at_release = pin_read_u32(slots_[heartbeat_]);
     const auto t0 = std::chrono::steady_clock::now();  // vDSO: no system call
-    while (pin_read_u32(slots_[heartbeat_]) == beat_seen_) {
+    while (pin_read_u32(slots_[heartbeat_]) == at_release) {
       if (std::chrono::steady_clock::now() - t0 >= params_.pace_wait) break;
 #if defined(__x86_64__) || defined(__i386__)
       __builtin_ia32_pause();
 #endif
     }
-    if (pin_read_u32(slots_[heartbeat_]) != beat_seen_) ++paced_;
+    if (pin_read_u32(slots_[heartbeat_]) != at_release) ++paced_;
   }
   ++cycles_;
   for (std::size_t i = 0; i < map_.size(); ++i) {

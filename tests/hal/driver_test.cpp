@@ -8,10 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <thread>
 
 #include "edm/runtime/loopback_driver.hpp"
 #include "edm/runtime/runtime.hpp"
@@ -25,10 +27,12 @@ using test::HalSession;
 
 // A machine of the hal driver with one task; pins and wires as given.
 std::string machine(const std::string& component, const std::string& pins,
-                    const std::string& wires = "", const std::string& params = "") {
+                    const std::string& wires = "", const std::string& params = "",
+                    const std::string& interval = "1ms") {
   return "version: 1\nmachine:\n  name: haltest\n  io:\n    driver: hal\n    params: {component: " +
          component + (params.empty() ? "" : ", " + params) + "}\n    pins:\n" + pins +
-         "tasks:\n  - {name: t, interval: 1ms, priority: 0, programs: [p]}\nprograms:\n"
+         "tasks:\n  - {name: t, interval: " + interval +
+         ", priority: 0, programs: [p]}\nprograms:\n"
          "  - name: p\n    blocks: []\n" +
          (wires.empty() ? "" : "    wires:\n" + wires);
 }
@@ -183,21 +187,39 @@ TEST(HalDriverDetached, AStoppedHeartbeatIsAlarm121AndTheSafeStateWithinStaleCyc
   EXPECT_EQ(b.rt->machine().state(), rt::MachineState::kReady);
 }
 
-// Pacing: a cycle whose heartbeat has not moved waits pace_wait (then goes on: the stale check
-// counts it); one whose heartbeat moved since the last cycle latches at once and counts as paced.
-TEST(HalDriverDetached, PacingWaitsForTheBeatAtMostPaceWait) {
-  Built b(machine("edmtest", kPins, kWires, "pace_wait: 0.5ms"), false);
+// Pacing: a cycle waits for the HAL side's next beat after its release, at most pace_wait. No beat:
+// it waits pace_wait and goes on; a beat before the release is not the next one. A beat another
+// thread writes 5 ms into the wait ends it (a 200 ms task and a 100 ms pace_wait: a loaded host's
+// thread wake-ups, several ms here, stay inside the window).
+TEST(HalDriverDetached, PacingWaitsForTheNextBeatAtMostPaceWait) {
+  Built b(machine("edmtest", kPins, kWires, "pace_wait: 100ms, stale_cycles: 100", "200ms"), false);
   const std::size_t beat = b.index("beat");
   b.driver->set_raw(beat, 1.0);
-  b.cycles(1);  // the first reading: no wait (no beat seen yet)
-  const auto t0 = std::chrono::steady_clock::now();
-  b.cycles(1);  // the beat has not moved: waits pace_wait
-  const auto waited = std::chrono::steady_clock::now() - t0;
-  EXPECT_GE(waited, std::chrono::microseconds(500));
+  b.cycles(1);
+  auto t0 = std::chrono::steady_clock::now();
+  b.cycles(1);  // no beat comes: waits pace_wait
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(100));
   EXPECT_EQ(b.driver->paced_cycles(), 0u);
   b.driver->set_raw(beat, 2.0);
-  b.cycles(1);  // it moved: latched at once, on the beat
-  EXPECT_EQ(b.driver->paced_cycles(), 1u);
+  t0 = std::chrono::steady_clock::now();
+  b.cycles(1);  // a beat before the release is not the next one: waits again
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(100));
+  EXPECT_EQ(b.driver->paced_cycles(), 0u);
+  std::atomic<bool> go{false};
+  std::thread hal_side([&] {
+    while (!go.load()) {
+      std::this_thread::yield();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));  // the HAL side's step time
+    b.driver->set_raw(beat, 3.0);
+  });
+  go.store(true);
+  t0 = std::chrono::steady_clock::now();
+  b.cycles(1);
+  const auto waited = std::chrono::steady_clock::now() - t0;
+  hal_side.join();
+  EXPECT_EQ(b.driver->paced_cycles(), 1u) << "the wait ended on the beat";
+  EXPECT_LT(waited, std::chrono::milliseconds(100));
 }
 
 // Without a HAL session, an attached build refuses at the config (edmplc: exit 2).

@@ -25,8 +25,9 @@
 // An output with `role: heartbeat_out` counts edmplc's cycles for the HAL side's own watchdog.
 //
 // Pacing (`pace_wait` > 0): read_inputs() first spins (no system call, no lock) until the
-// heartbeat changes or pace_wait has passed, so the inputs are latched just after the HAL side's
-// step instead of up to a period later; it costs the CPU time of the wait (docs/hal.md "Timing").
+// heartbeat changes from its value at the cycle's release, or pace_wait has passed, so the inputs
+// are latched just after the HAL side's next step instead of up to a period later; it costs the
+// CPU time of the wait, every cycle (docs/hal.md "Pacing edmplc").
 //
 // Thread-safety: the RT methods from the I/O task's thread; configure/start/stop from the
 // controlling thread.
