@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <optional>
 #include <regex>
+#include <sstream>
 
 #include "edm/apps/free_port.hpp"
 #include "hal/hal_session.hpp"
@@ -125,7 +126,18 @@ TEST_F(SilTest, TheDemoHoleIsDrilledAndFinishedThroughHal) {
   EXPECT_NEAR(*depth, 12.0, 0.010) << r.out;
   EXPECT_NEAR(*reached, 12.0, 0.010) << r.out;
   EXPECT_NEAR(*wall, 0.600, 0.005) << r.out;
-  EXPECT_NE(r.out.find("alarms                  none"), std::string::npos) << r.out;
+  // No alarm, save the host-stall warning (102, tolerated by drill-hal.yaml's watchdog) a loaded
+  // host gives a wall-clock run: every alarm line under the row must be one.
+  const auto at = r.out.find("  alarms                  ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  std::istringstream rest(r.out.substr(at));
+  std::string line;
+  std::getline(rest, line);
+  if (line.find("none") == std::string::npos) {
+    while (std::getline(rest, line) && line.rfind("    ", 0) == 0) {
+      EXPECT_NE(line.find("102 host_stall (warning"), std::string::npos) << r.out;
+    }
+  }
   std::printf("%s", r.out.c_str());  // the figures docs/hal.md quotes
 }
 
