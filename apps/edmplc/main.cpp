@@ -20,6 +20,9 @@
 #include "edm/apps/cli.hpp"
 #include "edm/blocks/register.hpp"
 #include "edm/bridge/server.hpp"
+#ifdef EDM_HAVE_HAL
+#include "edm/hal/driver.hpp"
+#endif
 #include "edm/modbus/driver.hpp"
 #include "edm/modbus/server.hpp"
 #include "edm/programs/register.hpp"
@@ -190,6 +193,10 @@ int main(int argc, char** argv) {
   edm::rt::register_runtime_drivers(drivers);
   edm::sim::register_sim_driver(drivers);
   edm::modbus::register_modbus_driver(drivers);
+#ifdef EDM_HAVE_HAL
+  // Attached only when edmplc is going to run: --check and the listings need no HAL session.
+  edm::hal::register_hal_driver(drivers, !opt.check && !opt.list_vars && !opt.modbus_map);
+#endif
 
   std::unique_ptr<edm::rt::Runtime> rt;
   // `mqtt:` (docs/mqtt.md), checked against the built runtime's variables.

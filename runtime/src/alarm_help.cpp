@@ -29,9 +29,11 @@ AlarmHelp alarm_help(AlarmCode code) noexcept {
               "check the drive and the generator, their cables and power; then reset"};
     case AlarmCode::kIoStale:
       return {
-          "a field-bus image is older than its stale_cycles limit: the remote I/O stopped "
-          "answering (the value is the age in cycles)",
-          "check the remote I/O's power and network cable; reset once it answers again"};
+          "a field-bus image is older than its stale_cycles limit, or the HAL side's "
+          "heartbeat stopped: the remote I/O or the HAL component (a card's driver, "
+          "edm-sim-hal) stopped answering (the value is the age in cycles)",
+          "check the remote I/O's power and network cable, or the HAL session (halcmd show "
+          "comp); reset once it answers again"};
     case AlarmCode::kEstop:
       return {"the emergency stop was pressed or requested",
               "make the machine safe, release the E-stop, then reset"};
