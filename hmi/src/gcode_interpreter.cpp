@@ -89,9 +89,10 @@ GcodeResult Interpreter::run() {
                    [](const GcodeError& a, const GcodeError& b) {
                      return a.line != b.line ? a.line < b.line : a.col < b.col;
                    });
-  if (too_many_) {
+  if (too_many_) {  // after the last one reported (a subprogram's may lie past where it stopped)
+    const int at = std::max(line_no, result_.errors.empty() ? 1 : result_.errors.back().line);
     result_.errors.push_back(
-        {line_no, 1, "too many errors (" + std::to_string(opt_.max_errors) + "), stopping"});
+        {at, 1, "too many errors (" + std::to_string(opt_.max_errors) + "), stopping"});
   }
   if (!result_.errors.empty()) {
     result_.blocks.clear();

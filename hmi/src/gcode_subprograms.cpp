@@ -2,7 +2,8 @@
 // definition, `M99` alone on a line closes it; the lines between are its body, run by
 // `M98 P<n> [L<k>]` k times (a skim pass over the same contour). Definitions may stand anywhere,
 // after M30 too, and are skipped where they stand. Calls nest up to kMaxDepth deep; the lines run
-// through calls are bounded, so no program makes the interpreter loop without end.
+// through calls are bounded (100 000), so no program makes the interpreter loop without end or
+// fill memory with blocks.
 
 #include <string>
 
@@ -12,7 +13,7 @@
 namespace edm::hmi::detail {
 namespace {
 constexpr int kMaxDepth = 8;
-constexpr std::size_t kMaxCalledLines = 1'000'000;
+constexpr std::size_t kMaxCalledLines = 100'000;
 constexpr double kMaxRepeats = 1000.0;
 }  // namespace
 
@@ -115,7 +116,7 @@ void Interpreter::call_subprogram(const Block& b) {
   for (int k = 0; k < static_cast<int>(repeats) && !stop_; ++k) {
     for (int line = def.first; line <= def.last && !stop_; ++line) {
       if (++lines_called_ > kMaxCalledLines) {
-        error(b, b.sub_m, "subprogram calls run more than 1000000 lines: the program is refused");
+        error(b, b.sub_m, "subprogram calls run more than 100000 lines: the program is refused");
         stop_ = true;
         break;
       }
